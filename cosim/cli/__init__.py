@@ -1,0 +1,1 @@
+"""Command-line interface: ``cosim pour | validate | bench | stress | replay | view``."""
