@@ -1,0 +1,8 @@
+"""warp-lang SPH liquid: weakly compressible SPH with moving rigid vessels as boundaries.
+
+One code path for 2-D (the pour plane, world x-z at y = 0) and 3-D. No MuJoCo imports here: the coupling layer
+sets vessel poses and reads back the liquid's wrench on each vessel.
+
+Public API: :class:`FluidConfig`, :class:`KernelType`, :class:`PressureSolver` (``cosim.fluid.config``),
+:class:`FluidSolver` (``cosim.fluid.solver``), the particle seeders in ``cosim.fluid.seeding``.
+"""

@@ -1,0 +1,339 @@
+"""Moving rigid vessels as SPH boundaries (warp side).
+
+Per vessel: its geometry (:class:`VesselGeometry`, vessel frame) and its motion over one coupling interval
+(:class:`VesselMotion`): the interval's start pose (p0, R0) and a constant linear velocity v and angular velocity
+w (world frame), set from outside before each interval, so that the pose at time tau into the interval is
+p(tau) = p0 + v tau, R(tau) = exp([w] tau) R0. The dummy wall particles ride on that motion with velocity
+v + w x (x_b - p). Their pressure is extrapolated from the liquid each substep (Adami, Hu & Adams 2012):
+p_w = (sum_f p_f W_wf + (g - a_w) . sum_f rho_f (x_w - x_f) W_wf) / sum_f W_wf, clamped at 0 so walls never
+pull on the liquid, with a_w the wall's acceleration; and a no-slip velocity 2 v_wall - (sum_f v_f W_wf /
+sum_f W_wf) is extrapolated for the viscous terms.
+
+The non-penetration guard (:func:`guard_vessel`) runs after every position update: a particle whose path from its
+old position (in the vessel frame at the old pose) to its new one (in the frame at the new pose) enters the wall
+solid is put back on the side it came from, just outside the face it crossed, and loses its velocity into that
+face relative to the wall. This also catches a particle that would pass through a thin wall within one step.
+"""
+
+from __future__ import annotations
+
+import warp as wp
+
+from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
+from cosim.fluid.params import SPHParams
+from cosim.fluid.sph_kernels import kernel_w
+
+SHAPE_BOX = 0
+SHAPE_CYLINDER = 1
+
+
+@wp.struct
+class VesselGeometry:
+    """Vessel frame geometry (m). shape: SHAPE_BOX or SHAPE_CYLINDER (a cylinder is a box section in 2-D).
+
+    half_width: b = inner_width / 2 (a cylinder's inner radius); half_depth: inner_depth / 2 (box, 3-D);
+    height: inner height H; thickness: wall thickness the liquid sees (the dummy layers', if thicker than the
+    vessel's own); com: centre of mass in the vessel frame (torque point).
+    """
+
+    shape: int
+    half_width: float
+    half_depth: float
+    height: float
+    thickness: float
+    com: wp.vec3
+
+
+@wp.struct
+class VesselMotion:
+    """Rigid motion over one interval (world frame): start pose, constant velocities, the acceleration estimated
+    from the change of velocity since the previous interval (m/s^2, rad/s^2), and the poses at the current
+    substep's start/end."""
+
+    p0: wp.vec3
+    r0: wp.mat33
+    lin_vel: wp.vec3
+    ang_vel: wp.vec3
+    lin_acc: wp.vec3
+    ang_acc: wp.vec3
+    p_now: wp.vec3
+    r_now: wp.mat33
+    p_next: wp.vec3
+    r_next: wp.mat33
+
+
+@wp.func
+def rotation_exp(w: wp.vec3, tau: float) -> wp.mat33:
+    """exp([w] tau): rotation by angle |w| tau about w (Rodrigues)."""
+    angle = wp.length(w) * tau
+    if angle < 1.0e-12:
+        return wp.identity(n=3, dtype=float)
+    k = wp.normalize(w)
+    kx = wp.skew(k)
+    return wp.identity(n=3, dtype=float) + wp.sin(angle) * kx + (1.0 - wp.cos(angle)) * (kx @ kx)
+
+
+@wp.kernel
+def advance_vessel_poses(
+    # State in
+    substep: wp.array(dtype=wp.int32),
+    dt: wp.array(dtype=float),
+    # State in/out
+    motions: wp.array(dtype=VesselMotion),
+):
+    """Poses at the start (tau = s dt) and end (tau = (s + 1) dt) of substep s of the interval."""
+    k = wp.tid()
+    m = motions[k]
+    tau = float(substep[0]) * dt[0]
+    m.p_now = m.p0 + m.lin_vel * tau
+    m.r_now = rotation_exp(m.ang_vel, tau) @ m.r0
+    m.p_next = m.p0 + m.lin_vel * (tau + dt[0])
+    m.r_next = rotation_exp(m.ang_vel, tau + dt[0]) @ m.r0
+    motions[k] = m
+
+
+@wp.kernel
+def place_wall_particles(
+    # Model
+    local_pos: wp.array(dtype=wp.vec3),
+    vessel_of: wp.array(dtype=wp.int32),
+    # State in
+    motions: wp.array(dtype=VesselMotion),
+    # Out
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+):
+    """World position and velocity of each wall sample at the current substep's start pose."""
+    b = wp.tid()
+    m = motions[vessel_of[b]]
+    arm = m.r_now @ local_pos[b]
+    x[b] = m.p_now + arm
+    v[b] = m.lin_vel + wp.cross(m.ang_vel, arm)
+
+
+@wp.kernel
+def extrapolate_wall_state(
+    # Model
+    prm: SPHParams,
+    g: GridSpec,
+    b_vessel: wp.array(dtype=wp.int32),
+    # State in
+    motions: wp.array(dtype=VesselMotion),
+    bx: wp.array(dtype=wp.vec3),
+    bv: wp.array(dtype=wp.vec3),
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    p: wp.array(dtype=float),
+    cell_start: wp.array(dtype=wp.int32),
+    cell_end: wp.array(dtype=wp.int32),
+    # Out
+    b_p: wp.array(dtype=float),
+    b_rho: wp.array(dtype=float),
+    b_v_noslip: wp.array(dtype=wp.vec3),
+):
+    """Pressure, density and no-slip velocity of each dummy wall particle from the liquid around it."""
+    b = wp.tid()
+    xb = bx[b]
+    m = motions[b_vessel[b]]
+    arm = xb - m.p_now
+    a_wall = m.lin_acc + wp.cross(m.ang_acc, arm) + wp.cross(m.ang_vel, wp.cross(m.ang_vel, arm))
+    support2 = prm.support * prm.support
+    sum_w = float(0.0)
+    sum_pw = float(0.0)
+    sum_rho_r = wp.vec3(0.0)
+    sum_v = wp.vec3(0.0)
+    c = grid_cell(g, xb)
+    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
+        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
+            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
+                cell = grid_index(g, cx, cy, cz)
+                for f in range(cell_start[cell], cell_end[cell]):
+                    r = xb - x[f]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2:
+                        continue
+                    w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                    sum_w += w
+                    sum_pw += p[f] * w
+                    sum_rho_r += (rho[f] * w) * r
+                    sum_v += w * v[f]
+    pw = float(0.0)
+    v_noslip = bv[b]
+    if sum_w > 0.0:
+        pw = wp.max((sum_pw + wp.dot(prm.gravity - a_wall, sum_rho_r)) / sum_w, 0.0)
+        v_noslip = 2.0 * bv[b] - sum_v / sum_w
+    b_p[b] = pw
+    b_rho[b] = prm.rest_density * wp.pow(1.0 + pw / prm.eos_b, 1.0 / prm.gamma)
+    b_v_noslip[b] = v_noslip
+
+
+@wp.func
+def slab_entry(q_old: wp.vec3, q_new: wp.vec3, lo: wp.vec3, hi: wp.vec3, dim: int, margin: float):
+    """Guard against one wall slab [lo, hi] (vessel frame; the y axis is ignored in 2-D).
+
+    Returns (q, normal, depth, hit): if the path q_old -> q_new enters the slab, q is q_new moved back onto the
+    entry face plus ``margin`` on the side it came from, normal the outward normal of that face and depth how far
+    past the face q_new went (m); otherwise (q_new, 0, 0, 0).
+    """
+    no_hit = wp.vec3(0.0)
+    inside_old = True
+    for a in range(3):
+        if dim == 2 and a == 1:
+            continue
+        if q_old[a] <= lo[a] or q_old[a] >= hi[a]:
+            inside_old = False
+    axis = int(-1)
+    side = float(0.0)
+    if inside_old:
+        # Started inside (only possible if a previous step was breached): leave by the face nearest q_new.
+        best = float(1.0e30)
+        for a in range(3):
+            if dim == 2 and a == 1:
+                continue
+            if q_new[a] - lo[a] < best:
+                best = q_new[a] - lo[a]
+                axis = a
+                side = -1.0
+            if hi[a] - q_new[a] < best:
+                best = hi[a] - q_new[a]
+                axis = a
+                side = 1.0
+        if best <= 0.0:
+            return q_new, no_hit, 0.0, 0
+    else:
+        t_enter = float(-1.0e30)
+        t_exit = float(1.0e30)
+        for a in range(3):
+            if dim == 2 and a == 1:
+                continue
+            d = q_new[a] - q_old[a]
+            if wp.abs(d) < 1.0e-15:
+                if q_old[a] <= lo[a] or q_old[a] >= hi[a]:
+                    return q_new, no_hit, 0.0, 0
+            else:
+                t1 = (lo[a] - q_old[a]) / d
+                t2 = (hi[a] - q_old[a]) / d
+                tn = wp.min(t1, t2)
+                if tn > t_enter:
+                    t_enter = tn
+                    axis = a
+                    side = wp.where(d > 0.0, -1.0, 1.0)
+                t_exit = wp.min(t_exit, wp.max(t1, t2))
+        if axis < 0 or t_enter > t_exit or t_enter > 1.0 or t_exit < 0.0:
+            return q_new, no_hit, 0.0, 0
+    q = q_new
+    normal = wp.vec3(0.0)
+    normal[axis] = side
+    depth = float(0.0)
+    if side > 0.0:
+        depth = hi[axis] - q_new[axis]
+        q[axis] = hi[axis] + margin
+    else:
+        depth = q_new[axis] - lo[axis]
+        q[axis] = lo[axis] - margin
+    return q, normal, wp.max(depth, 0.0), 1
+
+
+@wp.func
+def box_slab(index: int, geo: VesselGeometry):
+    """(lo, hi) of a box vessel's wall slab in the vessel frame: 0 floor, 1 +x, 2 -x, 3 +y, 4 -y."""
+    b = geo.half_width
+    d = geo.half_depth
+    t = geo.thickness
+    h = geo.height
+    if index == 0:
+        return wp.vec3(-b - t, -d - t, -t), wp.vec3(b + t, d + t, 0.0)
+    if index == 1:
+        return wp.vec3(b, -d - t, 0.0), wp.vec3(b + t, d + t, h)
+    if index == 2:
+        return wp.vec3(-b - t, -d - t, 0.0), wp.vec3(-b, d + t, h)
+    if index == 3:
+        return wp.vec3(-b, d, 0.0), wp.vec3(b, d + t, h)
+    return wp.vec3(-b, -d - t, 0.0), wp.vec3(b, -d, h)
+
+
+@wp.func
+def cylinder_guard(q_old: wp.vec3, q_new: wp.vec3, geo: VesselGeometry, margin: float):
+    """Guard against a cylindrical cup (3-D): floor disc z in [-t, 0], r <= R + t, then the side wall r in
+    [R, R + t], z in [0, H]. Same returns as :func:`guard_vessel`. Relies on the CFL step moving a particle less
+    than the wall thickness per step; a path from inside to outside (or back) below the rim counts as crossing
+    the side wall.
+    """
+    r_in = geo.half_width
+    t = geo.thickness
+    h = geo.height
+    q = q_new
+    normal = wp.vec3(0.0)
+    depth = float(0.0)
+    hits = int(0)
+    ro = wp.sqrt(q_old[0] * q_old[0] + q_old[1] * q_old[1])
+    rq = wp.sqrt(q[0] * q[0] + q[1] * q[1])
+    if ro < r_in + t and rq < r_in + t and q[2] < 0.0 and (q[2] > -t or q_old[2] >= 0.0):
+        if q_old[2] >= 0.0:
+            depth = -q[2]
+            q[2] = margin
+            normal = wp.vec3(0.0, 0.0, 1.0)
+            hits += 1
+        elif q_old[2] <= -t:
+            depth = q[2] + t
+            q[2] = -t - margin
+            normal = wp.vec3(0.0, 0.0, -1.0)
+            hits += 1
+    if q[2] < h and q[2] > -t and q_old[2] < h:
+        radial = wp.vec3(1.0, 0.0, 0.0)
+        if rq > 1.0e-12:
+            radial = wp.vec3(q[0] / rq, q[1] / rq, 0.0)
+        if ro <= r_in and rq > r_in:
+            depth = wp.max(depth, rq - r_in)
+            q = wp.vec3(radial[0] * (r_in - margin), radial[1] * (r_in - margin), q[2])
+            normal = -radial
+            hits += 1
+        elif ro >= r_in + t and rq < r_in + t:
+            depth = wp.max(depth, r_in + t - rq)
+            q = wp.vec3(radial[0] * (r_in + t + margin), radial[1] * (r_in + t + margin), q[2])
+            normal = radial
+            hits += 1
+    elif q[2] < h and q_old[2] >= h and rq > r_in and rq < r_in + t:
+        depth = wp.max(depth, h - q[2])
+        q[2] = h + margin
+        normal = wp.vec3(0.0, 0.0, 1.0)
+        hits += 1
+    return q, normal, depth, hits
+
+
+@wp.func
+def guard_vessel(q_old: wp.vec3, q_new: wp.vec3, geo: VesselGeometry, dim: int, margin: float):
+    """Apply the guard of one vessel. Returns (q, normal, max_depth, hits) in the vessel frame; ``normal`` is that
+    of the last face hit (its component of the relative velocity into the wall is removed by the caller)."""
+    q = q_new
+    normal = wp.vec3(0.0)
+    max_depth = float(0.0)
+    hits = int(0)
+    if geo.shape == 1 and dim == 3:
+        q, normal, max_depth, hits = cylinder_guard(q_old, q_new, geo, margin)
+    else:
+        n_slabs = wp.where(dim == 2, 3, 5)
+        for s in range(n_slabs):
+            lo, hi = box_slab(s, geo)
+            q_s, n_s, depth_s, hit_s = slab_entry(q_old, q, lo, hi, dim, margin)
+            if hit_s != 0:
+                q = q_s
+                normal = n_s
+                max_depth = wp.max(max_depth, depth_s)
+                hits += 1
+    return q, normal, max_depth, hits
+
+
+@wp.func
+def inside_vessel(q: wp.vec3, geo: VesselGeometry, dim: int) -> int:
+    """1 if the vessel-frame point q is in the vessel's inner volume (below the rim), else 0."""
+    if q[2] <= 0.0 or q[2] >= geo.height:
+        return 0
+    if geo.shape == 1 and dim == 3:
+        return wp.where(q[0] * q[0] + q[1] * q[1] < geo.half_width * geo.half_width, 1, 0)
+    if wp.abs(q[0]) >= geo.half_width:
+        return 0
+    if dim == 3 and wp.abs(q[1]) >= geo.half_depth:
+        return 0
+    return 1

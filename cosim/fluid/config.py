@@ -1,0 +1,151 @@
+"""Fluid configuration: frozen dataclasses validated on construction (SI units).
+
+Defaults follow the seed (Tait EOS, rho0 = 1000 kg/m^3, gamma = 7) with the changes DESIGN.md requires: an
+artificial speed of sound c0 = ``sound_speed_factor`` x ``max_expected_speed`` (>= 10 v_max keeps the density error
+near 1 %, see shared/reference/README.md) instead of the seed's 1480 m/s, delta-SPH density diffusion and a CFL
+time step that includes the vessel wall speed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+
+from cosim.checks import check_choice, check_int, check_positive, check_range, check_vector
+from cosim.errors import InputError
+
+GRAVITY = 9.81  # m/s^2, standard gravity magnitude used across the project
+
+
+class KernelType(Enum):
+    """SPH smoothing kernel (both with compact support 2h)."""
+
+    CUBIC_SPLINE = "cubic_spline"  # Monaghan (1992) M4 spline, the seed's kernel
+    WENDLAND_C2 = "wendland_c2"  # Wendland (1995) C2; no pairing instability at large neighbour counts
+
+
+class PressureSolver(Enum):
+    """How pressure is obtained."""
+
+    WCSPH = "wcsph"  # weakly compressible: Tait equation of state, continuity density + delta-SPH
+
+
+@dataclass(frozen=True)
+class FluidConfig:
+    """Numerical and physical parameters of the SPH liquid.
+
+    dim: 2 (liquid in the pour plane, world x-z at y = 0, per unit depth times ``depth_2d``) or 3.
+    spacing: m, initial particle spacing dx. (0, 0.05]
+    smoothing_ratio: h / dx. [1.0, 2.5]
+    kernel: :class:`KernelType`.
+    solver: :class:`PressureSolver`.
+    rest_density: kg/m^3, rho0. [500, 2000]
+    gamma: Tait exponent. [1, 10]
+    max_expected_speed: m/s, the largest liquid speed the scene is expected to reach (sets c0). (0, 50]
+    sound_speed_factor: c0 / max_expected_speed. [10, 100] (>= 10 keeps |rho - rho0|/rho0 ~ 1 %)
+    kinematic_viscosity: m^2/s, laminar viscosity (water 1.0e-6 at 20 C). [0, 0.01]
+    artificial_viscosity: Monaghan alpha (dimensionless), also applied against walls. [0, 1]
+    density_diffusion: delta of delta-SPH (Molteni & Colagrossi 2009; hydrostatic correction of Fourtakas et
+        al. 2019). [0, 1]
+    cfl: Courant number of the acoustic CFL step; 0.25 x of it for the force criterion. (0, 0.6]
+    depth_2d: m, liquid thickness perpendicular to the pour plane in 2-D (the pouring vessel's depth): masses,
+        volumes and wrenches reported to the outside are per unit depth times this. (0, 2]
+    boundary_spacing_ratio: wall sample spacing / dx. [0.3, 1.0]
+    domain_min, domain_max: m, world box of the simulation; its bottom face is the floor. Particles that leave it
+        are deactivated and counted as spilled.
+    max_density_error: |rho - rho0| / rho0 above which the run is declared unstable. (0, 1]
+    max_wall_penetration: penetration into a wall (in units of dx) above which the run is declared unstable;
+        shallower contacts are corrected by the non-penetration guard and counted. (0, 10]
+    min_time_step: s, a CFL step below this is an instability. (0, 1e-3]
+    gravity: m/s^2, world-frame gravity vector.
+    """
+
+    dim: int = 2
+    spacing: float = 0.191 / 40
+    smoothing_ratio: float = 1.5
+    kernel: KernelType = KernelType.WENDLAND_C2
+    solver: PressureSolver = PressureSolver.WCSPH
+    rest_density: float = 1000.0
+    gamma: float = 7.0
+    max_expected_speed: float = 2.0
+    sound_speed_factor: float = 10.0
+    kinematic_viscosity: float = 1.0e-6
+    artificial_viscosity: float = 0.01
+    density_diffusion: float = 0.1
+    cfl: float = 0.25
+    depth_2d: float = 0.1
+    boundary_spacing_ratio: float = 0.75
+    domain_min: tuple[float, float, float] = (-1.0, -0.5, 0.0)
+    domain_max: tuple[float, float, float] = (1.0, 0.5, 1.5)
+    max_density_error: float = 0.1
+    max_wall_penetration: float = 0.5
+    min_time_step: float = 1.0e-7
+    gravity: tuple[float, float, float] = field(default=(0.0, 0.0, -GRAVITY))
+
+    def __post_init__(self) -> None:
+        s = object.__setattr__
+        s(self, "dim", check_int("fluid.dim", self.dim, 2, 3))
+        s(self, "spacing", check_positive("fluid.spacing", self.spacing, "m", 0.05))
+        s(self, "smoothing_ratio", check_range("fluid.smoothing_ratio", self.smoothing_ratio, 1.0, 2.5))
+        s(self, "kernel", check_choice("fluid.kernel", self.kernel, KernelType))
+        s(self, "solver", check_choice("fluid.solver", self.solver, PressureSolver))
+        s(self, "rest_density", check_range("fluid.rest_density", self.rest_density, 500.0, 2000.0, "kg/m^3"))
+        s(self, "gamma", check_range("fluid.gamma", self.gamma, 1.0, 10.0))
+        s(self, "max_expected_speed", check_positive("fluid.max_expected_speed", self.max_expected_speed, "m/s", 50.0))
+        s(self, "sound_speed_factor", check_range("fluid.sound_speed_factor", self.sound_speed_factor, 10.0, 100.0))
+        s(self, "kinematic_viscosity", check_range("fluid.kinematic_viscosity", self.kinematic_viscosity, 0.0, 0.01, "m^2/s"))
+        s(self, "artificial_viscosity", check_range("fluid.artificial_viscosity", self.artificial_viscosity, 0.0, 1.0))
+        s(self, "density_diffusion", check_range("fluid.density_diffusion", self.density_diffusion, 0.0, 1.0))
+        s(self, "cfl", check_range("fluid.cfl", self.cfl, 0.0, 0.6, lo_open=True))
+        s(self, "depth_2d", check_positive("fluid.depth_2d", self.depth_2d, "m", 2.0))
+        s(self, "boundary_spacing_ratio", check_range("fluid.boundary_spacing_ratio", self.boundary_spacing_ratio, 0.3, 1.0))
+        lo = check_vector("fluid.domain_min", self.domain_min, 3)
+        hi = check_vector("fluid.domain_max", self.domain_max, 3)
+        for axis in range(3):
+            if hi[axis] - lo[axis] < 4.0 * self.support_radius:
+                raise InputError(
+                    f"fluid.domain_max[{axis}]: must exceed domain_min[{axis}] by at least 4 smoothing supports "
+                    f"({4.0 * self.support_radius:g} m), got {lo[axis]:g} .. {hi[axis]:g}"
+                )
+        s(self, "domain_min", lo)
+        s(self, "domain_max", hi)
+        s(self, "max_density_error", check_range("fluid.max_density_error", self.max_density_error, 0.0, 1.0, lo_open=True))
+        s(self, "max_wall_penetration", check_range("fluid.max_wall_penetration", self.max_wall_penetration, 0.0, 10.0, lo_open=True))
+        s(self, "min_time_step", check_range("fluid.min_time_step", self.min_time_step, 0.0, 1.0e-3, "s", lo_open=True))
+        s(self, "gravity", check_vector("fluid.gravity", self.gravity, 3))
+
+    # ---- derived quantities ------------------------------------------------------------------------------------
+    @property
+    def smoothing_length(self) -> float:
+        """h (m)."""
+        return self.smoothing_ratio * self.spacing
+
+    @property
+    def support_radius(self) -> float:
+        """Kernel support 2h (m)."""
+        return 2.0 * self.smoothing_ratio * self.spacing
+
+    @property
+    def sound_speed(self) -> float:
+        """Artificial speed of sound c0 (m/s)."""
+        return self.sound_speed_factor * self.max_expected_speed
+
+    @property
+    def particle_mass(self) -> float:
+        """SPH mass of one particle: kg (3-D) or kg per metre of depth (2-D)."""
+        return self.rest_density * self.spacing**self.dim
+
+    @property
+    def out_of_plane_scale(self) -> float:
+        """Factor that turns the solver's per-unit-depth quantities into 3-D ones (depth_2d in 2-D, 1 in 3-D)."""
+        return self.depth_2d if self.dim == 2 else 1.0
+
+    @property
+    def particle_volume(self) -> float:
+        """m^3 of liquid one particle stands for at rest."""
+        return self.spacing**self.dim * self.out_of_plane_scale
+
+    @property
+    def gravity_magnitude(self) -> float:
+        return math.sqrt(sum(g * g for g in self.gravity))

@@ -1,0 +1,72 @@
+"""Per-substep diagnostics: layout of the device rows and the host-side record.
+
+Each substep writes one row of floats and one row of ints (atomics: max for maxima, integer adds for counts, so
+every field but the kinetic energy is order-independent and deterministic on any device).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+# float row
+DIAG_MAX_SPEED = wp.constant(0)  # m/s
+DIAG_MAX_ACCEL = wp.constant(1)  # m/s^2 (total, gravity included)
+DIAG_MAX_DENSITY_ERROR = wp.constant(2)  # max |rho - rho0| / rho0
+DIAG_KINETIC_ENERGY = wp.constant(3)  # J (3-D equivalent)
+N_DIAG_FLOAT = 4
+# int row
+DIAG_NONFINITE = wp.constant(0)  # particles with a non-finite position, velocity or density
+DIAG_BREACHES = wp.constant(1)  # wall contacts deeper than max_wall_penetration (instability)
+DIAG_CORRECTIONS = wp.constant(2)  # shallow wall contacts corrected by the guard
+DIAG_ACTIVE = wp.constant(3)  # active particles after the substep
+DIAG_INSIDE0 = wp.constant(4)  # particles inside vessel k at DIAG_INSIDE0 + k
+N_DIAG_INT_BASE = 4
+
+
+@dataclass(frozen=True)
+class StepDiagnostics:
+    """One substep. Volumes are m^3 (3-D equivalent), counts are particles."""
+
+    step: int
+    time: float  # s, at the end of the substep
+    dt: float  # s
+    max_speed: float  # m/s
+    max_acceleration: float  # m/s^2
+    max_density_error: float  # max |rho - rho0| / rho0
+    kinetic_energy: float  # J
+    nonfinite: int
+    wall_breaches: int
+    wall_corrections: int
+    active: int
+    volume_in_vessel: tuple[float, ...]  # m^3 per vessel
+    spilled_volume: float  # m^3 deactivated (fell below the floor or left the domain)
+
+
+def rows_to_records(
+    first_step: int, t0: float, dt: float, rows_f: np.ndarray, rows_i: np.ndarray, n_total: int, particle_volume: float
+) -> list[StepDiagnostics]:
+    """Host records of ``len(rows_f)`` consecutive substeps."""
+    out = []
+    for s in range(rows_f.shape[0]):
+        f, i = rows_f[s], rows_i[s]
+        out.append(
+            StepDiagnostics(
+                step=first_step + s,
+                time=t0 + (s + 1) * dt,
+                dt=dt,
+                max_speed=float(f[0]),
+                max_acceleration=float(f[1]),
+                max_density_error=float(f[2]),
+                kinetic_energy=float(f[3]),
+                nonfinite=int(i[0]),
+                wall_breaches=int(i[1]),
+                wall_corrections=int(i[2]),
+                active=int(i[3]),
+                volume_in_vessel=tuple(float(c) * particle_volume for c in i[N_DIAG_INT_BASE:]),
+                spilled_volume=(n_total - int(i[3])) * particle_volume,
+            )
+        )
+    return out

@@ -1,0 +1,119 @@
+"""Model (static, built once) and State (per particle, two buffers swapped at each reorder) of the SPH liquid."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from cosim.fluid.boundary import SHAPE_BOX, SHAPE_CYLINDER, VesselGeometry
+from cosim.fluid.config import FluidConfig
+from cosim.fluid.neighbors import CellGrid
+from cosim.fluid.params import SPHParams, make_params
+from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls
+from cosim.vessel import VesselSpec
+
+
+@dataclass
+class FluidModel:
+    """Static data. Arrays live on ``device``; shapes: N fluid particles, Nb wall samples, V vessels.
+
+    params: :class:`SPHParams`.
+    vessel_specs: the V vessel specifications (vessel frames as in ``cosim.vessel``).
+    vessels: (V,) :class:`VesselGeometry`.
+    b_local: (Nb,) vec3, dummy wall particles in their vessel's frame (m).
+    b_vessel: (Nb,) int32, index of the vessel each wall particle belongs to.
+    b_volume: (Nb,) float, volume of each wall particle (m^dim; its mass is rho0 times this).
+    b_reach: (V,) numpy, largest distance of a vessel's wall particles from its frame origin (m): wall speed bound.
+    wall_thickness: (V,) numpy, wall thickness the liquid sees (m), >= the vessel's own.
+    grid, b_grid: neighbour grids for liquid and wall particles (identical cell layout).
+    """
+
+    config: FluidConfig
+    device: wp.context.Device
+    params: SPHParams
+    vessel_specs: tuple[VesselSpec, ...]
+    vessels: wp.array
+    b_local: wp.array
+    b_vessel: wp.array
+    b_volume: wp.array
+    b_reach: np.ndarray
+    wall_thickness: np.ndarray
+    grid: CellGrid
+    b_grid: CellGrid
+
+    @property
+    def n_vessels(self) -> int:
+        return len(self.vessel_specs)
+
+    @property
+    def n_boundary(self) -> int:
+        return self.b_local.shape[0]
+
+
+def _geometry(spec: VesselSpec, wall_thickness: float) -> VesselGeometry:
+    geo = VesselGeometry()
+    geo.shape = SHAPE_BOX if spec.is_box else SHAPE_CYLINDER
+    geo.half_width = 0.5 * spec.inner_width
+    geo.half_depth = 0.5 * spec.section_depth
+    geo.height = spec.inner_height
+    geo.thickness = wall_thickness
+    geo.com = wp.vec3(*spec.com_local)
+    return geo
+
+
+def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: int, device) -> FluidModel:
+    """Fill the walls with dummy particles and allocate the static arrays."""
+    walls = [sample_vessel_walls(s, cfg.spacing, cfg.support_radius, cfg.dim) for s in specs]
+    samples = [w[0] for w in walls]
+    b_local = np.concatenate(samples) if samples else np.zeros((0, 3))
+    b_volume = np.concatenate([w[1] for w in walls]) if walls else np.zeros(0)
+    b_vessel = np.concatenate([np.full(len(s), k, dtype=np.int32) for k, s in enumerate(samples)]) if samples else np.zeros(0, np.int32)
+    reach = np.array([np.linalg.norm(s, axis=1).max() for s in samples]) if samples else np.zeros(0)
+    thickness = np.array([numerical_wall_thickness(s, cfg.spacing, cfg.support_radius) for s in specs])
+    make_grid = lambda capacity: CellGrid(cfg.domain_min, cfg.domain_max, cfg.support_radius, cfg.dim, capacity, device)  # noqa: E731
+    return FluidModel(
+        config=cfg,
+        device=device,
+        params=make_params(cfg, len(specs)),
+        vessel_specs=tuple(specs),
+        vessels=wp.array([_geometry(s, t) for s, t in zip(specs, thickness)], dtype=VesselGeometry, device=device),
+        b_local=wp.array(b_local.astype(np.float32), dtype=wp.vec3, device=device),
+        b_vessel=wp.array(b_vessel, dtype=wp.int32, device=device),
+        b_volume=wp.array(b_volume.astype(np.float32), dtype=float, device=device),
+        b_reach=reach,
+        wall_thickness=thickness,
+        grid=make_grid(n_particles),
+        b_grid=make_grid(len(b_local)),
+    )
+
+
+@dataclass
+class FluidState:
+    """Per-particle arrays (N,), world frame, in cell order after each reorder.
+
+    x: m; v: m/s; rho: kg/m^3; p: Pa; active: 1 while simulated, 0 once spilled or broken; pid: the particle's
+    original index (to return results in the order the particles were given).
+    """
+
+    x: wp.array
+    v: wp.array
+    rho: wp.array
+    p: wp.array
+    active: wp.array
+    pid: wp.array
+
+    @staticmethod
+    def allocate(n: int, device) -> "FluidState":
+        return FluidState(
+            x=wp.zeros(n, dtype=wp.vec3, device=device),
+            v=wp.zeros(n, dtype=wp.vec3, device=device),
+            rho=wp.zeros(n, dtype=float, device=device),
+            p=wp.zeros(n, dtype=float, device=device),
+            active=wp.zeros(n, dtype=wp.int32, device=device),
+            pid=wp.zeros(n, dtype=wp.int32, device=device),
+        )
+
+    def arrays(self) -> list[wp.array]:
+        return [self.x, self.v, self.rho, self.p, self.active, self.pid]

@@ -1,0 +1,57 @@
+"""The solver's static parameters as one warp struct (built once from :class:`FluidConfig`)."""
+
+from __future__ import annotations
+
+import warp as wp
+
+from cosim.fluid.config import FluidConfig
+from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma
+
+
+@wp.struct
+class SPHParams:
+    """Static SPH parameters (SI). ``mass`` is the SPH particle mass (kg, or kg/m of depth in 2-D); ``mass_out``
+    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``eta2`` = 0.01 h^2 (m^2)."""
+
+    dim: int
+    kernel: int
+    h: float
+    inv_h: float
+    support: float
+    sigma: float
+    mass: float
+    mass_out: float
+    rest_density: float
+    sound_speed: float
+    eos_b: float
+    gamma: float
+    nu: float
+    alpha: float
+    delta: float
+    eta2: float
+    gravity: wp.vec3
+    n_vessels: int
+
+
+def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
+    p = SPHParams()
+    h = cfg.smoothing_length
+    p.dim = cfg.dim
+    p.kernel = KERNEL_IDS[cfg.kernel]
+    p.h = h
+    p.inv_h = 1.0 / h
+    p.support = 2.0 * h
+    p.sigma = kernel_sigma(cfg.kernel, h, cfg.dim)
+    p.mass = cfg.particle_mass
+    p.mass_out = cfg.particle_mass * cfg.out_of_plane_scale
+    p.rest_density = cfg.rest_density
+    p.sound_speed = cfg.sound_speed
+    p.eos_b = cfg.rest_density * cfg.sound_speed**2 / cfg.gamma
+    p.gamma = cfg.gamma
+    p.nu = cfg.kinematic_viscosity
+    p.alpha = cfg.artificial_viscosity
+    p.delta = cfg.density_diffusion
+    p.eta2 = 0.01 * h * h
+    p.gravity = wp.vec3(*cfg.gravity)
+    p.n_vessels = n_vessels
+    return p

@@ -1,0 +1,379 @@
+"""The SPH liquid solver: the public object of ``cosim.fluid``.
+
+Time is advanced in intervals (the coupling's MuJoCo step, or any duration): before an interval the caller gives
+each vessel's pose at the END of the interval (:meth:`FluidSolver.set_vessel_poses`); the vessel then moves from
+its current pose to that one at constant linear and angular velocity while the liquid takes as many equal
+substeps as the CFL, force and viscous criteria need (computed from the previous interval's maxima and the wall
+speed). Each substep runs the named stages
+
+    move_vessels; place_wall_particles; find_neighbors; extrapolate_wall_state; compute_forces;
+    compute_density_rate; integrate (+ wall guard); reduce_wrenches
+
+entirely on the device (no host copies inside; only the interval's plan and its diagnostics cross). After the
+interval the per-substep diagnostics are checked and an instability raises :class:`FluidInstabilityError`
+naming the step and what broke. Results come back as numpy arrays in the particles' original order.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+import warp as wp
+
+from cosim.errors import InputError, SimulationError
+from cosim.fluid import boundary as bd
+from cosim.fluid import wcsph
+from cosim.fluid.config import FluidConfig
+from cosim.fluid.diagnostics import N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, rows_to_records
+from cosim.fluid.model import FluidModel, FluidState, build_model
+from cosim.fluid.runtime import resolve_device
+from cosim.fluid.seeding import ParticleSet
+from cosim.frames import Pose, rotation_vector, rotation_y, tilt_about_y
+from cosim.vessel import VesselSpec
+
+WRENCH_CHUNKS = 64  # first-level chunks of the fixed-order wrench reduction
+FORCE_CFL = 0.25  # Monaghan's force criterion dt <= 0.25 sqrt(h / a_max)
+VISCOUS_CFL = 0.125  # viscous criterion dt <= 0.125 h^2 / nu
+GUARD_MARGIN = 0.01  # the guard puts a particle this many dx outside the wall face it crossed
+
+
+class FluidInstabilityError(SimulationError):
+    """The liquid broke: non-finite values, density error past its bound, a wall breached, a collapsed step."""
+
+    def __init__(self, step: int, time: float, reason: str):
+        super().__init__(f"SPH step {step} (t = {time:.5f} s): {reason}")
+        self.step = step
+        self.time = time
+        self.reason = reason
+
+
+@dataclass(frozen=True)
+class IntervalReport:
+    """What one :meth:`FluidSolver.advance` did: substeps taken, their dt (s), and the last substep's record."""
+
+    substeps: int
+    dt: float
+    last: StepDiagnostics
+
+
+class FluidSolver:
+    """SPH liquid in moving rigid vessels.
+
+    Args:
+      config: :class:`FluidConfig`.
+      vessels: vessel specifications (their frames as in ``cosim.vessel``).
+      poses: initial world pose of each vessel frame.
+      particles: the initial liquid (e.g. from :func:`cosim.fluid.seeding.fill_vessel`).
+      device: "cpu" or "cuda[:N]".
+    In 2-D, vessel poses are projected onto the pour plane (rotation about y, translation in x-z, y = 0).
+    """
+
+    def __init__(
+        self,
+        config: FluidConfig,
+        vessels: Sequence[VesselSpec],
+        poses: Sequence[Pose],
+        particles: ParticleSet,
+        device: str = "cpu",
+    ):
+        if len(vessels) != len(poses):
+            raise InputError(f"fluid: {len(vessels)} vessels but {len(poses)} poses")
+        if len(particles) == 0:
+            raise InputError("fluid: the initial liquid holds no particle")
+        if config.dim == 2 and not (config.domain_min[1] < 0.0 < config.domain_max[1]):
+            raise InputError("fluid.domain_min[1]..domain_max[1]: must contain y = 0 (the pour plane) in 2-D")
+        self.config = config
+        self.device = resolve_device(device)
+        self.n_particles = len(particles)
+        self.model: FluidModel = build_model(config, tuple(vessels), self.n_particles, self.device)
+        self.time = 0.0
+        self.step_count = 0
+        self._poses = [self._planar(p) for p in poses]
+        self._targets = list(self._poses)
+        self._last_max_speed = 0.0
+        self._last_max_accel = config.gravity_magnitude
+        self._history: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        self._last_report: IntervalReport | None = None
+        self._allocate(particles)
+
+    # ---- set-up ----------------------------------------------------------------------------------------------
+    def _planar(self, pose: Pose) -> Pose:
+        if self.config.dim == 3:
+            return Pose(pose.position, pose.rotation)
+        pos = pose.position.copy()
+        pos[1] = 0.0
+        return Pose(pos, rotation_y(tilt_about_y(pose.rotation)))
+
+    def _allocate(self, particles: ParticleSet) -> None:
+        d, n, m = self.device, self.n_particles, self.model
+        v_count = max(m.n_vessels, 1)
+        self.state = FluidState.allocate(n, d)
+        self._spare = FluidState.allocate(n, d)
+        self.state.x.assign(particles.positions.astype(np.float32))
+        self.state.v.assign(particles.velocities.astype(np.float32))
+        self.state.rho.assign(particles.densities.astype(np.float32))
+        self.state.active.fill_(1)
+        self.state.pid.assign(np.arange(n, dtype=np.int32))
+        wp.launch(wcsph.equation_of_state, dim=n, inputs=[m.params, self.state.rho], outputs=[self.state.p], device=d)
+        self._drho = wp.zeros(n, dtype=float, device=d)
+        self._acc = wp.zeros(n, dtype=wp.vec3, device=d)
+        self._wall_force = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
+        self._wall_torque = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
+        self._partial_force = wp.zeros((v_count, WRENCH_CHUNKS), dtype=wp.vec3, device=d)
+        self._partial_torque = wp.zeros((v_count, WRENCH_CHUNKS), dtype=wp.vec3, device=d)
+        self._force_sum = wp.zeros(v_count, dtype=wp.vec3, device=d)
+        self._torque_sum = wp.zeros(v_count, dtype=wp.vec3, device=d)
+        nb = m.n_boundary
+        self._bx = wp.zeros(nb, dtype=wp.vec3, device=d)
+        self._bv = wp.zeros(nb, dtype=wp.vec3, device=d)
+        self._b_p = wp.zeros(nb, dtype=float, device=d)
+        self._b_rho = wp.zeros(nb, dtype=float, device=d)
+        self._b_v_noslip = wp.zeros(nb, dtype=wp.vec3, device=d)
+        self._b_active = wp.ones(nb, dtype=wp.int32, device=d)
+        self._motions = wp.zeros(m.n_vessels, dtype=bd.VesselMotion, device=d)
+        self._dt = wp.zeros(1, dtype=float, device=d)
+        self._row = wp.zeros(1, dtype=wp.int32, device=d)
+        self._rows_capacity = 0
+        self._ensure_rows(64)
+        zero = np.zeros((m.n_vessels, 3))
+        self._lin_vel, self._ang_vel = zero, zero
+        self._upload_motions(zero, zero, zero, zero)
+        self._wrench = np.zeros((m.n_vessels, 6))
+
+    def _ensure_rows(self, n: int) -> None:
+        if n <= self._rows_capacity:
+            return
+        self._rows_capacity = max(n, 2 * self._rows_capacity)
+        self._diag_f = wp.zeros((self._rows_capacity, N_DIAG_FLOAT), dtype=float, device=self.device)
+        self._diag_i = wp.zeros((self._rows_capacity, N_DIAG_INT_BASE + self.model.n_vessels), dtype=wp.int32, device=self.device)
+
+    def _upload_motions(self, lin_vel: np.ndarray, ang_vel: np.ndarray, lin_acc: np.ndarray, ang_acc: np.ndarray) -> None:
+        motions = []
+        for k, pose in enumerate(self._poses):
+            mo = bd.VesselMotion()
+            mo.p0 = wp.vec3(*pose.position)
+            mo.r0 = wp.mat33(*pose.rotation.ravel())
+            mo.lin_vel = wp.vec3(*lin_vel[k])
+            mo.ang_vel = wp.vec3(*ang_vel[k])
+            mo.lin_acc = wp.vec3(*lin_acc[k])
+            mo.ang_acc = wp.vec3(*ang_acc[k])
+            mo.p_now = mo.p_next = mo.p0
+            mo.r_now = mo.r_next = mo.r0
+            motions.append(mo)
+        if motions:
+            self._motions = wp.array(motions, dtype=bd.VesselMotion, device=self.device)
+
+    # ---- driving ---------------------------------------------------------------------------------------------
+    def set_vessel_poses(self, poses: Sequence[Pose]) -> None:
+        """World poses of the vessel frames at the end of the next :meth:`advance` interval."""
+        if len(poses) != self.model.n_vessels:
+            raise InputError(f"fluid: {self.model.n_vessels} vessels but {len(poses)} poses given")
+        for k, pose in enumerate(poses):
+            if not (np.all(np.isfinite(pose.position)) and np.all(np.isfinite(pose.rotation))):
+                raise InputError(f"fluid: vessel {self.model.vessel_specs[k].name} pose is not finite")
+        self._targets = [self._planar(p) for p in poses]
+
+    def plan_time_step(self, duration: float, wall_speed: float) -> tuple[int, float]:
+        """(substeps, dt) for an interval: acoustic CFL with the wall speed, force and viscous criteria."""
+        cfg = self.config
+        h = cfg.smoothing_length
+        dt = cfg.cfl * h / (cfg.sound_speed + self._last_max_speed + wall_speed)
+        dt = min(dt, FORCE_CFL * math.sqrt(h / max(self._last_max_accel, 1e-9)))
+        if cfg.kinematic_viscosity > 0.0:
+            dt = min(dt, VISCOUS_CFL * h * h / cfg.kinematic_viscosity)
+        if dt < cfg.min_time_step:
+            raise FluidInstabilityError(self.step_count, self.time, f"time step collapsed to {dt:.3g} s (< fluid.min_time_step)")
+        n = max(1, math.ceil(duration / dt - 1e-9))
+        return n, duration / n
+
+    def advance(self, duration: float) -> IntervalReport:
+        """Advance the liquid by ``duration`` (s), moving each vessel to its target pose meanwhile."""
+        if not (duration > 0.0 and math.isfinite(duration)):
+            raise InputError(f"fluid.advance: duration must be > 0 s, got {duration}")
+        m, d = self.model, self.device
+        lin = np.array([(t.position - p.position) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
+        ang = np.array([rotation_vector(t.rotation @ p.rotation.T) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
+        wall_speed = max((np.linalg.norm(lin[k]) + np.linalg.norm(ang[k]) * m.b_reach[k] for k in range(m.n_vessels)), default=0.0)
+        n_sub, dt = self.plan_time_step(duration, wall_speed)
+        self._upload_motions(lin, ang, (lin - self._lin_vel) / duration, (ang - self._ang_vel) / duration)
+        self._lin_vel, self._ang_vel = lin, ang
+        self._ensure_rows(n_sub)
+        self._dt.fill_(dt)
+        self._row.zero_()
+        self._diag_f.zero_()
+        self._diag_i.zero_()
+        self._force_sum.zero_()
+        self._torque_sum.zero_()
+        for _ in range(n_sub):
+            self._substep()
+        rows_f = self._diag_f.numpy()[:n_sub].copy()
+        rows_i = self._diag_i.numpy()[:n_sub].copy()
+        first = self.step_count
+        t0 = self.time
+        self.step_count += n_sub
+        self.time += duration
+        self._poses = list(self._targets)
+        self._history.append((np.full(n_sub, dt), rows_f, rows_i))
+        scale = 1.0 / n_sub
+        self._wrench = np.concatenate([self._force_sum.numpy(), self._torque_sum.numpy()], axis=1)[: m.n_vessels] * scale
+        self._check(first, t0, dt, rows_f, rows_i)
+        self._last_max_speed = float(rows_f[:, 0].max())
+        self._last_max_accel = float(rows_f[:, 1].max())
+        last = rows_to_records(first + n_sub - 1, t0 + (n_sub - 1) * dt, dt, rows_f[-1:], rows_i[-1:], self.n_particles, self.config.particle_volume)[0]
+        self._last_report = IntervalReport(n_sub, dt, last)
+        return self._last_report
+
+    def _substep(self) -> None:
+        m, d, prm = self.model, self.device, self.model.params
+        cfg = self.config
+        s = self.state
+        # move_vessels; place_wall_particles
+        if m.n_vessels:
+            wp.launch(bd.advance_vessel_poses, dim=m.n_vessels, inputs=[self._row, self._dt], outputs=[self._motions], device=d)
+            wp.launch(bd.place_wall_particles, dim=m.n_boundary, inputs=[m.b_local, m.b_vessel, self._motions], outputs=[self._bx, self._bv], device=d)
+        # find_neighbors (wall samples by indirection, particles reordered into cell order)
+        m.b_grid.build(self._bx, self._b_active, m.n_boundary)
+        m.grid.build(s.x, s.active, self.n_particles)
+        wp.launch(wcsph.gather_particles, dim=self.n_particles, inputs=[m.grid.order, *s.arrays()], outputs=self._spare.arrays(), device=d)
+        self.state, self._spare = self._spare, self.state
+        s = self.state
+        # extrapolate_wall_state (pressure, density, no-slip velocity of the dummy wall particles)
+        if m.n_boundary:
+            wp.launch(
+                bd.extrapolate_wall_state,
+                dim=m.n_boundary,
+                inputs=[prm, m.grid.spec, m.b_vessel, self._motions, self._bx, self._bv, s.x, s.v, s.rho, s.p, m.grid.cell_start, m.grid.cell_end],
+                outputs=[self._b_p, self._b_rho, self._b_v_noslip],
+                device=d,
+            )
+        # compute_forces
+        wp.launch(
+            wcsph.compute_forces,
+            dim=self.n_particles,
+            inputs=[
+                prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel,
+                self._motions, s.x, s.v, s.rho, s.p, s.active, m.grid.cell_start, m.grid.cell_end,
+                self._bx, self._bv, self._b_p, self._b_rho, self._b_v_noslip,
+                m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, self._row,
+            ],
+            outputs=[self._acc, self._wall_force, self._wall_torque, self._diag_f],
+            device=d,
+        )
+        # compute_density_rate (with the kicked velocities)
+        wp.launch(
+            wcsph.compute_density_rate,
+            dim=self.n_particles,
+            inputs=[
+                prm, m.grid.spec, m.b_volume, s.x, s.v, self._acc, s.rho, s.active, self._dt,
+                m.grid.cell_start, m.grid.cell_end, self._bx, self._bv, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end,
+            ],
+            outputs=[self._drho],
+            device=d,
+        )
+        # integrate (+ wall guard, deactivation, diagnostics)
+        wp.launch(
+            wcsph.integrate,
+            dim=self.n_particles,
+            inputs=[
+                prm, m.vessels, wp.vec3(*cfg.domain_min), wp.vec3(*cfg.domain_max), GUARD_MARGIN * cfg.spacing,
+                cfg.max_wall_penetration * cfg.spacing, self._motions, self._dt, self._row, self._drho, self._acc,
+            ],
+            outputs=[s.x, s.v, s.rho, s.p, s.active, self._diag_f, self._diag_i],
+            device=d,
+        )
+        # reduce_wrenches (fixed order)
+        if m.n_vessels:
+            chunk = math.ceil(self.n_particles / WRENCH_CHUNKS)
+            wp.launch(wcsph.sum_wall_wrench_chunks, dim=(m.n_vessels, WRENCH_CHUNKS), inputs=[self.n_particles, chunk, self._wall_force, self._wall_torque], outputs=[self._partial_force, self._partial_torque], device=d)
+            wp.launch(wcsph.accumulate_wall_wrench, dim=m.n_vessels, inputs=[WRENCH_CHUNKS, self._partial_force, self._partial_torque], outputs=[self._force_sum, self._torque_sum], device=d)
+        wp.launch(wcsph.next_substep, dim=1, inputs=[self._row], device=d)
+
+    def _check(self, first: int, t0: float, dt: float, rows_f: np.ndarray, rows_i: np.ndarray) -> None:
+        cfg = self.config
+        checks = [
+            (rows_i[:, 0] > 0, lambda s: f"{rows_i[s, 0]} particles with a non-finite position, velocity or density"),
+            (rows_i[:, 1] > 0, lambda s: f"{rows_i[s, 1]} particles inside a vessel wall (deeper than {cfg.max_wall_penetration:g} dx)"),
+            (
+                rows_f[:, 2] > cfg.max_density_error,
+                lambda s: f"density error {rows_f[s, 2]:.3f} exceeds fluid.max_density_error = {cfg.max_density_error:g}",
+            ),
+        ]
+        bad = [(int(np.argmax(mask)), describe) for mask, describe in checks if mask.any()]
+        if bad:
+            s, describe = min(bad, key=lambda b: b[0])
+            raise FluidInstabilityError(first + s, t0 + (s + 1) * dt, describe(s))
+
+    # ---- readers (numpy, original particle order) ---------------------------------------------------------------
+    def _in_id_order(self, arr: wp.array) -> np.ndarray:
+        values = arr.numpy()
+        out = np.empty_like(values)
+        out[self.state.pid.numpy()] = values
+        return out
+
+    def positions(self) -> np.ndarray:
+        """(N, 3) m, world frame (a deactivated particle keeps the position where it left)."""
+        return self._in_id_order(self.state.x).astype(np.float64)
+
+    def velocities(self) -> np.ndarray:
+        """(N, 3) m/s."""
+        return self._in_id_order(self.state.v).astype(np.float64)
+
+    def densities(self) -> np.ndarray:
+        """(N,) kg/m^3."""
+        return self._in_id_order(self.state.rho).astype(np.float64)
+
+    def pressures(self) -> np.ndarray:
+        """(N,) Pa."""
+        return self._in_id_order(self.state.p).astype(np.float64)
+
+    def active_mask(self) -> np.ndarray:
+        """(N,) bool: still simulated (False once spilled out of the domain)."""
+        return self._in_id_order(self.state.active).astype(bool)
+
+    def vessel_poses(self) -> list[Pose]:
+        """Current world poses of the vessel frames (as simulated: projected onto the pour plane in 2-D)."""
+        return [Pose(p.position, p.rotation) for p in self._poses]
+
+    def wall_particles(self) -> np.ndarray:
+        """(Nb, 3) m: world positions of the dummy wall particles at the current poses."""
+        local = self.model.b_local.numpy().astype(np.float64)
+        vessel = self.model.b_vessel.numpy()
+        out = np.empty_like(local)
+        for k, pose in enumerate(self._poses):
+            out[vessel == k] = pose.transform(local[vessel == k])
+        return out
+
+    def vessel_wrenches(self) -> np.ndarray:
+        """(V, 6): the liquid's force (N) and torque (N m) on each vessel about its centre of mass, world frame,
+        averaged over the last interval's substeps (2-D: per unit depth x ``depth_2d``)."""
+        return self._wrench.copy()
+
+    @property
+    def last_report(self) -> IntervalReport | None:
+        return self._last_report
+
+    def history(self) -> dict[str, np.ndarray]:
+        """Every substep so far: 'dt' (s), 'time' (s, end of substep), 'max_speed', 'max_acceleration',
+        'max_density_error', 'kinetic_energy', 'nonfinite', 'wall_breaches', 'wall_corrections', 'active',
+        'volume_in_vessel' (steps, V) m^3."""
+        if not self._history:
+            return {}
+        dt = np.concatenate([h[0] for h in self._history])
+        f = np.concatenate([h[1] for h in self._history])
+        i = np.concatenate([h[2] for h in self._history])
+        return {
+            "dt": dt,
+            "time": np.cumsum(dt),
+            "max_speed": f[:, 0],
+            "max_acceleration": f[:, 1],
+            "max_density_error": f[:, 2],
+            "kinetic_energy": f[:, 3],
+            "nonfinite": i[:, 0],
+            "wall_breaches": i[:, 1],
+            "wall_corrections": i[:, 2],
+            "active": i[:, 3],
+            "volume_in_vessel": i[:, N_DIAG_INT_BASE:] * self.config.particle_volume,
+        }

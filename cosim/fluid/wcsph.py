@@ -1,0 +1,362 @@
+"""Weakly compressible SPH stages (warp kernels).
+
+compute_forces: per particle, over fluid and wall neighbours,
+  - the acceleration: symmetric pressure gradient, the dummy wall particles entering like liquid particles of
+    mass rho0 V_w with their extrapolated pressure (Adami et al. 2012, see ``cosim.fluid.boundary``); Monaghan
+    (1992) artificial viscosity and Morris et al. (1997) laminar viscosity (no-slip against the walls); gravity;
+  - the reaction on each vessel: -m a_ib summed per particle, and its moment about the vessel's centre of mass,
+    stored per particle so they can be reduced in a fixed order (deterministic on every device).
+compute_density_rate: continuity equation (liquid and wall particles) evaluated with the kicked velocities, plus
+  delta-SPH diffusion (Molteni & Colagrossi 2009) of the density minus its hydrostatic part (Fourtakas et al.
+  2019, here with the EOS's local slope dp/drho), so a resting column keeps its hydrostatic density profile.
+integrate: symplectic Euler, i.e. leapfrog with velocities at half steps: v += dt a(rho_n); rho += dt
+  Drho(v_new); x += dt v_new. (Updating rho with the old velocity instead would be forward Euler for the acoustic
+  waves and amplify them every step.) Then the wall guard, deactivation outside the domain, the equation of
+  state and the substep's diagnostics.
+"""
+
+from __future__ import annotations
+
+import warp as wp
+
+from cosim.fluid.boundary import VesselGeometry, VesselMotion, guard_vessel, inside_vessel
+from cosim.fluid.diagnostics import (
+    DIAG_ACTIVE,
+    DIAG_BREACHES,
+    DIAG_CORRECTIONS,
+    DIAG_INSIDE0,
+    DIAG_KINETIC_ENERGY,
+    DIAG_MAX_ACCEL,
+    DIAG_MAX_DENSITY_ERROR,
+    DIAG_MAX_SPEED,
+    DIAG_NONFINITE,
+)
+from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
+from cosim.fluid.params import SPHParams
+from cosim.fluid.sph_kernels import kernel_dw
+
+
+@wp.func
+def tait_pressure(prm: SPHParams, rho: float) -> float:
+    """Tait equation of state (seed Eq. 5) with the artificial sound speed: p = B ((rho/rho0)^gamma - 1)."""
+    return prm.eos_b * (wp.pow(rho / prm.rest_density, prm.gamma) - 1.0)
+
+
+@wp.kernel
+def compute_forces(
+    # Model
+    prm: SPHParams,
+    g: GridSpec,
+    vessels: wp.array(dtype=VesselGeometry),
+    b_volume: wp.array(dtype=float),
+    b_vessel: wp.array(dtype=wp.int32),
+    # State in
+    motions: wp.array(dtype=VesselMotion),
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    p: wp.array(dtype=float),
+    active: wp.array(dtype=wp.int32),
+    cell_start: wp.array(dtype=wp.int32),
+    cell_end: wp.array(dtype=wp.int32),
+    bx: wp.array(dtype=wp.vec3),
+    bv: wp.array(dtype=wp.vec3),
+    b_p: wp.array(dtype=float),
+    b_rho: wp.array(dtype=float),
+    b_v_noslip: wp.array(dtype=wp.vec3),
+    b_order: wp.array(dtype=wp.int32),
+    b_cell_start: wp.array(dtype=wp.int32),
+    b_cell_end: wp.array(dtype=wp.int32),
+    row: wp.array(dtype=wp.int32),
+    # Out
+    acc: wp.array(dtype=wp.vec3),
+    wall_force: wp.array2d(dtype=wp.vec3),
+    wall_torque: wp.array2d(dtype=wp.vec3),
+    diag_f: wp.array2d(dtype=float),
+):
+    """Acceleration of each particle and the reaction it exerts on each vessel (per particle, reduced later)."""
+    i = wp.tid()
+    for k in range(prm.n_vessels):
+        wall_force[k, i] = wp.vec3(0.0)
+        wall_torque[k, i] = wp.vec3(0.0)
+    if active[i] == 0:
+        acc[i] = wp.vec3(0.0)
+        return
+    xi = x[i]
+    vi = v[i]
+    rhoi = rho[i]
+    pi_term = p[i] / (rhoi * rhoi)
+    support2 = prm.support * prm.support
+    a = wp.vec3(0.0)
+    c = grid_cell(g, xi)
+    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
+        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
+            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
+                cell = grid_index(g, cx, cy, cz)
+                for j in range(cell_start[cell], cell_end[cell]):
+                    r = xi - x[j]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    rl = wp.sqrt(r2)
+                    gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+                    vij = vi - v[j]
+                    rhoj = rho[j]
+                    a -= prm.mass * (pi_term + p[j] / (rhoj * rhoj)) * gw
+                    vr = wp.dot(vij, r)
+                    if vr < 0.0:
+                        mu = prm.h * vr / (r2 + prm.eta2)
+                        a += (prm.mass * prm.alpha * prm.sound_speed * mu / (0.5 * (rhoi + rhoj))) * gw
+                    a += (prm.mass * prm.nu * (1.0 / rhoi + 1.0 / rhoj) * wp.dot(r, gw) / (r2 + prm.eta2)) * vij
+                for kk in range(b_cell_start[cell], b_cell_end[cell]):
+                    b = b_order[kk]
+                    xb = bx[b]
+                    r = xi - xb
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    rl = wp.sqrt(r2)
+                    gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+                    mw = prm.rest_density * b_volume[b]
+                    rhob = b_rho[b]
+                    ab = -(mw * (pi_term + b_p[b] / (rhob * rhob))) * gw
+                    vr = wp.dot(vi - bv[b], r)
+                    if vr < 0.0:
+                        mu = prm.h * vr / (r2 + prm.eta2)
+                        ab += (mw * prm.alpha * prm.sound_speed * mu / (0.5 * (rhoi + rhob))) * gw
+                    ab += (mw * prm.nu * (1.0 / rhoi + 1.0 / rhob) * wp.dot(r, gw) / (r2 + prm.eta2)) * (vi - b_v_noslip[b])
+                    a += ab
+                    kv = b_vessel[b]
+                    m = motions[kv]
+                    com = m.p_now + m.r_now @ vessels[kv].com
+                    f_vessel = -prm.mass_out * ab
+                    wall_force[kv, i] = wall_force[kv, i] + f_vessel
+                    wall_torque[kv, i] = wall_torque[kv, i] + wp.cross(xb - com, f_vessel)
+    a += prm.gravity
+    acc[i] = a
+    wp.atomic_max(diag_f, row[0], DIAG_MAX_ACCEL, wp.length(a))
+
+
+@wp.kernel
+def compute_density_rate(
+    # Model
+    prm: SPHParams,
+    g: GridSpec,
+    b_volume: wp.array(dtype=float),
+    # State in
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    acc: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    active: wp.array(dtype=wp.int32),
+    dt: wp.array(dtype=float),
+    cell_start: wp.array(dtype=wp.int32),
+    cell_end: wp.array(dtype=wp.int32),
+    bx: wp.array(dtype=wp.vec3),
+    bv: wp.array(dtype=wp.vec3),
+    b_order: wp.array(dtype=wp.int32),
+    b_cell_start: wp.array(dtype=wp.int32),
+    b_cell_end: wp.array(dtype=wp.int32),
+    # Out
+    drho: wp.array(dtype=float),
+):
+    """Density rate from the continuity equation with the KICKED velocities v + dt a (symplectic: the density
+    sees the velocity it is integrated with), plus delta-SPH diffusion with the hydrostatic correction."""
+    i = wp.tid()
+    if active[i] == 0:
+        drho[i] = 0.0
+        return
+    h = dt[0]
+    xi = x[i]
+    vi = v[i] + h * acc[i]
+    rhoi = rho[i]
+    support2 = prm.support * prm.support
+    # hydrostatic density difference per metre along gravity at this density: rho / (dp/drho), with
+    # dp/drho = c0^2 (rho/rho0)^(gamma-1) from the Tait EOS (the local slope, not c0^2: keeps deep water exact)
+    hydro_slope = rhoi / (prm.sound_speed * prm.sound_speed * wp.pow(rhoi / prm.rest_density, prm.gamma - 1.0))
+    diffusion = 2.0 * prm.delta * prm.h * prm.sound_speed
+    dr = float(0.0)
+    c = grid_cell(g, xi)
+    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
+        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
+            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
+                cell = grid_index(g, cx, cy, cz)
+                for j in range(cell_start[cell], cell_end[cell]):
+                    r = xi - x[j]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    rl = wp.sqrt(r2)
+                    gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+                    vij = vi - (v[j] + h * acc[j])
+                    rhoj = rho[j]
+                    dr += prm.mass * wp.dot(vij, gw)
+                    hydro = hydro_slope * wp.dot(prm.gravity, r)
+                    dr += diffusion * (prm.mass / rhoj) * ((rhoi - rhoj) - hydro) * wp.dot(r, gw) / (r2 + prm.eta2)
+                for kk in range(b_cell_start[cell], b_cell_end[cell]):
+                    b = b_order[kk]
+                    r = xi - bx[b]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    rl = wp.sqrt(r2)
+                    gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+                    dr += prm.rest_density * b_volume[b] * wp.dot(vi - bv[b], gw)
+    drho[i] = dr
+
+
+@wp.kernel
+def integrate(
+    # Model
+    prm: SPHParams,
+    vessels: wp.array(dtype=VesselGeometry),
+    domain_min: wp.vec3,
+    domain_max: wp.vec3,
+    guard_margin: float,
+    max_penetration: float,
+    # State in
+    motions: wp.array(dtype=VesselMotion),
+    dt: wp.array(dtype=float),
+    row: wp.array(dtype=wp.int32),
+    drho: wp.array(dtype=float),
+    acc: wp.array(dtype=wp.vec3),
+    # State in/out
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    p: wp.array(dtype=float),
+    active: wp.array(dtype=wp.int32),
+    # Out
+    diag_f: wp.array2d(dtype=float),
+    diag_i: wp.array2d(dtype=wp.int32),
+):
+    i = wp.tid()
+    if active[i] == 0:
+        return
+    s = row[0]
+    h = dt[0]
+    x_old = x[i]
+    vi = v[i] + h * acc[i]
+    xi = x_old + h * vi
+    rhoi = rho[i] + h * drho[i]
+    if prm.dim == 2:
+        vi[1] = 0.0
+        xi[1] = 0.0
+    for k in range(prm.n_vessels):
+        m = motions[k]
+        geo = vessels[k]
+        q_old = wp.transpose(m.r_now) @ (x_old - m.p_now)
+        q_new = wp.transpose(m.r_next) @ (xi - m.p_next)
+        q, normal, depth, hits = guard_vessel(q_old, q_new, geo, prm.dim, guard_margin)
+        if hits > 0:
+            xi = m.p_next + m.r_next @ q
+            n_world = m.r_next @ normal
+            v_wall = m.lin_vel + wp.cross(m.ang_vel, xi - m.p_next)
+            vn = wp.dot(vi - v_wall, n_world)
+            if vn < 0.0:
+                vi = vi - vn * n_world
+            wp.atomic_add(diag_i, s, DIAG_CORRECTIONS, 1)
+            if depth > max_penetration:
+                wp.atomic_add(diag_i, s, DIAG_BREACHES, 1)
+        if inside_vessel(q, geo, prm.dim) != 0:
+            wp.atomic_add(diag_i, s, DIAG_INSIDE0 + k, 1)
+    if not (wp.isfinite(xi) and wp.isfinite(vi) and wp.isfinite(rhoi)):
+        wp.atomic_add(diag_i, s, DIAG_NONFINITE, 1)
+        active[i] = 0
+        return
+    outside = False
+    for a in range(3):
+        if xi[a] < domain_min[a] or xi[a] > domain_max[a]:
+            outside = True
+    if outside:
+        active[i] = 0
+        x[i] = xi
+        v[i] = wp.vec3(0.0)
+        return
+    x[i] = xi
+    v[i] = vi
+    rho[i] = rhoi
+    p[i] = tait_pressure(prm, rhoi)
+    speed = wp.length(vi)
+    wp.atomic_add(diag_i, s, DIAG_ACTIVE, 1)
+    wp.atomic_max(diag_f, s, DIAG_MAX_SPEED, speed)
+    wp.atomic_max(diag_f, s, DIAG_MAX_DENSITY_ERROR, wp.abs(rhoi - prm.rest_density) / prm.rest_density)
+    wp.atomic_add(diag_f, s, DIAG_KINETIC_ENERGY, 0.5 * prm.mass_out * speed * speed)
+
+
+@wp.kernel
+def equation_of_state(prm: SPHParams, rho: wp.array(dtype=float), p: wp.array(dtype=float)):
+    """p from rho for every particle (used once at start-up; integrate() keeps p current afterwards)."""
+    i = wp.tid()
+    p[i] = tait_pressure(prm, rho[i])
+
+
+@wp.kernel
+def gather_particles(
+    order: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    p: wp.array(dtype=float),
+    active: wp.array(dtype=wp.int32),
+    pid: wp.array(dtype=wp.int32),
+    x_out: wp.array(dtype=wp.vec3),
+    v_out: wp.array(dtype=wp.vec3),
+    rho_out: wp.array(dtype=float),
+    p_out: wp.array(dtype=float),
+    active_out: wp.array(dtype=wp.int32),
+    pid_out: wp.array(dtype=wp.int32),
+):
+    """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
+    i = wp.tid()
+    src = order[i]
+    x_out[i] = x[src]
+    v_out[i] = v[src]
+    rho_out[i] = rho[src]
+    p_out[i] = p[src]
+    active_out[i] = active[src]
+    pid_out[i] = pid[src]
+
+
+@wp.kernel
+def sum_wall_wrench_chunks(
+    n: int,
+    chunk: int,
+    wall_force: wp.array2d(dtype=wp.vec3),
+    wall_torque: wp.array2d(dtype=wp.vec3),
+    partial_force: wp.array2d(dtype=wp.vec3),
+    partial_torque: wp.array2d(dtype=wp.vec3),
+):
+    """First level of the fixed-order reduction: chunk c of vessel k summed sequentially."""
+    k, c = wp.tid()
+    f = wp.vec3(0.0)
+    t = wp.vec3(0.0)
+    for i in range(c * chunk, wp.min((c + 1) * chunk, n)):
+        f += wall_force[k, i]
+        t += wall_torque[k, i]
+    partial_force[k, c] = f
+    partial_torque[k, c] = t
+
+
+@wp.kernel
+def accumulate_wall_wrench(
+    n_chunks: int,
+    partial_force: wp.array2d(dtype=wp.vec3),
+    partial_torque: wp.array2d(dtype=wp.vec3),
+    force_sum: wp.array(dtype=wp.vec3),
+    torque_sum: wp.array(dtype=wp.vec3),
+):
+    """Second level: the chunks of vessel k in order, added to the interval's running sum."""
+    k = wp.tid()
+    f = wp.vec3(0.0)
+    t = wp.vec3(0.0)
+    for c in range(n_chunks):
+        f += partial_force[k, c]
+        t += partial_torque[k, c]
+    force_sum[k] = force_sum[k] + f
+    torque_sum[k] = torque_sum[k] + t
+
+
+@wp.kernel
+def next_substep(row: wp.array(dtype=wp.int32)):
+    row[0] = row[0] + 1

@@ -1,0 +1,96 @@
+"""Frame conversions: the one audited place where rotations change representation.
+
+Conventions: world z up; quaternions are [w, x, y, z] (MuJoCo's order; warp's own quaternions are [x, y, z, w],
+so warp kernels in this project take rotation matrices instead); rotation matrices map vessel-frame vectors to
+world vectors (x_world = R @ x_local + p).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def quat_wxyz_to_matrix(q: np.ndarray) -> np.ndarray:
+    """Rotation matrix (3, 3) of a unit quaternion [w, x, y, z] (normalised here)."""
+    w, x, y, z = np.asarray(q, dtype=float) / np.linalg.norm(q)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def matrix_to_quat_wxyz(r: np.ndarray) -> np.ndarray:
+    """Unit quaternion [w, x, y, z] (w >= 0) of a rotation matrix (Shepperd's method)."""
+    r = np.asarray(r, dtype=float)
+    tr = np.trace(r)
+    if tr > 0:
+        s = 2.0 * math.sqrt(tr + 1.0)
+        q = [0.25 * s, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s]
+    else:
+        i = int(np.argmax(np.diag(r)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * math.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k])
+        q = [0.0, 0.0, 0.0, 0.0]
+        q[0] = (r[k, j] - r[j, k]) / s
+        q[1 + i] = 0.25 * s
+        q[1 + j] = (r[j, i] + r[i, j]) / s
+        q[1 + k] = (r[k, i] + r[i, k]) / s
+    q = np.array(q)
+    return q if q[0] >= 0 else -q
+
+
+def rotation_y(theta: float) -> np.ndarray:
+    """R_y(theta): rotation about world +y by theta (rad); positive theta lowers a vessel's +x lip."""
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def tilt_about_y(r: np.ndarray) -> float:
+    """The angle theta of the rotation about +y closest to ``r`` (rad): atan2(R[0, 2], R[2, 2])."""
+    return math.atan2(r[0, 2], r[2, 2])
+
+
+def rotation_vector(r: np.ndarray) -> np.ndarray:
+    """Axis-angle vector (rad) of a rotation matrix: the log map, angle in [0, pi]."""
+    cos_angle = np.clip(0.5 * (np.trace(r) - 1.0), -1.0, 1.0)
+    angle = math.acos(cos_angle)
+    axis = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]])
+    if angle < 1e-9:
+        return 0.5 * axis
+    if math.pi - angle < 1e-6:
+        # near pi: axis from the symmetric part
+        m = 0.5 * (r + np.eye(3))
+        k = int(np.argmax(np.diag(m)))
+        v = m[:, k] / math.sqrt(max(m[k, k], 1e-300))
+        return angle * v / np.linalg.norm(v)
+    return angle * axis / (2.0 * math.sin(angle))
+
+
+class Pose:
+    """A rigid pose: ``position`` (3,) m and ``rotation`` (3, 3), mapping frame vectors to world vectors."""
+
+    __slots__ = ("position", "rotation")
+
+    def __init__(self, position=(0.0, 0.0, 0.0), rotation=None):
+        self.position = np.array(position, dtype=float).reshape(3)
+        self.rotation = np.eye(3) if rotation is None else np.array(rotation, dtype=float).reshape(3, 3)
+
+    @classmethod
+    def from_quat_wxyz(cls, position, quat) -> "Pose":
+        return cls(position, quat_wxyz_to_matrix(quat))
+
+    def transform(self, points_local: np.ndarray) -> np.ndarray:
+        """World coordinates of points (n, 3) given in this frame."""
+        return np.asarray(points_local) @ self.rotation.T + self.position
+
+    def inverse_transform(self, points_world: np.ndarray) -> np.ndarray:
+        """This frame's coordinates of world points (n, 3)."""
+        return (np.asarray(points_world) - self.position) @ self.rotation
+
+    def __repr__(self) -> str:
+        return f"Pose(position={self.position.tolist()}, tilt_y={tilt_about_y(self.rotation):.4f} rad)"

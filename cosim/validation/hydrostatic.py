@@ -1,0 +1,133 @@
+"""Hydrostatic tank: a resting column must carry p(z) = rho0 g (H - z) (shared/reference/README.md).
+
+A box tank of inner width ``width`` is filled to ``fill`` and left alone for ``duration``; then the SPH pressure
+is interpolated (Shepard, the solver's kernel) at probes more than 2h from walls, floor and surface and compared
+with rho0 g (H - z), H being the liquid's actual height (its volume over the tank's floor area: the lattice
+holds a whole number of layers). Also: max density error, particles outside the tank, volume drift, and the
+liquid's vertical force on the tank against its weight.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from cosim.checks import check_positive
+from cosim.fluid.config import GRAVITY
+from cosim.fluid.seeding import fill_vessel
+from cosim.fluid.solver import FluidSolver
+from cosim.frames import Pose
+from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across
+from cosim.vessel import VesselSpec
+
+# Acceptance (issue "Fluid core"): pressure within 2 % of rho0 g (H - z) away from walls and surface, density
+# error <= 1 % (weakly compressible bound (v_max / c0)^2 with c0 >= 10 v_max, shared/reference/README.md),
+# vertical reaction = liquid weight within 1 %, no leak, volume conserved.
+PRESSURE_TOLERANCE = 0.02
+DENSITY_ERROR_LIMIT = 0.01
+WEIGHT_TOLERANCE = 0.01
+MIN_PARTICLES_ACROSS = 40
+PROBE_CLEARANCE = 2.0  # probes stay this many smoothing lengths h from walls, floor and surface
+INTERVAL = 0.02  # s, how often vessel poses are (re)set; the tank does not move
+
+
+@dataclass(frozen=True)
+class Params(FluidCaseParams):
+    """width: m, tank inner width (B). fill: m, fill depth. duration: s, simulated time before measuring."""
+
+    width: float = 0.191
+    fill: float = 0.159
+    duration: float = 2.0
+
+    def __post_init__(self) -> None:
+        self.validate_common()
+        check_positive("width", self.width, "m", 2.0)
+        check_positive("fill", self.fill, "m", 2.0)
+        check_positive("duration", self.duration, "s", 60.0)
+
+    @property
+    def resolved_spacing(self) -> float:
+        return self.spacing if self.spacing is not None else self.width / MIN_PARTICLES_ACROSS
+
+
+def _interpolate(points: np.ndarray, x: np.ndarray, values: np.ndarray, volumes: np.ndarray, h: float) -> np.ndarray:
+    """Shepard-normalised SPH interpolation with the Wendland C2 shape (normalisation cancels)."""
+    out = np.empty(len(points))
+    for k, p in enumerate(points):
+        q = np.linalg.norm(x - p, axis=1) / h
+        w = np.where(q < 2.0, (1.0 - 0.5 * q) ** 4 * (2.0 * q + 1.0), 0.0) * volumes
+        out[k] = (w * values).sum() / w.sum()
+    return out
+
+
+def run(p: Params) -> CaseResult:
+    dx = p.resolved_spacing
+    require_particles_across("spacing", p.width, dx, MIN_PARTICLES_ACROSS)
+    tank = VesselSpec(name="tank", inner_width=p.width, inner_depth=p.depth, inner_height=p.fill * 1.25 + 4 * dx)
+    margin = 0.05 * p.width + 10 * dx
+    half = 0.5 * p.width + margin
+    cfg = case_fluid_config(
+        p.dim, dx, p.fill, p.depth, (-half, -0.5 * p.depth - margin, -margin), (half, 0.5 * p.depth + margin, tank.inner_height + margin)
+    )
+    solver = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, p.fill, cfg), device=p.device)
+    start = time.perf_counter()
+    while solver.time < p.duration - 1e-9:
+        solver.advance(min(INTERVAL, p.duration - solver.time))
+    wall = time.perf_counter() - start
+
+    x, pressure, rho, active = solver.positions(), solver.pressures(), solver.densities(), solver.active_mask()
+    h = cfg.smoothing_length
+    volume0 = solver.n_particles * cfg.particle_volume
+    height = volume0 / (tank.inner_floor_area if p.dim == 3 else p.width * p.depth)
+    clearance = PROBE_CLEARANCE * h
+    zs = np.linspace(clearance, height - clearance, 12)
+    xs = np.linspace(-0.5 * p.width + clearance, 0.5 * p.width - clearance, 5)
+    probes = np.array([(px, 0.0, pz) for px in xs for pz in zs])
+    probe_p = _interpolate(probes, x, pressure, cfg.particle_mass / rho, h)
+    ref_p = cfg.rest_density * GRAVITY * (height - probes[:, 2])
+    rel = (probe_p - ref_p) / ref_p
+    worst = int(np.argmax(np.abs(rel)))
+    density_error = float(np.abs(rho - cfg.rest_density).max() / cfg.rest_density)
+    inside = solver.last_report.last.volume_in_vessel[0]
+    leaked = int(solver.n_particles - round(inside / cfg.particle_volume))
+    weight = volume0 * cfg.rest_density * GRAVITY
+    reaction = -float(solver.vessel_wrenches()[0, 2])
+    metrics = [
+        Metric("pressure (worst probe)", float(probe_p[worst]), float(ref_p[worst]), float(rel[worst]), PRESSURE_TOLERANCE, "Pa"),
+        Metric("max density error", density_error, 0.0, density_error, DENSITY_ERROR_LIMIT, "", absolute=True),
+        Metric("vertical reaction", reaction, weight, (reaction - weight) / weight, WEIGHT_TOLERANCE, "N"),
+        Metric("particles outside the tank", float(leaked), 0.0, float(leaked), 0.0, "", absolute=True),
+        Metric("liquid volume in the tank", inside, volume0, (inside - volume0) / volume0, 0.0, "m^3"),
+    ]
+    raw = {
+        "z": probes[:, 2].tolist(),
+        "x": probes[:, 0].tolist(),
+        "pressure": probe_p.tolist(),
+        "reference_pressure": ref_p.tolist(),
+        "liquid_height": height,
+        "leaked": leaked,
+        "max_density_error": density_error,
+        "reaction_force_z": reaction,
+        "fluid_weight": weight,
+        "particles": solver.n_particles,
+        "steps": solver.step_count,
+        "active": int(active.sum()),
+    }
+    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, duration=p.duration, depth=p.depth)
+    return CaseResult("hydrostatic", params, metrics, raw, wall)
+
+
+def plot(result: CaseResult, path) -> None:
+    fig, ax, plt = new_figure(f"Hydrostatic tank ({result.parameters['dim']}-D): pressure at the probes")
+    z, pr, ref = map(np.asarray, (result.raw["z"], result.raw["pressure"], result.raw["reference_pressure"]))
+    order = np.argsort(z)
+    ax.plot(ref[order], z[order], "k-", label="rho0 g (H - z)")
+    ax.plot(pr, z, "o", ms=4, label="SPH (Shepard interpolation)")
+    ax.set_xlabel("pressure (Pa)")
+    ax.set_ylabel("z above the tank floor (m)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
