@@ -172,9 +172,10 @@ class PourConfig:
     vessel: the pourer's :class:`controllers.geometry.VesselGeometry`.
     fill_depth: m, A, the initial liquid depth in the upright pourer. (0, vessel.inner_height)
     target_volume: m^3 to pour (partial pour), or None to pour until empty. (0, initial volume]
-    control_rate: Hz, rate of :meth:`PourController.step`. [20, 500]. Default 100 Hz: 50 samples per slosh
-      period (0.5 s), 16 per period of the closed loop's fastest pole, a derivative filter Tf = 2.7 samples, and
-      five 2 ms MuJoCo steps per control step.
+    control_rate: Hz, rate of :meth:`PourController.step`. [20, 500]. Default 100 Hz: five 2 ms MuJoCo steps,
+      50 samples per slosh period (0.50 s for the seed's vessel), the derivative filter Tf = 27 ms spans 2.7
+      samples, and the sampled SIM loop (theta1 measured one period before it acts) keeps a 52 deg phase
+      margin, 13.8 dB gain margin and Ms = 1.47 (50 Hz: 43 deg, 11.6 dB, Ms = 1.70).
     start_time: s, the controller idles (vessel at home, catcher pre-positioned) until this time. [0, 60]
     gravity: m/s^2. (0, 100]
     """

@@ -167,10 +167,10 @@ def vector_step(a: tuple[float, float], dh: float) -> float:
     """Tilt increment (rad) of the seed's CFS vector step (Fig. 9) that lowers the tip of ``a`` by ``dh``.
 
     ``a`` (m, world x-z) goes from the centre of rotation to the point at the lip; b = (0, dh) is the vertical
-    step at that point and c = a - b. The seed turns by the angle between a and c; this returns the rotation
-    (in the tilt sense) that brings the tip of a, kept at length |a|, exactly to the height of c, i.e. down by
-    dh (the two agree to first order in dh / |a|). dh < 0 raises the point. A dh beyond the reach of the circle
-    is clipped to it.
+    step at that point and c = a - b. Turning by the angle between a and c, as Fig. 9 reads literally, lowers
+    the tip by only cos^2(beta) dh to first order (beta = elevation of a; the tip stays at length |a|, not |c|).
+    This returns the rotation (in the tilt sense) that brings the tip of a exactly to the height of c, i.e. down
+    by dh, as the seed's text asks. dh < 0 raises the point. A dh beyond the reach of the circle is clipped.
     """
     ax, az = a
     r = math.hypot(ax, az)

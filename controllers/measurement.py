@@ -101,8 +101,9 @@ class PourCommand:
       :class:`controllers.geometry.PlanarPose`).
     catcher: target pose of vessel B relative to its home, (dx, 0, 0).
     phase, reason: the current phase and why it started.
-    landing_x: m, world x where the jet is predicted to cross vessel B's rim (Eqs. 6-7); before the outflow
-      starts, the prediction for the weir velocity at h_q_ref from the current lip.
+    landing_x: m, world x where the jet is predicted to cross vessel B's rim (Eqs. 6-7), vessel B's target.
+      Before the outflow starts: the prediction for the weir velocity at h_q_ref from the current lip. Once the
+      pour is over (return, done) and nothing flows: the last target, held.
     slosh_angle: rad, the measured sigma = theta1 - tilt.
     """
 

@@ -27,13 +27,12 @@ class RateLimitedTracker:
 
     def step(self, target: float) -> float:
         """Advance one step toward ``target``; returns the new position."""
-        err = target - self.position
-        # Speed from which max_accel still stops at the target; the discrete term keeps the last steps exact.
-        stop_speed = math.sqrt(2.0 * self.max_accel * abs(err))
-        want = math.copysign(min(self.max_rate, stop_speed, abs(err) / self.dt), err)
-        dv = self.max_accel * self.dt
-        self.velocity = min(max(want, self.velocity - dv), self.velocity + dv)
-        self.position += self.velocity * self.dt
+        err, a, dt = target - self.position, self.max_accel, self.dt
+        # Largest speed v from which braking by a dt per step stops within |err|: v^2/(2a) + v dt/2 = |err|.
+        stop_speed = a * (math.sqrt(0.25 * dt * dt + 2.0 * abs(err) / a) - 0.5 * dt)
+        want = math.copysign(min(self.max_rate, stop_speed, abs(err) / dt), err)
+        self.velocity = min(max(want, self.velocity - a * dt), self.velocity + a * dt)
+        self.position += self.velocity * dt
         return self.position
 
     def at(self, target: float, tol: float) -> bool:

@@ -32,8 +32,8 @@ from controllers.slosh_induction import excitation_duration, excitation_tilt, si
 # Time constant (s) of the first-order filter on the measured outflow rate d(poured)/dt: a fifth of the seed
 # vessel's slosh period, enough to smooth SPH particle-count steps while keeping the stop prediction current.
 OUTFLOW_FILTER_TIME = 0.1
-# Tilt (rad) within which the return counts as upright (0.006 deg).
-UPRIGHT_TOLERANCE = 1e-4
+# Tilt (rad) within which a rate-limited tilt counts as arrived (approach target, upright): 0.006 deg.
+ARRIVAL_TOLERANCE = 1e-4
 
 POURING = (Phase.SIM_EXCITE, Phase.SIM_HOLD, Phase.SIM_DAMP, Phase.APPROACH, Phase.CFS)
 
@@ -253,7 +253,7 @@ class PourController:
             return stop
         if m.h_q > 0.0:
             return Phase.CFS, f"liquid over the crest: h_q = {1e3 * m.h_q:.2f} mm"
-        if self._approach.at(self._reference, UPRIGHT_TOLERANCE):
+        if self._approach.at(self._reference, ARRIVAL_TOLERANCE):
             return Phase.CFS, f"reached the static crest tilt {math.degrees(self._reference):.2f} deg"
         return None
 
@@ -271,7 +271,7 @@ class PourController:
         return None
 
     def _check_return(self, m: LiquidMeasurement) -> Transition:
-        if self._return.at(0.0, UPRIGHT_TOLERANCE):
+        if self._return.at(0.0, ARRIVAL_TOLERANCE):
             return Phase.DONE, "upright at home"
         return None
 

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import control as ct
 import numpy as np
@@ -61,6 +62,7 @@ class SloshModel:
     """The first-mode pendulum of a liquid of depth ``fill_depth`` (A, m) in a vessel of inner width ``width`` (B, m).
 
     All lengths in m, frequencies in rad/s unless the name says Hz. See the module docstring for frames and signs.
+    Derived parameters are computed once (the instance is immutable).
     """
 
     width: float
@@ -72,27 +74,27 @@ class SloshModel:
         check_range("slosh.fill_depth", self.fill_depth, 0.0, 2.0, "m", lo_open=True)
         check_range("slosh.gravity", self.gravity, 0.0, 100.0, "m/s^2", lo_open=True)
 
-    @property
+    @cached_property
     def _k(self) -> float:
         """pi A / B (dimensionless)."""
         return math.pi * self.fill_depth / self.width
 
-    @property
+    @cached_property
     def l1(self) -> float:
         """Pendulum length (m), Eq. 10."""
         return self.width / math.pi / math.tanh(self._k)
 
-    @property
+    @cached_property
     def L1(self) -> float:  # noqa: N802 (the seed's symbol)
         """Pendulum hinge offset (m), Eq. 11 with the seed's quoted sign (see module docstring)."""
         return self.l1 + 0.5 * self.fill_depth - 2.0 * self.width / math.pi * math.tanh(self._k)
 
-    @property
+    @cached_property
     def b2(self) -> float:
         """b2 = A/2 - L1 - l1 (m), Eq. 14; negative for every fill, which puts a zero in the right half-plane."""
         return 0.5 * self.fill_depth - self.L1 - self.l1
 
-    @property
+    @cached_property
     def omega1(self) -> float:
         """First-mode angular frequency sqrt(g / l1) (rad/s); equals 2 pi times Eq. 17."""
         return math.sqrt(self.gravity / self.l1)
@@ -107,7 +109,7 @@ class SloshModel:
         """The right-half-plane zero sqrt(g / -b2) of Gp (rad/s)."""
         return math.sqrt(self.gravity / -self.b2)
 
-    @property
+    @cached_property
     def hinge_height(self) -> float:
         """Height above the inner floor (m) of the pivot that leaves the slosh unexcited: l1 - b2.
 
