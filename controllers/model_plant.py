@@ -19,6 +19,7 @@ import numpy as np
 
 from controllers.catcher import weir_velocity
 from controllers.checks import check_range
+from controllers.errors import ControllerInputError
 from controllers.geometry import PlanarPose, VesselGeometry, height_above, surface_offset
 from controllers.measurement import LiquidMeasurement, PourCommand
 from controllers.pour import PourController
@@ -47,7 +48,8 @@ class ModelPlantConfig:
     def __post_init__(self) -> None:
         check_range("plant.fill_depth", self.fill_depth, 0.0, self.vessel.inner_height, "m", lo_open=True)
         check_range("plant.discharge_coefficient", self.discharge_coefficient, 0.0, 1.0, lo_open=True)
-        check_range("plant.substeps", self.substeps, 1, 100)
+        if isinstance(self.substeps, bool) or not isinstance(self.substeps, int) or not 1 <= self.substeps <= 100:
+            raise ControllerInputError(f"plant.substeps: must be an integer in [1, 100], got {self.substeps!r}")
 
 
 class ModelPlant:

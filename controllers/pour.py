@@ -35,8 +35,6 @@ OUTFLOW_FILTER_TIME = 0.1
 # Tilt (rad) within which a rate-limited tilt counts as arrived (approach target, upright): 0.006 deg.
 ARRIVAL_TOLERANCE = 1e-4
 
-POURING = (Phase.SIM_EXCITE, Phase.SIM_HOLD, Phase.SIM_DAMP, Phase.APPROACH, Phase.CFS)
-
 Transition = tuple[Phase, str] | None
 
 

@@ -22,7 +22,10 @@ so that Gp(s) = theta1(s)/theta(s) = (b2 s^2 + g) / (l1 s^2 + g) for a rotation 
 unity-feedback loop). The seed's Eq. 9 measures the pendulum angle theta_n in the opposite sense
 (theta_n = -theta1), which is where the reference README's minus sign comes from; both describe the same physics.
 The -x'' term has the sign of the quasi-static limit: accelerating the vessel toward +x piles the liquid at the
-back wall (sigma = -x''/g).
+back wall (sigma = -x''/g). (M) is a pendulum of length l1 hanging from the vessel-frame point (0, l1 - b2),
+the "hinge": l1 sigma'' + g sigma = -(world x of the hinge)''. Rotating about a pivot below the hinge
+(the floor centre, SIM) excites the slosh, about the hinge not at all (the approach), about a pivot above it
+(the lip, CFS) with the opposite sign, which is what keeps the CFS integral law stable (:mod:`controllers.cfs`).
 
 Pendulum parameters (seed Eqs. 10-11). The seed writes them with the vessel height L; its vessel has L = B, and
 the pendulum reproduces the first sloshing frequency (Eq. 17, omega1^2 = g / l1) only with the width B in the
