@@ -26,7 +26,7 @@ import numpy as np  # noqa: E402
 from controllers.config import CatcherConfig, PourConfig  # noqa: E402
 from controllers.measurement import Phase  # noqa: E402
 from controllers.model_plant import ModelPlant, ModelPlantConfig, Trace, run_closed_loop  # noqa: E402
-from controllers.pid import PidDesign, design_filtered_pid  # noqa: E402
+from controllers.pid import PidDesign, design_filtered_pid, sampled_plant  # noqa: E402
 from controllers.pour import PourController  # noqa: E402
 from controllers.slosh import SloshModel  # noqa: E402
 
@@ -117,7 +117,8 @@ def sim_timeline(config: PourConfig) -> tuple[PourController, Trace]:
     return controller, run_closed_loop(controller, plant, SIM_PLOT_SECONDS)
 
 
-def figure_sim_timeline(path: Path, config: PourConfig) -> None:
+def figure_sim_timeline(path: Path, config: PourConfig) -> PourController:
+    """Draw Fig. 16 (model version); returns the controller that ran it (its transitions, SIM parameters)."""
     controller, trace = sim_timeline(config)
     t = trace.t
     theta = np.degrees([c.pourer.theta for c in trace.commands])
@@ -140,6 +141,7 @@ def figure_sim_timeline(path: Path, config: PourConfig) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+    return controller
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -150,22 +152,27 @@ def main(argv: list[str] | None = None) -> int:
     config = seed_config()
     model = SloshModel(config.vessel.inner_width, config.fill_depth, config.gravity)
     design = design_filtered_pid(model, config.sim.pid, config.dt)
-    outputs = {
-        "fig13_theta1_ratio.png": lambda p: figure_ratio(p, config),
-        "fig14_root_locus.png": lambda p: figure_root_locus(p, design),
-        "fig15_step_response.png": lambda p: figure_step(p, design),
-        "fig16_sim_timeline.png": lambda p: figure_sim_timeline(p, config),
-    }
-    for name, draw in outputs.items():
-        draw(args.out / name)
+    figure_ratio(args.out / "fig13_theta1_ratio.png", config)
+    figure_root_locus(args.out / "fig14_root_locus.png", design)
+    figure_step(args.out / "fig15_step_response.png", design)
+    controller = figure_sim_timeline(args.out / "fig16_sim_timeline.png", config)
+    for name in ("fig13_theta1_ratio.png", "fig14_root_locus.png", "fig15_step_response.png", "fig16_sim_timeline.png"):
         print(args.out / name)
     g = design.gains
     print(f"plant: l1 = {model.l1:.5f} m, L1 = {model.L1:.5f} m, b2 = {model.b2:.5f} m, "
           f"omega1 = {model.omega1:.3f} rad/s, RHP zero = {model.rhp_zero:.2f} rad/s")
     print(f"PID: Kp = {g.kp:.4f}, Ki = {g.ki:.4f} 1/s, Kd = {g.kd:.5f} s, Tf = {g.tf:.5f} s")
     print("closed-loop poles (rad/s): " + ", ".join(f"{p:.3f}" for p in design.closed_loop_poles))
-    print(f"min damping {design.min_damping:.3f}, settling time (2 %) {design.settling_time:.3f} s, "
-          f"sampled at {config.control_rate:g} Hz: max |z| = {np.max(np.abs(design.discrete_poles)):.4f}")
+    sampled = g.discrete_tf(config.dt) * sampled_plant(model, config.dt)
+    gm, pm, _, wc = ct.margin(sampled)
+    w = np.linspace(1e-3, math.pi / config.dt, 20000)
+    ms = float(np.max(np.abs(1.0 / (1.0 + sampled(np.exp(1j * w * config.dt))))))
+    print(f"min damping {design.min_damping:.3f}, settling time (2 %) {design.settling_time:.3f} s; "
+          f"sampled at {config.control_rate:g} Hz: max |z| = {np.max(np.abs(design.discrete_poles)):.4f}, "
+          f"gain margin {20 * math.log10(gm):.1f} dB, phase margin {pm:.1f} deg at {wc:.1f} rad/s, Ms = {ms:.2f}")
+    print(f"SIM: phi = {math.degrees(controller.sim_amplitude):.2f} deg, alpha = {controller.sim_frequency:.3f} rad/s")
+    for tr in controller.transitions:
+        print(f"  t = {tr.t:5.2f} s  {tr.source.value} -> {tr.target.value}: {tr.reason}")
     return 0
 
 
