@@ -1,6 +1,48 @@
-"""Pouring controllers: pure numpy + python-control (no warp, no MuJoCo).
+"""Pouring controllers: pure numpy + python-control (no warp, no MuJoCo, no cosim).
 
 The slosh pendulum model and plant Gp (seed Eqs. 10-14, 17), the filtered-derivative PID compensator, the slosh
 induction method (SIM) timeline, the constant-flow stage (CFS), the catcher's landing-point prediction
-(Eqs. 6-7) and the pour state machine. Outputs are vessel targets; the robot side turns them into joint targets.
+(Eqs. 6-7) and the pour state machine. Outputs are vessel targets (planar poses relative to home); the robot
+side turns them into joint targets.
+
+The coupling's entry point: build a :class:`PourConfig`, a :class:`PourController`, and call
+``PourController.step(LiquidMeasurement) -> PourCommand`` once per ``config.dt``. Conventions (frames, the
+theta1 measurement, signs) are in :mod:`controllers.measurement` and :mod:`controllers.slosh`.
 """
+
+from controllers.config import (
+    ApproachConfig,
+    CatcherConfig,
+    CfsConfig,
+    PourConfig,
+    ReturnConfig,
+    SimConfig,
+    SimMode,
+)
+from controllers.errors import ControllerInputError, MeasurementError
+from controllers.geometry import PlanarPose, VesselGeometry
+from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
+from controllers.pid import PidDesignSpec
+from controllers.pour import PourController
+from controllers.slosh import SloshModel
+
+__all__ = [
+    "ApproachConfig",
+    "CatcherConfig",
+    "CfsConfig",
+    "ControllerInputError",
+    "LiquidMeasurement",
+    "MeasurementError",
+    "Phase",
+    "PhaseTransition",
+    "PidDesignSpec",
+    "PlanarPose",
+    "PourCommand",
+    "PourConfig",
+    "PourController",
+    "ReturnConfig",
+    "SimConfig",
+    "SimMode",
+    "SloshModel",
+    "VesselGeometry",
+]

@@ -1,0 +1,221 @@
+"""Configuration of the pour controller: frozen dataclasses validated on construction, closed choices as enums.
+
+Each maps 1:1 onto a TOML table (field names are the keys, enum values the strings). Every error is one
+:class:`controllers.errors.ControllerInputError` line naming the field and its allowed range. SI units, rad.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+
+from controllers.checks import check_choice, check_range
+from controllers.errors import ControllerInputError
+from controllers.geometry import VesselGeometry
+from controllers.pid import PidDesignSpec
+from controllers.slosh import GRAVITY
+
+
+class SimMode(Enum):
+    """When the slosh induction method runs."""
+
+    AUTO = "auto"  # when the fill condition holds (controllers.slosh_induction.sim_needed)
+    ALWAYS = "always"
+    NEVER = "never"  # plain approach tilt, then CFS (the comparison case of issue 4)
+
+
+def _check_type(name: str, value: object, kind: type) -> None:
+    if not isinstance(value, kind):
+        raise ControllerInputError(f"{name}: must be a {kind.__name__}, got {type(value).__name__}")
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Slosh induction (seed Fig. 7).
+
+    mode: :class:`SimMode`.
+    trigger_angle: rad, the fill condition's tilt (seed: 20 deg). (0, 1.0]
+    amplitude_fraction: phi as a fraction of the tilt at which the resting liquid reaches the crest. (0, 1]
+      The default 0.9 leaves the static level just under the crest, so that the induced wave, not the tilt,
+      starts the outflow (the point of SIM).
+    frequency_ratio: alpha / omega1 of the excitation theta = phi sin(alpha t). (0, 0.5]; the seed keeps alpha
+      well below the slosh resonance (its Fig. 6, left); 0.25 puts the seed's vessel at alpha = 3.2 rad/s.
+    hold_timeout_periods: longest t1 hold, in slosh periods. [0.5, 10]
+    damp_timeout_periods: longest t2 damping, in slosh periods. [1, 50]
+    settle_tolerance: rad, |sigma| below which the slosh counts as damped. (0, 0.2]
+    settle_dwell: s, how long |sigma| must stay below the tolerance before t3. [0, 5]
+    max_tilt_rate: rad/s, rate limit of the PID's output. (0, 10]
+    pid: :class:`controllers.pid.PidDesignSpec`.
+    """
+
+    mode: SimMode = SimMode.AUTO
+    trigger_angle: float = math.radians(20.0)
+    amplitude_fraction: float = 0.9
+    frequency_ratio: float = 0.25
+    hold_timeout_periods: float = 1.5
+    damp_timeout_periods: float = 8.0
+    settle_tolerance: float = 0.01
+    settle_dwell: float = 0.25
+    max_tilt_rate: float = 2.0
+    pid: PidDesignSpec = field(default_factory=PidDesignSpec)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "mode", check_choice("sim.mode", self.mode, SimMode))
+        check_range("sim.trigger_angle", self.trigger_angle, 0.0, 1.0, "rad", lo_open=True)
+        check_range("sim.amplitude_fraction", self.amplitude_fraction, 0.0, 1.0, lo_open=True)
+        check_range("sim.frequency_ratio", self.frequency_ratio, 0.0, 0.5, lo_open=True)
+        check_range("sim.hold_timeout_periods", self.hold_timeout_periods, 0.5, 10.0)
+        check_range("sim.damp_timeout_periods", self.damp_timeout_periods, 1.0, 50.0)
+        check_range("sim.settle_tolerance", self.settle_tolerance, 0.0, 0.2, "rad", lo_open=True)
+        check_range("sim.settle_dwell", self.settle_dwell, 0.0, 5.0, "s")
+        check_range("sim.max_tilt_rate", self.max_tilt_rate, 0.0, 10.0, "rad/s", lo_open=True)
+        _check_type("sim.pid", self.pid, PidDesignSpec)
+
+
+@dataclass(frozen=True)
+class ApproachConfig:
+    """Tilt toward the crest without SIM, about the pendulum's hinge (no slosh excitation to first order).
+
+    max_rate: rad/s. (0, 2]   max_accel: rad/s^2. (0, 20]
+    """
+
+    max_rate: float = 0.15
+    max_accel: float = 0.5
+
+    def __post_init__(self) -> None:
+        check_range("approach.max_rate", self.max_rate, 0.0, 2.0, "rad/s", lo_open=True)
+        check_range("approach.max_accel", self.max_accel, 0.0, 20.0, "rad/s^2", lo_open=True)
+
+
+@dataclass(frozen=True)
+class CfsConfig:
+    """Constant-flow stage (seed Sec. 3.2).
+
+    h_q_ref: m, liquid height over the crest to hold (seed: 5 mm, about one SPH smoothing radius). [0.001, 0.05]
+    time_constant: s, the error h_ref - h_q is corrected at the rate dt / time_constant per step. [0.01, 10]
+    max_tilt_rate: rad/s. (0, 2]
+    max_tilt: rad, largest tilt. (0, 2.5]
+    empty_fraction: the pour ends as empty when the pourer holds at most this fraction of its initial volume.
+      [0, 0.5]
+    max_tilt_hold: s, holding max_tilt this long also ends the pour (what is left cannot be poured). [0, 60]
+    pivot_margin: m, least world height of the CFS pivot above the slosh pendulum's hinge (the pivot is the lip
+      while the lip is that high; see controllers.cfs). [0, 0.2]
+    """
+
+    h_q_ref: float = 0.005
+    time_constant: float = 0.3
+    max_tilt_rate: float = 0.35
+    max_tilt: float = 1.75
+    empty_fraction: float = 0.02
+    max_tilt_hold: float = 3.0
+    pivot_margin: float = 0.03
+
+    def __post_init__(self) -> None:
+        check_range("cfs.h_q_ref", self.h_q_ref, 0.001, 0.05, "m")
+        check_range("cfs.time_constant", self.time_constant, 0.01, 10.0, "s")
+        check_range("cfs.max_tilt_rate", self.max_tilt_rate, 0.0, 2.0, "rad/s", lo_open=True)
+        check_range("cfs.max_tilt", self.max_tilt, 0.0, 2.5, "rad", lo_open=True)
+        check_range("cfs.empty_fraction", self.empty_fraction, 0.0, 0.5)
+        check_range("cfs.max_tilt_hold", self.max_tilt_hold, 0.0, 60.0, "s")
+        check_range("cfs.pivot_margin", self.pivot_margin, 0.0, 0.2, "m")
+
+
+@dataclass(frozen=True)
+class ReturnConfig:
+    """Back upright after the pour, rate- and acceleration-limited (no back-slosh over the rim).
+
+    max_rate: rad/s. (0, 3]   max_accel: rad/s^2. (0, 20]
+    """
+
+    max_rate: float = 0.5
+    max_accel: float = 1.5
+
+    def __post_init__(self) -> None:
+        check_range("returning.max_rate", self.max_rate, 0.0, 3.0, "rad/s", lo_open=True)
+        check_range("returning.max_accel", self.max_accel, 0.0, 20.0, "rad/s^2", lo_open=True)
+
+
+@dataclass(frozen=True)
+class CatcherConfig:
+    """Vessel B, moved along world x under the predicted landing point.
+
+    home_x: m, world x of vessel B's centre (its vessel-frame origin) at home. Required.
+    travel_min, travel_max: m, allowed offsets from home (travel_min < 0 < travel_max is not required, but
+      travel_min < travel_max is).
+    max_speed: m/s. (0, 2]   max_accel: m/s^2. (0, 20]
+    discharge_coefficient: C_d of the weir estimate v_q = (2/3) C_d sqrt(2 g h_q) used to place vessel B before
+      the outflow starts (seed Sec. 2.2: about 0.6). (0, 1]
+    """
+
+    home_x: float
+    travel_min: float = -0.3
+    travel_max: float = 0.3
+    max_speed: float = 0.2
+    max_accel: float = 0.5
+    discharge_coefficient: float = 0.6
+
+    def __post_init__(self) -> None:
+        check_range("catcher.home_x", self.home_x, -10.0, 10.0, "m")
+        check_range("catcher.travel_min", self.travel_min, -2.0, 2.0, "m")
+        check_range("catcher.travel_max", self.travel_max, self.travel_min, 2.0, "m", lo_open=True)
+        check_range("catcher.max_speed", self.max_speed, 0.0, 2.0, "m/s", lo_open=True)
+        check_range("catcher.max_accel", self.max_accel, 0.0, 20.0, "m/s^2", lo_open=True)
+        check_range("catcher.discharge_coefficient", self.discharge_coefficient, 0.0, 1.0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class PourConfig:
+    """The whole pour.
+
+    catcher: :class:`CatcherConfig` (required: vessel B's home x depends on the scene).
+    vessel: the pourer's :class:`controllers.geometry.VesselGeometry`.
+    fill_depth: m, A, the initial liquid depth in the upright pourer. (0, vessel.inner_height)
+    target_volume: m^3 to pour (partial pour), or None to pour until empty. (0, initial volume]
+    control_rate: Hz, rate of :meth:`PourController.step`. [20, 500]. Default 100 Hz: five 2 ms MuJoCo steps,
+      50 samples per slosh period (0.50 s for the seed's vessel), the derivative filter Tf = 27 ms spans 2.7
+      samples, and the sampled SIM loop (theta1 measured one period before it acts) keeps a 52 deg phase
+      margin, 13.8 dB gain margin and Ms = 1.47 (50 Hz: 43 deg, 11.6 dB, Ms = 1.70).
+    start_time: s, the controller idles (vessel at home, catcher pre-positioned) until this time. [0, 60]
+    gravity: m/s^2. (0, 100]
+    """
+
+    catcher: CatcherConfig
+    vessel: VesselGeometry = field(default_factory=VesselGeometry)
+    fill_depth: float = 0.1591
+    target_volume: float | None = None
+    control_rate: float = 100.0
+    start_time: float = 0.0
+    gravity: float = GRAVITY
+    sim: SimConfig = field(default_factory=SimConfig)
+    approach: ApproachConfig = field(default_factory=ApproachConfig)
+    cfs: CfsConfig = field(default_factory=CfsConfig)
+    returning: ReturnConfig = field(default_factory=ReturnConfig)
+
+    def __post_init__(self) -> None:
+        for name, kind in (
+            ("catcher", CatcherConfig),
+            ("vessel", VesselGeometry),
+            ("sim", SimConfig),
+            ("approach", ApproachConfig),
+            ("cfs", CfsConfig),
+            ("returning", ReturnConfig),
+        ):
+            _check_type(f"pour.{name}", getattr(self, name), kind)
+        check_range("pour.fill_depth", self.fill_depth, 0.0, self.vessel.inner_height, "m", lo_open=True, hi_open=True)
+        if self.target_volume is not None:
+            check_range("pour.target_volume", self.target_volume, 0.0, self.initial_volume, "m^3", lo_open=True)
+        check_range("pour.control_rate", self.control_rate, 20.0, 500.0, "Hz")
+        check_range("pour.start_time", self.start_time, 0.0, 60.0, "s")
+        check_range("pour.gravity", self.gravity, 0.0, 100.0, "m/s^2", lo_open=True)
+
+    @property
+    def initial_volume(self) -> float:
+        """m^3 of liquid in the upright pourer filled to fill_depth."""
+        v = self.vessel
+        return v.inner_width * v.inner_depth * self.fill_depth
+
+    @property
+    def dt(self) -> float:
+        """Control period (s)."""
+        return 1.0 / self.control_rate

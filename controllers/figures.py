@@ -1,0 +1,180 @@
+"""Model versions of the seed's controller figures (the SPH versions come from the coupled simulation).
+
+    python -m controllers.figures --out DIR
+
+writes, for the seed's vessel (B = L = 0.191 m, A = 0.1591 m) and the default configuration:
+  fig13_theta1_ratio.png    theta1/theta against the excitation frequency, fills A = 54..162 mm (Eq. 13; Fig. 13)
+  fig14_root_locus.png      root loci of Gp and of C Gp with the design's closed-loop poles (Fig. 14)
+  fig15_step_response.png   step responses of Gp and C Gp in unity feedback (Fig. 15)
+  fig16_sim_timeline.png    the SIM timeline theta, theta1 and the slosh angle on the model plant (Fig. 16)
+and prints the design's numbers. matplotlib is imported here only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import control as ct
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from controllers.config import CatcherConfig, PourConfig  # noqa: E402
+from controllers.measurement import Phase  # noqa: E402
+from controllers.model_plant import ModelPlant, ModelPlantConfig, Trace, run_closed_loop  # noqa: E402
+from controllers.pid import PidDesign, design_filtered_pid, sampled_plant  # noqa: E402
+from controllers.pour import PourController  # noqa: E402
+from controllers.slosh import SloshModel  # noqa: E402
+
+SEED_FILLS_MM = (54, 81, 108, 135, 162)  # seed Sec. 4 tests fills from 54 to 162 mm
+SIM_PLOT_SECONDS = 4.0  # s of the SIM timeline plotted: excitation, hold, damping and the start of CFS
+PHASE_COLOURS = {
+    Phase.SIM_EXCITE: "#fde0c5",
+    Phase.SIM_HOLD: "#fff3b0",
+    Phase.SIM_DAMP: "#d4edda",
+    Phase.CFS: "#d6e4f0",
+}
+
+
+def seed_config() -> PourConfig:
+    """The default pour of the seed's vessel and fill; vessel B's home is arbitrary for these figures."""
+    return PourConfig(catcher=CatcherConfig(home_x=0.25))
+
+
+def figure_ratio(path: Path, config: PourConfig) -> None:
+    width = config.vessel.inner_width
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    for fill_mm in SEED_FILLS_MM:
+        model = SloshModel(width, fill_mm / 1000.0, config.gravity)
+        alpha = np.linspace(0.0, 0.97 * model.omega1, 400)
+        ax.plot(alpha, np.abs(model.forced_ratio(alpha)), label=f"A = {fill_mm} mm (omega1 = {model.omega1:.1f} rad/s)")
+    seed = SloshModel(width, config.fill_depth, config.gravity)
+    ax.axvline(config.sim.frequency_ratio * seed.omega1, color="k", ls="--", lw=1, label="SIM alpha (A = 159 mm)")
+    ax.axhline(1.0, color="grey", lw=0.8)
+    ax.set(xlabel="excitation frequency alpha (rad/s)", ylabel="|theta1 / theta|", ylim=(0.0, 4.0),
+           title="Forced slosh response, pendulum model (seed Eq. 13)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def _locus(ax: plt.Axes, open_loop: ct.TransferFunction, marked: np.ndarray, title: str, max_gain: float) -> None:
+    gains = np.concatenate([[0.0], np.logspace(-3, math.log10(max_gain), 1500)])
+    loci = ct.root_locus_map(open_loop, gains=gains).loci
+    ax.plot(loci.real, loci.imag, ".", ms=1.5, color="tab:blue")
+    ax.plot(ct.poles(open_loop).real, ct.poles(open_loop).imag, "x", color="k", ms=8, label="open-loop poles")
+    z = ct.zeros(open_loop)
+    ax.plot(z.real, z.imag, "o", mfc="none", color="k", ms=8, label="zeros")
+    ax.plot(marked.real, marked.imag, "s", color="tab:red", ms=6, label="closed loop, gain 1")
+    ax.axvline(0.0, color="grey", lw=0.8)
+    ax.set(xlabel="Re (rad/s)", ylabel="Im (rad/s)", title=title)
+    ax.legend(fontsize=7, loc="lower left")
+
+
+def figure_root_locus(path: Path, design: PidDesign) -> None:
+    gp = design.model.plant()
+    gpc = design.gains.transfer_function() * gp
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.6))
+    _locus(a1, gp, ct.poles(ct.feedback(gp, 1)), "k Gp: poles stay on the imaginary axis", 1e3)
+    a1.set(xlim=(-80, 80), ylim=(-60, 60))
+    _locus(a2, gpc, design.closed_loop_poles, "k C Gp (filtered PID)", 1e2)
+    a2.set(xlim=(-80, 80), ylim=(-40, 40))
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def figure_step(path: Path, design: PidDesign) -> None:
+    gp = design.model.plant()
+    t = np.linspace(0.0, 3.0, 3001)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 6.0), sharex=True)
+    _, y = ct.step_response(ct.feedback(gp, 1), T=t)
+    a1.plot(t, y)
+    a1.axhline(0.5, color="grey", ls="--", lw=0.8)
+    a1.set(ylabel="theta1 (rad per rad)", title="Gp in unity feedback: undamped, mean 1/2 (error 1/2)")
+    _, y = ct.step_response(design.closed_loop(), T=t)
+    a2.plot(t, y)
+    a2.axhline(1.0, color="grey", ls="--", lw=0.8)
+    g = design.gains
+    a2.set(xlabel="t (s)", ylabel="theta1 (rad per rad)",
+           title=f"C Gp: Kp={g.kp:.3f}, Ki={g.ki:.3f}/s, Kd={g.kd:.4f} s, Tf={1e3 * g.tf:.1f} ms; "
+           f"settles in {design.settling_time:.2f} s")
+    a2.title.set_fontsize(9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def sim_timeline(config: PourConfig) -> tuple[PourController, Trace]:
+    """The controller's SIM timeline on the model plant (pendulum + box + weir), first SIM_PLOT_SECONDS."""
+    controller = PourController(config)
+    plant = ModelPlant(ModelPlantConfig(vessel=config.vessel, fill_depth=config.fill_depth), config.dt)
+    return controller, run_closed_loop(controller, plant, SIM_PLOT_SECONDS)
+
+
+def figure_sim_timeline(path: Path, config: PourConfig) -> PourController:
+    """Draw Fig. 16 (model version); returns the controller that ran it (its transitions, SIM parameters)."""
+    controller, trace = sim_timeline(config)
+    t = trace.t
+    theta = np.degrees([c.pourer.theta for c in trace.commands])
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7.5, 6.0), sharex=True)
+    a1.plot(t, theta, label="theta (vessel tilt, command)")
+    a1.plot(t, np.degrees(trace.series("theta1")), label="theta1 (free surface, vessel frame)")
+    a1.plot(t, np.degrees(trace.series("theta1") - trace.series("tilt")), label="sigma = theta1 - theta (slosh)")
+    a1.set(ylabel="angle (deg)", title="SIM timeline on the pendulum model (seed Figs. 7, 16)")
+    a1.legend(fontsize=8)
+    a2.plot(t, 1e3 * trace.series("h_q"), color="tab:purple", label="h_q")
+    a2.axhline(1e3 * config.cfs.h_q_ref, color="grey", ls="--", lw=0.8, label="h_q reference")
+    a2.set(xlabel="t (s)", ylabel="h_q (mm)", ylim=(-40, 15))
+    a2.legend(fontsize=8)
+    for phase, t0, t1 in controller.phase_intervals(float(t[-1])):
+        colour = PHASE_COLOURS.get(Phase(phase))
+        if colour:
+            for ax in (a1, a2):
+                ax.axvspan(t0, t1, color=colour, lw=0)
+            a1.text(0.5 * (t0 + t1), a1.get_ylim()[1], phase, ha="center", va="top", fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return controller
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m controllers.figures", description=__doc__.split("\n")[0])
+    parser.add_argument("--out", type=Path, required=True, help="directory for the PNG files")
+    args = parser.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    config = seed_config()
+    model = SloshModel(config.vessel.inner_width, config.fill_depth, config.gravity)
+    design = design_filtered_pid(model, config.sim.pid, config.dt)
+    figure_ratio(args.out / "fig13_theta1_ratio.png", config)
+    figure_root_locus(args.out / "fig14_root_locus.png", design)
+    figure_step(args.out / "fig15_step_response.png", design)
+    controller = figure_sim_timeline(args.out / "fig16_sim_timeline.png", config)
+    for name in ("fig13_theta1_ratio.png", "fig14_root_locus.png", "fig15_step_response.png", "fig16_sim_timeline.png"):
+        print(args.out / name)
+    g = design.gains
+    print(f"plant: l1 = {model.l1:.5f} m, L1 = {model.L1:.5f} m, b2 = {model.b2:.5f} m, "
+          f"omega1 = {model.omega1:.3f} rad/s, RHP zero = {model.rhp_zero:.2f} rad/s")
+    print(f"PID: Kp = {g.kp:.4f}, Ki = {g.ki:.4f} 1/s, Kd = {g.kd:.5f} s, Tf = {g.tf:.5f} s")
+    print("closed-loop poles (rad/s): " + ", ".join(f"{p:.3f}" for p in design.closed_loop_poles))
+    sampled = g.discrete_tf(config.dt) * sampled_plant(model, config.dt)
+    gm, pm, _, wc = ct.margin(sampled)
+    w = np.linspace(1e-3, math.pi / config.dt, 20000)
+    ms = float(np.max(np.abs(1.0 / (1.0 + sampled(np.exp(1j * w * config.dt))))))
+    print(f"min damping {design.min_damping:.3f}, settling time (2 %) {design.settling_time:.3f} s; "
+          f"sampled at {config.control_rate:g} Hz: max |z| = {np.max(np.abs(design.discrete_poles)):.4f}, "
+          f"gain margin {20 * math.log10(gm):.1f} dB, phase margin {pm:.1f} deg at {wc:.1f} rad/s, Ms = {ms:.2f}")
+    print(f"SIM: phi = {math.degrees(controller.sim_amplitude):.2f} deg, alpha = {controller.sim_frequency:.3f} rad/s")
+    for tr in controller.transitions:
+        print(f"  t = {tr.t:5.2f} s  {tr.source.value} -> {tr.target.value}: {tr.reason}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,48 @@
+"""Rate- and acceleration-limited 1-D tracking: moves a coordinate toward a target without large steps.
+
+Used for the catcher's position (m), the approach tilt and the return tilt (rad). Units follow the coordinate:
+``max_rate`` per second, ``max_accel`` per second squared, ``dt`` in s.
+"""
+
+from __future__ import annotations
+
+import math
+
+from controllers.checks import check_range
+
+
+class RateLimitedTracker:
+    """Discrete second-order tracker: each step the velocity moves by at most max_accel dt toward the
+    velocity that would stop exactly at the target under max_accel, itself capped by max_rate."""
+
+    def __init__(self, max_rate: float, max_accel: float, dt: float, position: float = 0.0) -> None:
+        self.max_rate = check_range("tracker.max_rate", max_rate, 0.0, None, lo_open=True)
+        self.max_accel = check_range("tracker.max_accel", max_accel, 0.0, None, lo_open=True)
+        self.dt = check_range("tracker.dt", dt, 0.0, 1.0, "s", lo_open=True)
+        self.position = float(position)
+        self.velocity = 0.0
+
+    def reset(self, position: float, velocity: float = 0.0) -> None:
+        self.position, self.velocity = float(position), float(velocity)
+
+    def step(self, target: float) -> float:
+        """Advance one step toward ``target``; returns the new position."""
+        err, a, dt = target - self.position, self.max_accel, self.dt
+        # Largest speed v from which braking by a dt per step stops within |err|: v^2/(2a) + v dt/2 = |err|.
+        stop_speed = a * (math.sqrt(0.25 * dt * dt + 2.0 * abs(err) / a) - 0.5 * dt)
+        want = math.copysign(min(self.max_rate, stop_speed, abs(err) / dt), err)
+        self.velocity = min(max(want, self.velocity - a * dt), self.velocity + a * dt)
+        self.position += self.velocity * dt
+        return self.position
+
+    def at(self, target: float, tol: float) -> bool:
+        """True when within ``tol`` of ``target`` and (almost) at rest."""
+        return abs(target - self.position) <= tol and abs(self.velocity) <= self.max_accel * self.dt
+
+
+def stop_time(distance: float, max_rate: float, max_accel: float) -> float:
+    """Time (s) to travel ``distance`` from rest with the rate and acceleration limits (accelerate, cruise)."""
+    d = abs(distance)
+    if d <= 0.5 * max_rate * max_rate / max_accel:
+        return math.sqrt(2.0 * d / max_accel)
+    return d / max_rate + 0.5 * max_rate / max_accel

@@ -1,0 +1,322 @@
+"""The pour state machine: SIM (or a plain approach), constant flow, return; the catcher throughout.
+
+    IDLE --t >= start_time--> SIM_EXCITE -> SIM_HOLD -> SIM_DAMP -> CFS -> RETURN -> DONE
+                         \\-> APPROACH ------------------------------/
+    (any pouring phase -> RETURN when the target volume is reached or the pourer is empty)
+
+Call :meth:`PourController.step` once per control period (``config.dt``, 10 ms by default) with a
+:class:`controllers.measurement.LiquidMeasurement`; it returns a :class:`controllers.measurement.PourCommand`.
+The discrete elements (PID, limiters) assume that period; the measurement's own time stamps drive the phase
+timing. Pivots of the pourer's rotation (vessel frame): SIM about the inner floor centre (0, 0), the approach
+about the slosh pendulum's hinge (0, l1 - b2), CFS about the pour lip (B/2 + t, L), raised in the world at large
+tilts to stay above that hinge (:func:`controllers.cfs.cfs_pivot`); the return brings the pose
+back to home along a straight line in (dx, dz, theta). Every pivot change keeps the pose continuous.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from controllers.catcher import CatcherFollower, landing_x, weir_velocity
+from controllers.cfs import after_flow_volume, cfs_increment, cfs_pivot, crest_lever
+from controllers.config import PourConfig, SimMode
+from controllers.errors import ControllerInputError, MeasurementError
+from controllers.geometry import PlanarPose, static_tilt_for_h_q
+from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
+from controllers.motion import RateLimitedTracker
+from controllers.pid import DiscretePid, PidDesign, design_filtered_pid
+from controllers.slosh import SloshModel
+from controllers.slosh_induction import excitation_duration, excitation_tilt, sim_needed
+
+# Time constant (s) of the first-order filter on the measured outflow rate d(poured)/dt: a fifth of the seed
+# vessel's slosh period, enough to smooth SPH particle-count steps while keeping the stop prediction current.
+OUTFLOW_FILTER_TIME = 0.1
+# Tilt (rad) within which a rate-limited tilt counts as arrived (approach target, upright): 0.006 deg.
+ARRIVAL_TOLERANCE = 1e-4
+
+Transition = tuple[Phase, str] | None
+
+
+class PourController:
+    """Closed-loop pour controller for one pour. Pure: its output depends only on the config and measurements."""
+
+    def __init__(self, config: PourConfig) -> None:
+        if not isinstance(config, PourConfig):
+            raise ControllerInputError(f"pour: must be a PourConfig, got {type(config).__name__}")
+        self.config = config
+        self.dt = config.dt
+        geom = config.vessel
+        self.model = SloshModel(geom.inner_width, config.fill_depth, config.gravity)
+        sim = config.sim
+        if sim.mode is SimMode.AUTO:
+            self.use_sim, self.entry_reason = sim_needed(
+                geom.inner_width, geom.inner_height, config.fill_depth, sim.trigger_angle
+            )
+        else:
+            self.use_sim = sim.mode is SimMode.ALWAYS
+            self.entry_reason = f"sim.mode = {sim.mode.value}"
+        self.pid_design: PidDesign | None = None
+        self._pid: DiscretePid | None = None
+        if self.use_sim:
+            self.pid_design = design_filtered_pid(self.model, sim.pid, self.dt)
+            self._pid = DiscretePid(self.pid_design.gains, self.dt, 0.0, config.cfs.max_tilt, sim.max_tilt_rate)
+        self.sim_frequency = sim.frequency_ratio * self.model.omega1  # alpha, rad/s
+        self.sim_amplitude = math.nan  # phi, rad; set from the first measurement's volume
+        self._approach = RateLimitedTracker(config.approach.max_rate, config.approach.max_accel, self.dt)
+        self._return = RateLimitedTracker(config.returning.max_rate, config.returning.max_accel, self.dt)
+        c = config.catcher
+        self._catcher = CatcherFollower(c.home_x, (c.travel_min, c.travel_max), c.max_speed, c.max_accel, self.dt)
+
+        self.pose = PlanarPose()
+        self.phase = Phase.IDLE
+        self.reason = "waiting for start_time"
+        self._transitions: list[PhaseTransition] = []
+        self._phase_start = 0.0
+        self._last_t: float | None = None
+        self._first_t = math.nan
+        self._initial_volume = math.nan
+        self._outflow_rate = 0.0  # m^3/s, filtered
+        self._last_poured = 0.0
+        self._sigma_prev = 0.0
+        self._since = math.nan  # start of the current settle (SIM_DAMP) or max-tilt (CFS) interval, s
+        self._reference = 0.0  # rad, tilt reference of SIM_DAMP / target of APPROACH
+        self._return_from = PlanarPose()
+
+        self._check: dict[Phase, Callable[[LiquidMeasurement], Transition]] = {
+            Phase.IDLE: self._check_idle,
+            Phase.SIM_EXCITE: self._check_excite,
+            Phase.SIM_HOLD: self._check_hold,
+            Phase.SIM_DAMP: self._check_damp,
+            Phase.APPROACH: self._check_approach,
+            Phase.CFS: self._check_cfs,
+            Phase.RETURN: self._check_return,
+            Phase.DONE: lambda m: None,
+        }
+        self._act: dict[Phase, Callable[[LiquidMeasurement], PlanarPose]] = {
+            Phase.IDLE: lambda m: self.pose,
+            Phase.SIM_EXCITE: self._act_excite,
+            Phase.SIM_HOLD: lambda m: self.pose,
+            Phase.SIM_DAMP: self._act_damp,
+            Phase.APPROACH: self._act_approach,
+            Phase.CFS: self._act_cfs,
+            Phase.RETURN: self._act_return,
+            Phase.DONE: lambda m: PlanarPose(),
+        }
+
+    # ---- public -----------------------------------------------------------------------------------------------
+    @property
+    def transitions(self) -> tuple[PhaseTransition, ...]:
+        return tuple(self._transitions)
+
+    def phase_intervals(self, t_end: float) -> list[tuple[str, float, float]]:
+        """(phase name, start s, end s) of every phase entered so far, IDLE from the first step, the current
+        phase ending at ``t_end``. Empty before the first step."""
+        if self._last_t is None:
+            return []
+        starts = [(Phase.IDLE, self._first_t)] + [(tr.target, tr.t) for tr in self._transitions]
+        ends = [t for _, t in starts[1:]] + [t_end]
+        return [(phase.value, t0, t1) for (phase, t0), t1 in zip(starts, ends)]
+
+    def step(self, m: LiquidMeasurement) -> PourCommand:
+        """One control step: the pourer's and vessel B's target poses for this measurement."""
+        if not isinstance(m, LiquidMeasurement):
+            raise MeasurementError(f"measurement: must be a LiquidMeasurement, got {type(m).__name__}")
+        if self._last_t is None:
+            self._begin(m)
+        elif not m.t > self._last_t:
+            raise MeasurementError(f"measurement.t: must increase, got {m.t:g} s after {self._last_t:g} s")
+        else:
+            rate = (m.poured_volume - self._last_poured) / (m.t - self._last_t)
+            self._outflow_rate += min((m.t - self._last_t) / OUTFLOW_FILTER_TIME, 1.0) * (rate - self._outflow_rate)
+        self._last_t, self._last_poured = m.t, m.poured_volume
+
+        for _ in Phase:  # a step may pass several phases; each at most once
+            nxt = self._check[self.phase](m)
+            if nxt is None:
+                break
+            self._enter(nxt[0], nxt[1], m)
+        self.pose = self._act[self.phase](m)
+        landing = self._landing(m)
+        return PourCommand(
+            t=m.t,
+            pourer=self.pose,
+            catcher=PlanarPose(self._catcher.step(landing), 0.0, 0.0),
+            phase=self.phase,
+            reason=self.reason,
+            landing_x=self._catcher.target_dx + self.config.catcher.home_x if landing is None else landing,
+            slosh_angle=m.slosh_angle,
+        )
+
+    # ---- bookkeeping ------------------------------------------------------------------------------------------
+    def _begin(self, m: LiquidMeasurement) -> None:
+        self._first_t = m.t
+        self._initial_volume = m.volume_in_pourer + m.poured_volume
+        if not self._initial_volume > 0.0:
+            raise MeasurementError("measurement.volume_in_pourer: the pourer is empty at the first step")
+        contact = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
+        self.sim_amplitude = self.config.sim.amplitude_fraction * contact
+
+    def _area(self, m: LiquidMeasurement) -> float:
+        return self.config.vessel.area(m.volume_in_pourer)
+
+    def _enter(self, phase: Phase, reason: str, m: LiquidMeasurement) -> None:
+        self._transitions.append(PhaseTransition(m.t, self.phase, phase, reason))
+        self.phase, self.reason, self._phase_start = phase, reason, m.t
+        self._since = math.nan
+        if phase is Phase.SIM_HOLD:
+            self._sigma_prev = m.slosh_angle
+        elif phase is Phase.SIM_DAMP:
+            assert self._pid is not None
+            self._reference = self._damp_reference(m)
+            self._pid.reset(u0=self.pose.theta, y0=m.theta1, r0=self._reference)
+        elif phase is Phase.APPROACH:
+            self._reference = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
+            self._approach.reset(self.pose.theta)
+        elif phase is Phase.RETURN:
+            self._return_from = self.pose
+            self._return.reset(self.pose.theta)
+
+    def _elapsed(self, m: LiquidMeasurement) -> float:
+        return m.t - self._phase_start
+
+    def _damp_reference(self, m: LiquidMeasurement) -> float:
+        """Tilt (rad) at which the current liquid, at rest, would stand h_q_ref over the crest."""
+        cfs = self.config.cfs
+        return min(static_tilt_for_h_q(self.config.vessel, cfs.h_q_ref, self._area(m)), cfs.max_tilt)
+
+    # ---- transitions ------------------------------------------------------------------------------------------
+    def _check_idle(self, m: LiquidMeasurement) -> Transition:
+        if m.t < self.config.start_time:
+            return None
+        return (Phase.SIM_EXCITE if self.use_sim else Phase.APPROACH), self.entry_reason
+
+    def _check_stop(self, m: LiquidMeasurement) -> Transition:
+        """Partial pour reached (with the predicted after-flow) or pourer empty: go back upright."""
+        target = self.config.target_volume
+        if target is not None:
+            lever = crest_lever(self.config.vessel, self.pose.theta, self._area(m))
+            ret = self.config.returning
+            after = after_flow_volume(self._outflow_rate, m.h_q, lever, ret.max_rate, ret.max_accel)
+            if m.poured_volume + after >= target:
+                return Phase.RETURN, (
+                    f"poured {1e6 * m.poured_volume:.1f} mL + {1e6 * after:.1f} mL predicted after-flow "
+                    f">= target {1e6 * target:.1f} mL"
+                )
+        left = self.config.cfs.empty_fraction * self._initial_volume
+        if m.volume_in_pourer <= left:
+            return Phase.RETURN, f"empty: {1e6 * m.volume_in_pourer:.1f} mL left <= {1e6 * left:.1f} mL"
+        return None
+
+    def _check_excite(self, m: LiquidMeasurement) -> Transition:
+        stop = self._check_stop(m)
+        if stop or self._elapsed(m) < excitation_duration(self.sim_frequency):
+            return stop
+        return Phase.SIM_HOLD, f"t0 done: theta reached phi = {math.degrees(self.sim_amplitude):.2f} deg"
+
+    def _check_hold(self, m: LiquidMeasurement) -> Transition:
+        stop = self._check_stop(m)
+        if stop:
+            return stop
+        sigma, prev = m.slosh_angle, self._sigma_prev
+        self._sigma_prev = sigma
+        if prev < 0.0 <= sigma:
+            return Phase.SIM_DAMP, f"t1 done: slosh angle crossed zero toward the lip ({prev:+.4f} -> {sigma:+.4f} rad)"
+        limit = self.config.sim.hold_timeout_periods * self.model.period
+        if self._elapsed(m) >= limit:
+            return Phase.SIM_DAMP, f"t1 timeout: no zero crossing of the slosh angle within {limit:.2f} s"
+        return None
+
+    def _check_damp(self, m: LiquidMeasurement) -> Transition:
+        stop = self._check_stop(m)
+        if stop:
+            return stop
+        sim = self.config.sim
+        if abs(m.slosh_angle) > sim.settle_tolerance:
+            self._since = math.nan
+        elif math.isnan(self._since):
+            self._since = m.t
+        if not math.isnan(self._since) and m.t - self._since >= sim.settle_dwell:
+            return Phase.CFS, (
+                f"t2 done: slosh damped, |sigma| <= {sim.settle_tolerance:g} rad for {sim.settle_dwell:g} s"
+            )
+        limit = sim.damp_timeout_periods * self.model.period
+        if self._elapsed(m) >= limit:
+            return Phase.CFS, f"t2 timeout after {limit:.2f} s, |sigma| = {abs(m.slosh_angle):.4f} rad"
+        return None
+
+    def _check_approach(self, m: LiquidMeasurement) -> Transition:
+        stop = self._check_stop(m)
+        if stop:
+            return stop
+        if m.h_q > 0.0:
+            return Phase.CFS, f"liquid over the crest: h_q = {1e3 * m.h_q:.2f} mm"
+        if self._approach.at(self._reference, ARRIVAL_TOLERANCE):
+            return Phase.CFS, f"reached the static crest tilt {math.degrees(self._reference):.2f} deg"
+        return None
+
+    def _check_cfs(self, m: LiquidMeasurement) -> Transition:
+        stop = self._check_stop(m)
+        if stop:
+            return stop
+        cfs = self.config.cfs
+        if self.pose.theta < cfs.max_tilt:
+            self._since = math.nan
+        elif math.isnan(self._since):
+            self._since = m.t
+        if not math.isnan(self._since) and m.t - self._since >= cfs.max_tilt_hold:
+            return Phase.RETURN, f"held max_tilt {math.degrees(cfs.max_tilt):.1f} deg for {cfs.max_tilt_hold:g} s"
+        return None
+
+    def _check_return(self, m: LiquidMeasurement) -> Transition:
+        if self._return.at(0.0, ARRIVAL_TOLERANCE):
+            return Phase.DONE, "upright at home"
+        return None
+
+    # ---- actions ----------------------------------------------------------------------------------------------
+    def _act_excite(self, m: LiquidMeasurement) -> PlanarPose:
+        theta = excitation_tilt(self._elapsed(m), self.sim_amplitude, self.sim_frequency)
+        return self.pose.rotated_about((0.0, 0.0), theta)
+
+    def _act_damp(self, m: LiquidMeasurement) -> PlanarPose:
+        assert self._pid is not None
+        self._reference = self._damp_reference(m)
+        return self.pose.rotated_about((0.0, 0.0), self._pid.step(self._reference, m.theta1))
+
+    def _act_approach(self, m: LiquidMeasurement) -> PlanarPose:
+        theta = self._approach.step(self._reference)
+        return self.pose.rotated_about((0.0, self.model.hinge_height), theta)
+
+    def _act_cfs(self, m: LiquidMeasurement) -> PlanarPose:
+        cfs, geom, theta = self.config.cfs, self.config.vessel, self.pose.theta
+        step = cfs_increment(
+            geom,
+            theta,
+            self._area(m),
+            m.h_q,
+            cfs.h_q_ref,
+            self.dt / cfs.time_constant,
+            self._outflow_rate * self.dt,
+            cfs.max_tilt_rate * self.dt,
+        )
+        pivot = cfs_pivot(geom, self.model, theta, cfs.pivot_margin)
+        return self.pose.rotated_about(pivot, min(max(theta + step, 0.0), cfs.max_tilt))
+
+    def _act_return(self, m: LiquidMeasurement) -> PlanarPose:
+        start = self._return_from
+        theta = self._return.step(0.0)
+        f = min(max(theta / start.theta, 0.0), 1.0) if start.theta > 0.0 else 0.0
+        return PlanarPose(start.dx * f, start.dz * f, theta)
+
+    def _landing(self, m: LiquidMeasurement) -> float | None:
+        """Predicted landing x (m, world): measured jet while liquid flows, else the weir estimate at h_q_ref;
+        None (hold vessel B) once the pour is over and nothing flows."""
+        flowing = m.h_q > 0.0 and m.v_q > 0.0
+        if not flowing and self.phase in (Phase.RETURN, Phase.DONE):
+            return None
+        cfg = self.config
+        if flowing:
+            v_x, v_z = m.v_q, m.v_q_z
+        else:
+            v_x, v_z = weir_velocity(cfg.cfs.h_q_ref, cfg.catcher.discharge_coefficient, cfg.gravity), 0.0
+        return landing_x(m.lip_x, m.lip_z, m.catcher_rim_z, v_x, v_z, cfg.gravity)

@@ -1,0 +1,67 @@
+"""The catcher: landing point from the free-fall parabola (seed Eqs. 6-7) and rate-limited following."""
+
+import math
+
+import numpy as np
+import pytest
+
+from controllers.catcher import CatcherFollower, fall_time, landing_x, weir_velocity
+from controllers.motion import RateLimitedTracker, stop_time
+from controllers.slosh import GRAVITY
+
+EXACT = 1e-12  # m: closed-form identities in float64
+# Symplectic-Euler integration of the free fall with step 1e-6 s over < 0.3 s: position error < g h t = 3e-6 m.
+BALLISTIC_TOL = 1e-5  # m
+DT = 0.01  # s, control period
+
+
+def _integrate_fall(x0: float, z0: float, vx: float, vz: float, rim: float, h: float = 1e-6) -> float:
+    x, z, w = x0, z0, vz
+    while True:
+        w -= GRAVITY * h
+        x_new, z_new = x + vx * h, z + w * h
+        if z_new <= rim:
+            return x + (x_new - x) * (z - rim) / (z - z_new)
+        x, z = x_new, z_new
+
+
+@pytest.mark.parametrize("vx, vz", [(0.125, 0.0), (0.3, 0.0), (0.2, -0.15), (0.2, 0.1)])
+def test_landing_point_is_on_the_parabola(vx: float, vz: float) -> None:
+    lip_x, lip_z, rim = 0.16, 0.45, 0.20
+    x = landing_x(lip_x, lip_z, rim, vx, vz)
+    t = (x - lip_x) / vx
+    assert lip_z + vz * t - 0.5 * GRAVITY * t * t == pytest.approx(rim, abs=EXACT)  # Eq. 6 at the rim
+    assert x == pytest.approx(_integrate_fall(lip_x, lip_z, vx, vz, rim), abs=BALLISTIC_TOL)
+    if vz == 0.0:
+        assert t == pytest.approx(math.sqrt(2 * (lip_z - rim) / GRAVITY), abs=EXACT)  # the seed's form
+
+
+def test_weir_velocity_and_degenerate_cases() -> None:
+    assert weir_velocity(0.005, 0.6) == pytest.approx(2 / 3 * 0.6 * math.sqrt(2 * GRAVITY * 0.005), abs=EXACT)
+    assert weir_velocity(-0.002, 0.6) == 0.0
+    assert fall_time(-0.01) == 0.0  # lip below the rim: no fall
+
+
+def test_tracker_respects_rate_and_acceleration_and_arrives() -> None:
+    tr = RateLimitedTracker(max_rate=0.2, max_accel=0.5, dt=DT)
+    pos, vel = [tr.position], [0.0]
+    target = 0.15
+    for k in range(400):
+        tr.step(target if k < 300 else -0.05)
+        pos.append(tr.position)
+        vel.append(tr.velocity)
+    v = np.diff(pos) / DT
+    assert np.max(np.abs(v)) <= 0.2 + 1e-12
+    assert np.max(np.abs(np.diff(vel))) <= 0.5 * DT + 1e-12
+    assert pos[300] == pytest.approx(target, abs=1e-9)
+    assert np.max(pos) <= target + 0.5 * DT * DT + 1e-12  # no overshoot beyond one step of acceleration
+    assert stop_time(0.15, 0.2, 0.5) == pytest.approx(0.15 / 0.2 + 0.2 / (2 * 0.5))
+
+
+def test_follower_clips_travel_and_never_steps() -> None:
+    f = CatcherFollower(home_x=0.30, travel=(-0.10, 0.05), max_speed=0.2, max_accel=0.5, dt=DT)
+    xs = [f.step(0.10) for _ in range(300)]  # landing 0.2 m behind home: clipped to -0.10
+    assert xs[-1] == pytest.approx(-0.10, abs=1e-9)
+    assert np.max(np.abs(np.diff([0.0] + xs))) <= 0.2 * DT + 1e-12
+    held = f.step(None)  # no prediction: keep going to the last target
+    assert held == pytest.approx(-0.10, abs=1e-9)

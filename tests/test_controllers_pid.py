@@ -1,0 +1,180 @@
+"""The PID compensator on Gp: the ideal PID cannot stabilise it, the filtered one can (seed Sec. 3.1, Eq. 15)."""
+
+import itertools
+import math
+
+import control as ct
+import numpy as np
+import pytest
+
+from controllers.errors import ControllerInputError
+from controllers.pid import (
+    DiscretePid,
+    PidDesignSpec,
+    PidGains,
+    design_filtered_pid,
+    hurwitz_sign_condition,
+    ideal_pid_characteristic,
+    sampled_plant,
+)
+from controllers.slosh import SloshModel
+
+SEED = SloshModel(0.191, 0.1591)  # seed vessel and fill (Sec. 4)
+DT = 0.01  # s, the default 100 Hz control period
+# A pole with real part above -MARGINAL_RE is not asymptotically stable (numerical zero for these polynomials,
+# whose roots are O(1..1e4) rad/s and computed to ~1e-12 relative).
+MARGINAL_RE = 1e-7  # rad/s
+SETTLE_BAND = 0.02  # 2 % band, as the design's settling time (python-control default)
+STEADY_STATE_TOL = 1e-6  # zero steady-state error: final value of a unit step, after 40 time constants
+ROOTS_RTOL = 1e-6  # python-control's closed-loop poles against numpy roots of the analytic polynomial
+
+
+def _gain_grid(magnitudes: list[float]) -> list[tuple[float, float, float]]:
+    values = sorted({0.0, *magnitudes, *(-m for m in magnitudes)})
+    return [g for g in itertools.product(values, repeat=3) if any(g)]
+
+
+def test_ideal_pid_sign_conflict_is_analytic() -> None:
+    """With b2 < 0: sign(a4) = -sign(Kd), sign(a0) = sign(Ki), and a2 = b2 Ki + g Kd has the sign of -a4 whenever
+    a4 and a0 share a sign. So a4, a2, a0 never all share a sign: the Hurwitz necessary condition fails for
+    every (Kp, Ki, Kd), whatever the fill (b2 < 0 for every fill)."""
+    for fill in (0.054, 0.1, 0.1591, 0.185):
+        model = SloshModel(0.191, fill)
+        assert model.b2 < 0
+        for kp, ki, kd in _gain_grid([1e-3, 0.1, 1.0, 10.0, 1e3]):
+            a4, a3, a2, a1, a0 = ideal_pid_characteristic(model, kp, ki, kd)
+            if a4 * a0 > 0:
+                assert a2 * a4 < 0
+            assert not hurwitz_sign_condition([a4, a3, a2, a1, a0])
+
+
+def test_ideal_pid_closed_loop_poles_are_never_all_stable() -> None:
+    """python-control's closed-loop poles of (Kd s^2 + Kp s + Ki)/s * Gp over a gain grid of both signs."""
+    s = ct.tf("s")
+    gp = SEED.plant()
+    for kp, ki, kd in _gain_grid([0.01, 1.0, 100.0]):
+        loop = ct.feedback((kd * s**2 + kp * s + ki) / s * gp, 1)
+        poles = ct.poles(loop)
+        assert np.max(poles.real) > -MARGINAL_RE, (kp, ki, kd, poles)
+        expected = np.roots(np.trim_zeros(ideal_pid_characteristic(SEED, kp, ki, kd), "f"))
+        assert np.allclose(np.sort_complex(poles), np.sort_complex(expected), rtol=ROOTS_RTOL, atol=1e-9)
+
+
+def test_filtered_pid_places_the_poles_and_is_stable() -> None:
+    spec = PidDesignSpec()
+    design = design_filtered_pid(SEED, spec, DT)
+    poles = ct.poles(design.closed_loop())
+    assert poles.size == 4
+    assert np.max(poles.real) < 0
+    assert np.allclose(np.sort_complex(poles), np.sort_complex(spec.target_poles(SEED.omega1)), rtol=1e-6)
+    assert design.min_damping == pytest.approx(spec.damping, rel=1e-9)
+    assert design.gains.tf > 2 * DT  # the 100 Hz loop resolves the derivative filter
+    assert np.max(np.abs(design.discrete_poles)) < 1.0
+
+
+def test_filtered_pid_has_zero_steady_state_error() -> None:
+    design = design_filtered_pid(SEED)
+    loop = design.closed_loop()
+    assert ct.dcgain(loop) == pytest.approx(1.0, abs=1e-12)
+    slowest = float(np.min(-ct.poles(loop).real))
+    t = np.linspace(0.0, 40.0 / slowest, 8001)
+    _, y = ct.step_response(loop, T=t)
+    assert abs(y[-1] - 1.0) < STEADY_STATE_TOL
+    settled = np.abs(y - 1.0) <= SETTLE_BAND
+    first_settled = t[np.argmax(settled & np.flip(np.cumprod(np.flip(settled))).astype(bool))]
+    assert first_settled == pytest.approx(design.settling_time, abs=t[1] - t[0] + 1e-3)
+
+
+def test_designs_across_sim_fills_are_stable() -> None:
+    """SIM runs for h_e <= (B/2) tan 20 deg, i.e. A >= 156 mm in the seed's vessel; also lower fills."""
+    for fill in (0.12, 0.156, 0.1591, 0.175, 0.189):
+        design = design_filtered_pid(SloshModel(0.191, fill), dt=DT)
+        assert np.max(design.closed_loop_poles.real) < 0
+        assert np.max(np.abs(design.discrete_poles)) < 1.0
+
+
+def test_too_slow_control_rate_is_a_one_line_error() -> None:
+    with pytest.raises(ControllerInputError, match=r"^control_rate: 20 Hz is too slow") as info:
+        design_filtered_pid(SEED, PidDesignSpec(bandwidth_ratio=3.0), dt=0.05)
+    assert "\n" not in str(info.value)
+
+
+def _run_pid(pid: DiscretePid, r: np.ndarray, y: np.ndarray) -> np.ndarray:
+    return np.array([pid.step(ri, yi) for ri, yi in zip(r, y)])
+
+
+def test_discrete_pid_is_its_discrete_transfer_function() -> None:
+    """Unsaturated, with r = 0 (derivative on the measurement equals derivative on the error)."""
+    gains = design_filtered_pid(SEED).gains
+    rng = np.random.default_rng(4)
+    y = np.cumsum(rng.normal(0.0, 0.01, 300))
+    pid = DiscretePid(gains, DT, -1e9, 1e9, 1e9)
+    pid.reset(u0=0.0, y0=0.0, r0=0.0)
+    u = _run_pid(pid, np.zeros_like(y), y)
+    e = -y
+    _, u_tf = ct.forced_response(gains.discrete_tf(DT), T=np.arange(y.size) * DT, U=e)
+    # reset(y0 = 0) makes the first derivative sample -(y0 - 0); the transfer function assumes e_{-1} = 0 too
+    assert np.allclose(u, u_tf, rtol=1e-9, atol=1e-12)
+
+
+def test_discrete_loop_on_the_sampled_plant_settles() -> None:
+    """DiscretePid in closed loop with the exact sampled plant (ZOH input, theta1 measured before each new
+    command), stepped by hand: it settles to the reference; its poles are those of the design's check."""
+    design = design_filtered_pid(SEED, dt=DT)
+    assert np.allclose(
+        np.sort_complex(ct.poles(ct.feedback(design.gains.discrete_tf(DT) * sampled_plant(SEED, DT), 1))),
+        np.sort_complex(design.discrete_poles),
+    )
+    assert np.max(np.abs(design.discrete_poles)) < 1.0
+    plant = ct.c2d(ct.tf2ss(SEED.plant()), DT, "zoh")
+    a, b, c = np.asarray(plant.A), np.asarray(plant.B)[:, 0], np.asarray(plant.C)[0]
+    d = SEED.b2 / SEED.l1
+    pid = DiscretePid(design.gains, DT, -10.0, 10.0, 100.0)
+    pid.reset(u0=0.0, y0=0.0, r0=0.0)
+    x, u, r = np.zeros(a.shape[0]), 0.0, 0.1  # rad step
+    y_hist = []
+    for _ in range(600):  # 6 s
+        y = float(c @ x) + d * u  # measured before the new command: feed-through of the held one
+        y_hist.append(y)
+        u = pid.step(r, y)
+        x = a @ x + b * u
+    y_hist = np.array(y_hist)
+    k = int(3.0 * design.settling_time / DT)  # |z| <= 0.94: decays like the continuous loop
+    assert np.all(np.abs(y_hist[k:] - r) <= SETTLE_BAND * r)
+    assert abs(y_hist[-1] - r) < 1e-4 * r
+
+
+def test_discrete_pid_respects_limits_and_unwinds() -> None:
+    """A reference beyond the output limit: the output stays within limits and rate, and the integrator does not
+    wind up (the output leaves the limit as soon as the error changes sign)."""
+    gains = design_filtered_pid(SEED).gains
+    pid = DiscretePid(gains, DT, 0.0, 0.3, 1.0)
+    pid.reset(u0=0.0, y0=0.0, r0=0.0)
+    u_prev, outs = 0.0, []
+    y = 0.0
+    for k in range(400):
+        r = 1.0 if k < 200 else 0.1  # unreachable, then reachable
+        u = pid.step(r, y)
+        assert 0.0 <= u <= 0.3
+        assert abs(u - u_prev) <= 1.0 * DT + 1e-12
+        u_prev = u
+        y += 0.2 * (u - y)  # a stable first-order stand-in: y follows u
+        outs.append(u)
+    outs = np.array(outs)
+    assert outs[199] == pytest.approx(0.3)
+    # without anti-windup, 2 s of error 0.7 rad * ki = 3.7/s would keep the output saturated for seconds
+    assert outs[200 + int(0.5 / DT)] < 0.3
+
+
+def test_bumpless_reset() -> None:
+    pid = DiscretePid(design_filtered_pid(SEED).gains, DT, 0.0, 1.0, 2.0)
+    pid.reset(u0=0.29, y0=0.31, r0=0.35)
+    assert pid.step(0.35, 0.31) == pytest.approx(0.29, abs=1e-15)
+
+
+def test_gains_validation() -> None:
+    with pytest.raises(ControllerInputError, match=r"^pid\.tf: must be in \(0, 10\] s, got -0\.1$"):
+        PidGains(1.0, 1.0, 0.1, -0.1)
+    with pytest.raises(ControllerInputError, match=r"^pid\.damping: "):
+        PidDesignSpec(damping=1.5)
+    assert math.isfinite(PidDesignSpec().damping)
