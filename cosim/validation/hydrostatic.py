@@ -64,7 +64,7 @@ def _interpolate(points: np.ndarray, x: np.ndarray, values: np.ndarray, volumes:
 
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
-    require_particles_across("spacing", p.width, dx, MIN_PARTICLES_ACROSS)
+    require_particles_across("spacing", p.width, dx, 8)
     tank = VesselSpec(name="tank", inner_width=p.width, inner_depth=p.depth, inner_height=p.fill * 1.25 + 4 * dx)
     margin = 0.05 * p.width + 10 * dx
     half = 0.5 * p.width + margin

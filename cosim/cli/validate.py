@@ -1,0 +1,91 @@
+"""``cosim validate [CASE ...]``: run validation cases and print measured values next to their references.
+
+Human output is a table (case, quantity, measured, reference, error, tolerance, pass, wall time) plus one PNG per
+case run; ``--json`` prints a machine-readable document instead (the contract for outside checks):
+``{"passed": bool, "cases": [{"case", "passed", "wall_time_s", "parameters", "metrics": [...], <raw values>}]}``
+with the raw values of each case (slosh ``frequency_hz``; hydrostatic ``z``, ``pressure``, ``leaked``;
+dam-break ``a``, ``t``, ``front``). A failed validation is reported, not hidden; with ``--strict`` it also makes
+the exit status 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from cosim.atomic_files import atomic_path
+from cosim.errors import InputError
+from cosim.validation import CASES, DEFAULT_CASES, slosh
+from cosim.validation.common import CaseResult
+DEFAULT_OUT = Path("recordings") / "validate"
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("validate", help="run validation cases against analytic and experimental references",
+                              description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("cases", nargs="*", metavar="CASE",
+                   help="; ".join(f"{k}: {c.summary}" for k, c in CASES.items()) + f" (default: {' '.join(DEFAULT_CASES)})")
+    p.add_argument("--json", action="store_true", help="print machine-readable results (with raw series) on stdout")
+    p.add_argument("--width", type=float, help="tank width B (hydrostatic, slosh) or column width a (dam-break), m")
+    p.add_argument("--fill", type=float, help="fill depth A (hydrostatic, slosh) or column height (dam-break), m; "
+                   "slosh without --fill runs the seed's fills 0.054, 0.108, 0.162 m")
+    p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
+    p.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2-D (pour plane) or 3-D (default 2)")
+    p.add_argument("--device", default="cpu", help="cpu or cuda[:N] (default cpu)")
+    p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
+    p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
+    p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
+    p.set_defaults(func=run)
+
+
+def _case_params(name: str, args) -> list:
+    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing}
+    geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
+    params = CASES[name].params
+    if name in ("tilt", "shake"):
+        geometry.pop("width", None)  # the seed's vessel
+    if name == "slosh" and args.fill is None:
+        return [params(**common, **geometry, fill=fill) for fill in slosh.SEED_FILLS]
+    return [params(**common, **geometry)]
+
+
+def _table(results: list[CaseResult]) -> str:
+    header = f"{'case':<12} {'quantity':<28} {'measured':>12} {'reference':>12} {'error':>9} {'tol':>7} {'pass':>5} {'wall s':>7}"
+    lines = [header, "-" * len(header)]
+    for r in results:
+        label = r.case if r.case != "slosh" else f"slosh A={r.parameters['fill']:.3f}"
+        for k, m in enumerate(r.metrics):
+            err = f"{m.error:+.4f}" if m.absolute else f"{100 * m.error:+.2f}%"
+            tol = ("-" if m.tolerance == float("inf") else (f"{m.tolerance:g}" if m.absolute else f"{100 * m.tolerance:g}%"))
+            status = "ok" if m.passed else "FAIL"
+            wall = f"{r.wall_time:7.1f}" if k == 0 else ""
+            lines.append(f"{label if k == 0 else '':<12} {m.name:<28} {m.measured:>12.5g} {m.reference:>12.5g} {err:>9} {tol:>7} {status:>5} {wall:>7}")
+    return "\n".join(lines)
+
+
+def run(args) -> int:
+    names = args.cases or list(DEFAULT_CASES)
+    unknown = [n for n in names if n not in CASES]
+    if unknown:
+        raise InputError(f"case {unknown[0]!r}: unknown; choose from {', '.join(CASES)}")
+    jobs = [(name, params) for name in names for params in _case_params(name, args)]
+    results = []
+    for name, params in jobs:
+        print(f"running {name} ({', '.join(f'{k}={v}' for k, v in vars(params).items() if v is not None)}) ...", file=sys.stderr)
+        result = CASES[name].run(params)
+        results.append(result)
+        if not args.no_plot:
+            suffix = f"-A{result.parameters['fill']:.3f}" if name == "slosh" else ""
+            path = args.out / f"{name}{suffix}-{result.parameters['dim']}d.png"
+            with atomic_path(path) as tmp:
+                CASES[name].plot(result, tmp)
+            print(f"  plot: {path}", file=sys.stderr)
+    passed = all(r.passed for r in results)
+    if args.json:
+        print(json.dumps({"passed": passed, "cases": [r.to_json() for r in results]}))
+    else:
+        print(_table(results))
+        print(f"\n{'all validations passed' if passed else 'SOME VALIDATIONS FAILED (see FAIL rows)'}")
+    return 1 if (args.strict and not passed) else 0
