@@ -2,7 +2,7 @@
 
 A motion is a time series of joint configurations per arm (rad, the arms' joint order). Each configuration is
 posed on a private copy of the model and data (the live simulation is never touched) and MuJoCo's collision detection
-runs on it; consecutive samples are subdivided so that no joint moves more than ``max_joint_step`` between checks.
+(``mj_kinematics`` + ``mj_collision``) runs on it; consecutive samples are subdivided so that no joint moves more than ``max_joint_step`` between checks.
 Pairs the scene excludes (neighbouring links, a vessel with its own mount and flange link) never produce contacts;
 every other contact closer than ``clearance`` is a collision: arm-arm, arm-table, vessel-vessel, arm-vessel, ...
 The first one in time is reported.
@@ -74,10 +74,24 @@ class MotionChecker:
         self.scene = scene
         self.clearance = check_range("collision.clearance", clearance, 0.0, 0.2, "m")
         self.max_joint_step = check_positive("collision.max_joint_step", max_joint_step, "rad", 0.5)
-        self.model = copy.copy(scene.model)
-        self.model.geom_margin[:] = scene.model.geom_margin + self.clearance
+        self.model = self._model_with_margin(scene, self.clearance)
         self.data = mujoco.MjData(self.model)
         self._kinds = self._classify_bodies()
+
+    @staticmethod
+    def _model_with_margin(scene: RobotScene, clearance: float) -> mujoco.MjModel:
+        """A private model whose geoms generate contacts ``clearance`` m early.
+
+        The margin has to be set before compiling: MuJoCo's broad phase uses bounds computed at compile time.
+        """
+        if clearance == 0.0:
+            return copy.copy(scene.model)
+        if scene.spec is None:
+            raise InputError("collision.clearance: a positive clearance needs a scene loaded from its MjSpec")
+        spec = scene.spec.copy()
+        for geom in spec.geoms:
+            geom.margin = geom.margin + clearance
+        return spec.compile()
 
     def _classify_bodies(self) -> list[PartKind]:
         """Kind of every body: vessel parts (vessel, its mount, bodies under the vessel), the rest of each arm's tree."""
@@ -117,8 +131,8 @@ class MotionChecker:
         c = min(hits, key=lambda h: h.dist)
         return Collision(
             time=time,
-            geom1=m.geom(c.geom1).name,
-            geom2=m.geom(c.geom2).name,
+            geom1=m.geom(c.geom1).name or f"geom {c.geom1}",
+            geom2=m.geom(c.geom2).name or f"geom {c.geom2}",
             body1=m.body(m.geom_bodyid[c.geom1]).name,
             body2=m.body(m.geom_bodyid[c.geom2]).name,
             kind1=self._geom_kind(c.geom1),

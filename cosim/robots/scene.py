@@ -183,14 +183,15 @@ def _load_spec(path: Path) -> mujoco.MjSpec:
 
 
 class RobotScene:
-    """A compiled two-arm scene with its live ``MjData`` (``self.model``, ``self.data``).
+    """A compiled two-arm scene with its live ``MjData`` (``self.model``, ``self.data``) and its ``MjSpec``.
 
     Build with :meth:`load` (a scene file: the default ``models/scene.xml`` or one written by the scene builder) or
     :meth:`from_spec`. The data starts at the ``home`` keyframe.
     """
 
-    def __init__(self, model: mujoco.MjModel, source: str = "scene") -> None:
+    def __init__(self, model: mujoco.MjModel, source: str = "scene", spec: mujoco.MjSpec | None = None) -> None:
         self.model = model
+        self.spec = spec  # the spec the model was compiled from, when known (see cosim.robots.collision)
         self.data = mujoco.MjData(model)
         key = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_KEY, HOME_KEY)
         if key < 0:
@@ -199,6 +200,7 @@ class RobotScene:
         self.reset_home()
         self.arms = {role: _arm_info(model, self.data, role, source) for role in ArmRole}
         self._ik: dict[ArmRole, ArmIK] = {}
+        self._inverse_data: mujoco.MjData | None = None
 
     # ---- construction --------------------------------------------------------------------------------------------
     @classmethod
@@ -212,7 +214,7 @@ class RobotScene:
             for vessel in (pourer, catcher):
                 if depths[vessel.name] > 0.0:
                     add_liquid_payload(spec, vessel, depths[vessel.name])
-        return cls(spec.compile(), source)
+        return cls(spec.compile(), source, spec)
 
     @classmethod
     def load(cls, path: str | Path | None = None, payload: PayloadMode = PayloadMode.EMPTY) -> "RobotScene":
@@ -256,6 +258,23 @@ class RobotScene:
         if tau_ff is not None:
             u += np.asarray(tau_ff, dtype=float) / arm.kp
         self.data.ctrl[arm.ctrl_adr] = u
+
+    def dynamics_feedforward(self, role: ArmRole, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
+        """Inverse-dynamics feedforward torque (n,) N m for desired ``q``, ``qd``, ``qdd`` (n,) of the arm.
+
+        ``M(q) qdd + c(q, qd)`` (inertia incl. armature, Coriolis and centrifugal terms) at the desired state, the
+        other arm at its current state; gravity is left out because the model's gravity compensation already
+        supplies it through the actuators. Computed on a private MjData (``mj_inverse``), the live data is untouched.
+        """
+        arm, m = self.arms[role], self.model
+        if self._inverse_data is None:
+            self._inverse_data = mujoco.MjData(m)
+        d = self._inverse_data
+        d.qpos[:], d.qvel[:] = self.data.qpos, self.data.qvel
+        d.qacc[:] = 0.0
+        d.qpos[arm.qpos_adr], d.qvel[arm.dof_adr], d.qacc[arm.dof_adr] = q, qd, qdd
+        mujoco.mj_inverse(m, d)
+        return d.qfrc_inverse[arm.dof_adr] - d.qfrc_gravcomp[arm.dof_adr]
 
     def vessel_state(self, role: ArmRole) -> VesselState:
         """The held vessel's pose, velocity and centre of mass, world frame (valid after mj_forward/mj_step)."""
