@@ -78,6 +78,15 @@ class ArmInfo:
     home_quat: np.ndarray  # (4,), vessel orientation at home
 
 
+def shift_wrench(force: np.ndarray, torque: np.ndarray, from_point: np.ndarray, to_point: np.ndarray) -> np.ndarray:
+    """Torque (3,) N m about ``to_point`` of a wrench given as ``force`` (3,) N and ``torque`` (3,) N m about
+    ``from_point``; all world frame: ``tau_to = tau_from + (from_point - to_point) x force``. Use it to move a wrench
+    to the vessel's centre of mass (``VesselState.com``) before :meth:`RobotScene.apply_vessel_wrench`."""
+    return np.asarray(torque, dtype=float) + np.cross(
+        np.asarray(from_point, dtype=float) - np.asarray(to_point, dtype=float), np.asarray(force, dtype=float)
+    )
+
+
 def _text(model: mujoco.MjModel, name: str, source: str) -> str:
     tid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, name)
     if tid < 0:

@@ -3,7 +3,8 @@
 What it builds (world z up, SI units):
 * a floor, a table (box), lights;
 * each arm's MJCF attached at its base pose with the name prefix ``<role>/`` (``pour_arm/shoulder_pan``), its own
-  keyframes dropped;
+  keyframes dropped; every arm link excluded from colliding with its parent link (explicitly: MuJoCo does not filter
+  a child of a world-welded base);
 * on each arm's attachment site a mount body ``<role>/mount`` (an aluminium adapter plate along the flange axis) and
   the vessel body (:func:`cosim.robots.vessel_mjcf.add_vessel_body`) with the held wall against the plate at half
   the wall height; vessel contacts with the flange link are excluded (the vessel's own gripper/mount);
@@ -111,6 +112,33 @@ def _add_environment(scene: mujoco.MjSpec, config: SceneConfig) -> None:
     )
 
 
+def _check_joints(compiled: mujoco.MjModel, placement: ArmPlacement) -> None:
+    role = placement.role.value
+    for joint in placement.arm.joints:
+        jid = mujoco.mj_name2id(compiled, mujoco.mjtObj.mjOBJ_JOINT, f"{role}/{joint}")
+        if jid < 0:
+            raise InputError(f"{role}.arm.joints: no joint {joint!r} in {placement.arm.mjcf}")
+        if int(compiled.jnt_type[jid]) not in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
+            raise InputError(f"{role}.arm.joints: {joint!r} is not a hinge or slide joint")
+
+
+def _exclude_neighbours(scene: mujoco.MjSpec, compiled: mujoco.MjModel, placement: ArmPlacement) -> None:
+    """Exclude every arm link from colliding with its parent link.
+
+    MuJoCo filters parent/child contacts itself except when the parent is welded to the world (an arm's fixed base),
+    so the pairs are listed explicitly; pairs the arm's own file already excludes are kept once.
+    """
+    site_id = mujoco.mj_name2id(compiled, mujoco.mjtObj.mjOBJ_SITE, f"{placement.role.value}/{placement.arm.attachment_site}")
+    root = compiled.body_rootid[compiled.site_bodyid[site_id]]
+    existing = set()
+    for signature in compiled.exclude_signature:
+        existing.add(frozenset((int(signature) >> 16, int(signature) & 0xFFFF)))  # (body1 << 16) + body2
+    for body in range(1, compiled.nbody):
+        parent = int(compiled.body_parentid[body])
+        if compiled.body_rootid[body] == root and parent > 0 and frozenset((body, parent)) not in existing:
+            scene.add_exclude(bodyname1=compiled.body(parent).name, bodyname2=compiled.body(body).name)
+
+
 def _add_mount_and_vessel(scene: mujoco.MjSpec, compiled: mujoco.MjModel, placement: ArmPlacement, config: SceneConfig) -> str:
     """Build the mount plate and the vessel on the arm's attachment site; return the flange link's body name."""
     role = placement.role.value
@@ -190,6 +218,8 @@ def build_scene_spec(config: SceneConfig | None = None) -> mujoco.MjSpec:
         scene.attach(_load_arm(placement), frame=frame, prefix=f"{placement.role.value}/")
     arms_only = scene.compile()
     for placement in config.placements:
+        _check_joints(arms_only, placement)
+        _exclude_neighbours(scene, arms_only, placement)
         flange_link = _add_mount_and_vessel(scene, arms_only, placement, config)
         _add_mapping(scene, placement, flange_link)
     _add_home_key(scene, scene.compile(), config)
