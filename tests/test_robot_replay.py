@@ -50,7 +50,7 @@ def test_holding_home_has_no_tracking_error(scene):
 
 
 def test_smooth_pour_is_tracked_within_acceptance(scene):
-    spec = PourMotionSpec(duration=4.0, max_tilt=math.radians(70.0), pivot=Pivot.LIP, catcher_dx=0.1)
+    spec = PourMotionSpec(duration=6.0, max_tilt=math.radians(90.0), pivot=Pivot.LIP, catcher_dx=0.1)
     trajectory = plan_pour_trajectory(scene, spec)
     gravity = replay(scene, trajectory, Feedforward.GRAVITY)
     dynamics = replay(scene, trajectory, Feedforward.DYNAMICS)

@@ -52,9 +52,3 @@ def add_liquid_payload(spec: mujoco.MjSpec, vessel: VesselSpec, fill_depth: floa
     body.ipos = [0.0, 0.0, 0.5 * fill_depth]
     body.inertia = list(map(float, inertia))
 
-
-def liquid_mass(vessel: VesselSpec, fill_depth: float) -> float:
-    """kg of liquid filling ``vessel`` to ``fill_depth`` m."""
-    return LIQUID_DENSITY * vessel.inner_floor_area * fill_depth if fill_depth > 0.0 else 0.0
-
-

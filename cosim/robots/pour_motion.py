@@ -1,16 +1,16 @@
-"""A smooth pour motion for both arms, as a jerk-limited joint trajectory (ruckig) through IK of the vessel path.
+"""A smooth pour motion for both arms, as a joint trajectory through IK of a quintic-timed vessel path.
 
-Task path (pour plane, relative to the vessels' home poses, see :mod:`cosim.robots.planar`): a phase
-``s(t)`` rises from 0 to 1 over the first half of ``duration`` and falls back over the second half, each half a
-quintic smoothstep ``10 u^3 - 15 u^4 + 6 u^5`` (zero velocity and acceleration at the ends). The pourer tilts by
-``s * max_tilt`` about the chosen pivot (bottom middle or lip, fixed in the vessel at home); the catcher translates
-by ``s * catcher_dx`` along world x.
+Task path (pour plane, relative to the vessels' home poses, see :mod:`cosim.robots.planar`): a phase ``s(t)``
+rises from 0 to 1 over the first half of ``duration`` and falls back over the second half, each half a quintic
+smoothstep ``10 u^3 - 15 u^4 + 6 u^5`` (zero velocity and acceleration at the ends and at the turn-around). The
+pourer tilts by ``s * max_tilt`` about the chosen pivot (bottom middle or lip, fixed in the vessel at home); the
+catcher translates by ``s * catcher_dx`` along world x.
 
-Joint trajectory: the path is solved by IK every ``period`` s (each solve seeded with the previous one, so the arm
-stays on its home branch), and ruckig, run online with the same cycle, tracks those joint targets (position and
-finite-difference velocity) under the arm's joint speed limits and :data:`MAX_ACCELERATION` /
-:data:`MAX_JERK`; it ends at rest at home. The ruckig output (position, velocity, acceleration per cycle) is the
-trajectory written to CSV.
+Joint trajectory: the path is solved by IK every ``period`` s to :data:`PLANNING_TOLERANCE` (each solve seeded with
+the previous one, so the arms stay on their home branches); velocities and accelerations are central differences of
+those samples (zero at both ends, where the path is at rest). The result is checked against the arms' joint speed
+limits and :data:`MAX_ACCELERATION` / :data:`MAX_JERK` (jerk by differencing the accelerations); a motion that
+exceeds them is refused with an ``InputError`` naming the joint, so every trajectory written is jerk-limited.
 
 ``python -m cosim.robots.pour_motion --out pour.csv`` writes it; ``cosim replay pour.csv`` measures how the servos
 track it.
@@ -25,22 +25,22 @@ from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
-from ruckig import InputParameter, OutputParameter, Result, Ruckig
 
 from cosim.checks import check_choice, check_positive, check_range
 from cosim.errors import InputError
 from cosim.io.trajectory_csv import JointTrajectory, write_trajectory_csv
+from cosim.robots.ik import IKSettings
 from cosim.robots.planar import PlanarPose, tilt_about_pivot
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 
 # Joint acceleration and jerk limits for generated motions, rad/s^2 and rad/s^3. UR publishes no per-joint
 # acceleration limit for the UR10e; PolyScope's default joint acceleration is 80 deg/s^2 (1.4 rad/s^2) and its
-# maximum 800 deg/s^2. 2.5 rad/s^2 leaves room above the path's own peak (about 0.5 rad/s^2 for 120 deg in 5 s).
+# maximum 800 deg/s^2. 2.5 rad/s^2 and 15 rad/s^3 leave room above a 120 deg tilt in 5 s (about 1 rad/s^2).
 MAX_ACCELERATION = 2.5
 MAX_JERK = 15.0
-# Extra time allowed after the path ends for ruckig to come to rest at home, s.
-SETTLE_TIME = 2.0
+# IK tolerance of the path samples (m and rad): far below the differencing step so derivatives are not noise.
+PLANNING_TOLERANCE = 1e-10
 
 
 class Pivot(Enum):
@@ -53,7 +53,7 @@ class Pivot(Enum):
 @dataclass(frozen=True)
 class PourMotionSpec:
     """duration: s (1, 120]. max_tilt: rad [0, 2.1]. pivot: :class:`Pivot`. catcher_dx: m [-0.3, 0.3].
-    period: s, IK and ruckig cycle (0.001, 0.1]."""
+    period: s, sample period of the trajectory (0.001, 0.1]."""
 
     duration: float = 10.0
     max_tilt: float = math.radians(120.0)
@@ -87,46 +87,46 @@ def task_poses(scene: RobotScene, spec: PourMotionSpec, t: float) -> dict[ArmRol
     }
 
 
+def _check_limits(trajectory: JointTrajectory, max_speed: np.ndarray, period: float) -> None:
+    jerk = np.diff(trajectory.accelerations, axis=0) / period
+    for quantity, values, limit, unit in (
+        ("speed", trajectory.velocities, max_speed, "rad/s"),
+        ("acceleration", trajectory.accelerations, np.full(max_speed.size, MAX_ACCELERATION), "rad/s^2"),
+        ("jerk", jerk, np.full(max_speed.size, MAX_JERK), "rad/s^3"),
+    ):
+        peak = np.max(np.abs(values), axis=0)
+        worst = int(np.argmax(peak / limit))
+        if peak[worst] > limit[worst]:
+            raise InputError(
+                f"pour trajectory: joint {trajectory.joint_names[worst]} needs {quantity} {peak[worst]:.3g} {unit}, "
+                f"above its limit {limit[worst]:.3g} {unit}; use a longer duration"
+            )
+
+
 def plan_pour_trajectory(scene: RobotScene, spec: PourMotionSpec = PourMotionSpec()) -> JointTrajectory:
-    """The jerk-limited joint trajectory of both arms for ``spec`` (see the module docstring)."""
+    """The joint trajectory of both arms for ``spec`` (see the module docstring); ``InputError`` if a target is
+    unreachable or the motion exceeds the joint limits."""
     roles = list(ArmRole)
-    joints = [name for role in roles for name in scene.arms[role].joints]
-    n = len(joints)
+    solvers = {role: scene.ik(role, IKSettings(PLANNING_TOLERANCE, PLANNING_TOLERANCE, 100, stall_iterations=20)) for role in roles}
     seeds = {role: scene.arms[role].home_q for role in roles}
-
-    def path_q(t: float) -> np.ndarray:
-        poses = task_poses(scene, spec, t)
+    times = np.linspace(0.0, spec.duration, int(round(spec.duration / spec.period)) + 1)
+    samples = []
+    for t in times:
+        poses = task_poses(scene, spec, float(t))
         for role in roles:
-            seeds[role] = scene.solve_vessel_target(role, poses[role], seeds[role])
-        return np.concatenate([seeds[role] for role in roles])
-
-    otg = Ruckig(n, spec.period)
-    inp, out = InputParameter(n), OutputParameter(n)
-    home = np.concatenate([scene.arms[r].home_q for r in roles])
-    inp.current_position, inp.current_velocity, inp.current_acceleration = home, np.zeros(n), np.zeros(n)
-    inp.max_velocity = np.concatenate([scene.arms[r].max_joint_speed for r in roles])
-    inp.max_acceleration = np.full(n, MAX_ACCELERATION)
-    inp.max_jerk = np.full(n, MAX_JERK)
-    times, pos, vel, acc = [0.0], [home.copy()], [np.zeros(n)], [np.zeros(n)]
-    q_prev = home.copy()
-    steps = int(round((spec.duration + SETTLE_TIME) / spec.period))
-    for k in range(1, steps + 1):
-        t = k * spec.period
-        q_target = path_q(min(t, spec.duration))
-        inp.target_position = q_target
-        inp.target_velocity = (q_target - q_prev) / spec.period if t <= spec.duration else np.zeros(n)
-        q_prev = q_target
-        result = otg.update(inp, out)
-        if result not in (Result.Working, Result.Finished):
-            raise InputError(f"pour trajectory: ruckig failed at t={t:.3f} s ({result})")
-        times.append(t)
-        pos.append(np.array(out.new_position))
-        vel.append(np.array(out.new_velocity))
-        acc.append(np.array(out.new_acceleration))
-        out.pass_to_input(inp)
-        if t > spec.duration and result == Result.Finished:
-            break
-    return JointTrajectory(np.array(times), tuple(joints), np.array(pos), np.array(vel), np.array(acc))
+            pos, quat = scene.vessel_target(role, poses[role])
+            label = f"{scene.arms[role].vessel.name} path at t={t:.2f} s"
+            seeds[role] = solvers[role].solve_or_raise(pos, quat, seeds[role], label)
+        samples.append(np.concatenate([seeds[role] for role in roles]))
+    q = np.array(samples)
+    h = times[1] - times[0]
+    qd, qdd = np.zeros_like(q), np.zeros_like(q)
+    qd[1:-1] = (q[2:] - q[:-2]) / (2.0 * h)
+    qdd[1:-1] = (q[2:] - 2.0 * q[1:-1] + q[:-2]) / (h * h)
+    joints = tuple(name for role in roles for name in scene.arms[role].joints)
+    trajectory = JointTrajectory(times, joints, q, qd, qdd)
+    _check_limits(trajectory, np.concatenate([scene.arms[r].max_joint_speed for r in roles]), h)
+    return trajectory
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -121,7 +121,7 @@ def _arm_columns(scene: RobotScene, trajectory: JointTrajectory) -> dict[ArmRole
     return columns
 
 
-def _torque_limits(model: mujoco.MjModel, scene: RobotScene, trajectory: JointTrajectory) -> tuple[np.ndarray, np.ndarray]:
+def _torque_limits(model: mujoco.MjModel, trajectory: JointTrajectory) -> tuple[np.ndarray, np.ndarray]:
     """(dof indices (J,), torque limit (J,) N m) of the trajectory's joints; inf where the joint is not clamped."""
     dofs, limits = [], []
     for name in trajectory.joint_names:
@@ -143,10 +143,13 @@ def replay(scene: RobotScene, trajectory: JointTrajectory, feedforward: Feedforw
         scene.set_joint_positions(role, q0[cols], qd0[cols])
     mujoco.mj_forward(model, data)
 
-    fk = mujoco.MjData(model)  # private data for forward kinematics of the commanded configuration
+    fk = mujoco.MjData(model)  # private data: forward kinematics of the commanded configuration
     fk.qpos[:] = data.qpos
+    # private data: kinematics of the actual configuration (after mj_step, data.site_xpos still belongs to the
+    # configuration before the step's integration)
+    measured = mujoco.MjData(model)
     vessels = {arm.vessel.name: arm for arm in scene.arms.values()}
-    dofs, limits = _torque_limits(model, scene, trajectory)
+    dofs, limits = _torque_limits(model, trajectory)
     qpos_cols = np.concatenate([scene.arms[role].qpos_adr for role in columns])
     traj_cols = np.concatenate([np.array(cols) for cols in columns.values()])
 
@@ -169,8 +172,10 @@ def replay(scene: RobotScene, trajectory: JointTrajectory, feedforward: Feedforw
         max_joint = np.maximum(max_joint, np.abs(joint_err))
         fk.qpos[qpos_cols] = q_cmd[traj_cols]
         mujoco.mj_kinematics(model, fk)
+        measured.qpos[:] = data.qpos
+        mujoco.mj_kinematics(model, measured)
         for name, arm in vessels.items():
-            e = float(np.linalg.norm(fk.site_xpos[arm.lip_site] - data.site_xpos[arm.lip_site]))
+            e = float(np.linalg.norm(fk.site_xpos[arm.lip_site] - measured.site_xpos[arm.lip_site]))
             lip_sq[name] += e * e
             lip_max[name] = max(lip_max[name], e)
         if data.ncon > 0:
