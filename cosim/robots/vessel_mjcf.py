@@ -134,8 +134,8 @@ def add_vessel_body(
             )
     else:
         _add_cylinder_geoms(body, vessel)
-    body.add_site(name=frame_site(vessel), size=[SITE_SIZE, 0.0, 0.0], group=4)
-    body.add_site(name=lip_site(vessel), pos=list(map(float, vessel.lip_local)), size=[SITE_SIZE, 0.0, 0.0], group=4)
+    body.add_site(name=frame_site(vessel), size=[SITE_SIZE] * 3, group=4)
+    body.add_site(name=lip_site(vessel), pos=list(map(float, vessel.lip_local)), size=[SITE_SIZE] * 3, group=4)
     return body
 
 
