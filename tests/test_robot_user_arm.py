@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from cosim.errors import InputError
+from cosim.robots.ik import IKSettings
 from cosim.robots.planar import tilt_about_pivot
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_builder import build_scene_spec, scene_mjcf
@@ -63,29 +64,38 @@ TEST_ARM_XML = """
 </mujoco>
 """
 JOINTS = ("j1", "j2", "j3", "j4", "j5", "j6")
+# The same arm made redundant (7-DOF, like a Panda): a second wrist pitch on the axis of j4, so only j4 + j7 matters
+# to the vessel and (j4 - j7) spans the task nullspace.
+TEST_ARM7_XML = TEST_ARM_XML.replace(
+    '<joint name="j4" axis="0 1 0"/>', '<joint name="j4" axis="0 1 0"/> <joint name="j7" axis="0 1 0"/>'
+).replace('<general name="a6" joint="j6"/>', '<general name="a6" joint="j6"/> <general name="a7" joint="j7"/>')
 # Reaching a vessel target: the acceptance tolerances of issue 3 (m, rad).
 MAX_POSITION_ERROR_M = 1e-3
 MAX_ROTATION_ERROR_RAD = math.radians(0.1)
 
 
-@pytest.fixture
-def config(tmp_path):
+def _config(tmp_path, xml: str, joints: tuple[str, ...], seed: tuple[float, ...]):
     path = tmp_path / "test_arm.xml"
-    path.write_text(TEST_ARM_XML)
+    path.write_text(xml)
     default = default_scene_config()
     pour = ArmPlacement(
         role=ArmRole.POUR,
-        arm=ArmModel(str(path), JOINTS, "tool", (2.0,) * 6),
+        arm=ArmModel(str(path), joints, "tool", (2.0,) * len(joints)),
         base_pos=(-0.55, 0.0, 0.75),
         base_yaw=0.0,
         vessel=seed_pouring_vessel(),
         vessel_home=(0.0, 0.0, 1.25),
         mount_side=MountSide.BACK,
-        home_seed=(0.0, -1.2, 2.0, -0.8, 0.0, 0.0),
+        home_seed=seed,
     )
     cup = VesselSpec(name="catcher", shape="cylinder", inner_width=0.2, inner_height=0.14)
     catch = dataclasses.replace(default.catch, vessel=cup, vessel_home=(0.2, 0.0, 1.25 - 0.21 - 0.14))
     return dataclasses.replace(default, pour=pour, catch=catch)
+
+
+@pytest.fixture
+def config(tmp_path):
+    return _config(tmp_path, TEST_ARM_XML, JOINTS, (0.0, -1.2, 2.0, -0.8, 0.0, 0.0))
 
 
 def test_user_arm_holds_the_vessel_and_reaches_targets(config):
@@ -130,3 +140,22 @@ def test_bad_mapping_is_reported(config):
     )
     with pytest.raises(InputError, match="pour_arm.arm.joints: no joint 'j7'"):
         build_scene_spec(dataclasses.replace(config, pour=wrong_joint))
+
+
+def test_redundant_user_arm_is_pulled_toward_home_in_the_nullspace(tmp_path):
+    config = _config(tmp_path, TEST_ARM7_XML, JOINTS + ("j7",), (0.0, -1.2, 2.0, -0.4, 0.0, 0.0, -0.4))
+    scene = RobotScene.from_config(config)
+    arm = scene.arms[ArmRole.POUR]
+    j4, j7 = 3, 6
+    seed = arm.home_q.copy()
+    seed[j4] += 0.4  # a pure nullspace offset: the vessel does not move
+    seed[j7] -= 0.4
+    pose = tilt_about_pivot(arm.home_quat, arm.vessel.lip_local, math.radians(30.0))
+    target_pos, target_quat = scene.vessel_target(ArmRole.POUR, pose)
+    pulled = scene.ik(ArmRole.POUR, IKSettings(1e-6, 1e-6)).solve(target_pos, target_quat, seed)
+    unpulled = scene.ik(ArmRole.POUR, IKSettings(1e-6, 1e-6, posture_gain=0.0)).solve(target_pos, target_quat, seed)
+    assert pulled.converged and unpulled.converged
+    assert pulled.position_error <= MAX_POSITION_ERROR_M and pulled.rotation_error <= MAX_ROTATION_ERROR_RAD
+    split = lambda q: (q[j4] - q[j7]) - (arm.home_q[j4] - arm.home_q[j7])  # noqa: E731  nullspace coordinate
+    assert abs(split(unpulled.q)) > 0.7  # without the pull the offset stays
+    assert abs(split(pulled.q)) < 1e-2  # with it the solution returns to the home split

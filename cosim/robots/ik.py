@@ -10,9 +10,10 @@ Iteration (Levenberg-Marquardt form of damped least squares), for the arm's join
     dq = J^T (J J^T + lambda^2 I)^-1 e + N (k_home (q_home - q)),  N = I - J^T (J J^T)^-1 J (task nullspace)
     q  = clip(q + dq, joint range)
 ``L`` (:attr:`IKSettings.rotation_length`) makes metres and radians comparable. The nullspace pull keeps a
-redundant arm (n > 6) near its home posture; a 6-DOF arm has no task nullspace away from singularities (the term is
-skipped: with the damped inverse it would only bias the solution by ~lambda^2), and its posture is kept by seeding
-from the current or home configuration (the nearest IK branch).
+redundant arm (n > 6) near its home posture: its solve continues after the task converged until the pull is below
+``posture_tolerance``. A 6-DOF arm has no task nullspace away from singularities (the term is skipped: with the
+damped inverse it would only bias the solution by ~lambda^2), and its posture is kept by seeding from the current or
+home configuration (the nearest IK branch).
 """
 
 from __future__ import annotations
@@ -40,7 +41,10 @@ class IKSettings:
     damping: lambda of the damped least squares, in units of the (weighted) error, m. (0, 1]
     max_step: rad, largest joint change per iteration. (0, 3.15]
     rotation_length: m, weight L of the rotation error against the position error. (0, 10]
-    posture_gain: fraction of the home-posture error pulled in per iteration in the task nullspace. [0, 1]
+    posture_gain: fraction of the home-posture error pulled in per iteration in the task nullspace (redundant arms,
+        n > 6). [0, 1]
+    posture_tolerance: rad, a redundant arm's solve ends when the nullspace pull toward home is below this (or at
+        max_iterations with the task reached). (0, 1]
     stall_iterations: stop early when the error has not dropped by 1% in this many iterations. [1, 10000]
     """
 
@@ -50,7 +54,8 @@ class IKSettings:
     damping: float = 1e-4
     max_step: float = 0.4
     rotation_length: float = 0.2
-    posture_gain: float = 0.1
+    posture_gain: float = 0.5
+    posture_tolerance: float = 1e-3
     stall_iterations: int = 8
 
     def __post_init__(self) -> None:
@@ -61,6 +66,7 @@ class IKSettings:
         object.__setattr__(self, "max_step", check_positive("ik.max_step", self.max_step, "rad", 3.15))
         object.__setattr__(self, "rotation_length", check_positive("ik.rotation_length", self.rotation_length, "m", 10.0))
         object.__setattr__(self, "posture_gain", check_range("ik.posture_gain", self.posture_gain, 0.0, 1.0))
+        object.__setattr__(self, "posture_tolerance", check_positive("ik.posture_tolerance", self.posture_tolerance, "rad", 1.0))
         check_int("ik.stall_iterations", self.stall_iterations, 1, 10000)
 
 
@@ -138,38 +144,42 @@ class ArmIK:
         q = np.clip(np.asarray(seed_q, dtype=float).copy(), self.lower, self.upper)
         n = q.size
         damping2 = s.damping**2 * np.eye(6)
+        redundant = n > 6 and s.posture_gain > 0.0
         best_norm, best_iter = math.inf, 0
         err_p = err_r = math.inf
+        task_ok = False
         iteration = 0
         for iteration in range(1, s.max_iterations + 1):
             data.qpos[self.qpos_adr] = q
             mujoco.mj_kinematics(model, data)
-            pos = data.site_xpos[self.site_id]
-            mat = data.site_xmat[self.site_id].reshape(3, 3)
-            e_pos = target_pos - pos
-            e_rot = rotation_error(target_mat, mat)
+            e_pos = target_pos - data.site_xpos[self.site_id]
+            e_rot = rotation_error(target_mat, data.site_xmat[self.site_id].reshape(3, 3))
             err_p, err_r = float(np.linalg.norm(e_pos)), float(np.linalg.norm(e_rot))
-            if err_p <= s.position_tolerance and err_r <= s.rotation_tolerance:
+            task_ok = err_p <= s.position_tolerance and err_r <= s.rotation_tolerance
+            if task_ok and not redundant:
                 return IKResult(q, err_p, err_r, iteration, True)
-            norm = err_p + s.rotation_length * err_r
-            if norm < 0.99 * best_norm:
-                best_norm, best_iter = norm, iteration
-            elif iteration - best_iter >= s.stall_iterations:
-                break
+            if not task_ok:
+                norm = err_p + s.rotation_length * err_r
+                if norm < 0.99 * best_norm:
+                    best_norm, best_iter = norm, iteration
+                elif iteration - best_iter >= s.stall_iterations:
+                    break
             mujoco.mj_comPos(model, data)
             mujoco.mj_jacSite(model, data, self._jacp, self._jacr, self.site_id)
             jac = np.vstack((self._jacp[:, self.dof_adr], s.rotation_length * self._jacr[:, self.dof_adr]))
             err = np.concatenate((e_pos, s.rotation_length * e_rot))
-            gram_inv_jac = np.linalg.solve(jac @ jac.T + damping2, jac)  # (J J^T + l^2 I)^-1 J, (6, n)
-            dq = gram_inv_jac.T @ err
-            if n > 6 and s.posture_gain > 0.0:  # redundant arm: pull toward home in the exact task nullspace
+            dq = np.linalg.solve(jac @ jac.T + damping2, jac).T @ err  # J^T (J J^T + l^2 I)^-1 e
+            if redundant:  # pull toward home in the exact task nullspace until that pull is negligible
                 nullspace = np.eye(n) - jac.T @ np.linalg.solve(jac @ jac.T + _NULLSPACE_REG * np.eye(6), jac)
-                dq += nullspace @ (s.posture_gain * (self.home_q - q))
+                pull = nullspace @ (self.home_q - q)
+                if task_ok and float(np.max(np.abs(pull))) <= s.posture_tolerance:
+                    return IKResult(q, err_p, err_r, iteration, True)
+                dq += s.posture_gain * pull
             largest = float(np.max(np.abs(dq)))
             if largest > s.max_step:
                 dq *= s.max_step / largest
             q = np.clip(q + dq, self.lower, self.upper)
-        return IKResult(q, err_p, err_r, iteration, False)
+        return IKResult(q, err_p, err_r, iteration, task_ok)
 
     def solve_or_raise(
         self, target_pos: np.ndarray, target_quat: np.ndarray, seed_q: np.ndarray, label: str

@@ -30,8 +30,8 @@ from cosim.robots import assets
 from cosim.robots.ik import ArmIK, IKSettings
 from cosim.robots.payload import PayloadMode, add_liquid_payload, payload_fill_depths
 from cosim.robots.planar import PlanarPose, planar_to_world
-from cosim.robots.scene_builder import CUSTOM_PREFIX, HOME_KEY
-from cosim.robots.scene_config import ArmRole
+from cosim.robots.scene_builder import CUSTOM_PREFIX, HOME_KEY, build_scene_spec
+from cosim.robots.scene_config import ArmRole, SceneConfig
 from cosim.robots.vessel_mjcf import frame_site, lip_site
 from cosim.vessel import VesselShape, VesselSpec
 
@@ -194,8 +194,9 @@ def _load_spec(path: Path) -> mujoco.MjSpec:
 class RobotScene:
     """A compiled two-arm scene with its live ``MjData`` (``self.model``, ``self.data``) and its ``MjSpec``.
 
-    Build with :meth:`load` (a scene file: the default ``models/scene.xml`` or one written by the scene builder) or
-    :meth:`from_spec`. The data starts at the ``home`` keyframe.
+    Build with :meth:`load` (a scene file: the default ``models/scene.xml`` or one written by the scene builder),
+    :meth:`from_config` (a :class:`SceneConfig`, e.g. with a user's arm) or :meth:`from_spec`. The data starts at the
+    ``home`` keyframe.
     """
 
     def __init__(self, model: mujoco.MjModel, source: str = "scene", spec: mujoco.MjSpec | None = None) -> None:
@@ -224,6 +225,11 @@ class RobotScene:
                 if depths[vessel.name] > 0.0:
                     add_liquid_payload(spec, vessel, depths[vessel.name])
         return cls(spec.compile(), source, spec)
+
+    @classmethod
+    def from_config(cls, config: SceneConfig | None = None, payload: PayloadMode = PayloadMode.EMPTY) -> "RobotScene":
+        """Build the scene for ``config`` (e.g. a user's arm MJCF with its mapping; default: the project's scene)."""
+        return cls.from_spec(build_scene_spec(config), payload, source="scene config")
 
     @classmethod
     def load(cls, path: str | Path | None = None, payload: PayloadMode = PayloadMode.EMPTY) -> "RobotScene":
