@@ -22,7 +22,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "replay",
         help="play a joint trajectory CSV in MuJoCo (no liquid) and report tracking error",
-        description=__doc__.splitlines()[0].strip("`"),
+        description="Play a joint trajectory CSV through the arms' position servos in MuJoCo without liquid (the "
+        "liquid as a rigid payload) and report per-joint tracking error and the pour-lip path error.",
     )
     parser.add_argument("trajectory", help="trajectory CSV: time, <arm>/<joint>.pos/.vel/.acc columns")
     parser.add_argument("--json", action="store_true", help="print the results as JSON")
