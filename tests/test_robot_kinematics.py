@@ -11,7 +11,7 @@ import pytest
 from cosim.robots import assets
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
-from cosim.robots.ur10e import UR10E_JOINTS, dh_forward_kinematics
+from cosim.robots.ur10e import UR10E_JOINT_RANGE, UR10E_JOINTS, dh_forward_kinematics
 
 # The MJCF is written from the DH table itself, so FK must agree to floating-point round-off (m, and unitless for
 # rotation-matrix entries); 1e-9 leaves room for the 7-digit quaternions in the file (normalised on load).
@@ -60,3 +60,9 @@ def test_scene_arms_fk_matches_dh_model_in_their_base_frames(role):
 def test_arm_weight_matches_data_sheet():
     model = mujoco.MjModel.from_xml_path(str(assets.model_path(assets.UR10E_ARM)))
     assert abs(model.body_mass.sum() - UR10E_WEIGHT_KG) < WEIGHT_TOLERANCE_KG
+
+
+def test_joint_ranges_match_data_sheet():
+    model = mujoco.MjModel.from_xml_path(str(assets.model_path(assets.UR10E_ARM)))
+    for name in UR10E_JOINTS:
+        np.testing.assert_allclose(model.joint(name).range, UR10E_JOINT_RANGE, rtol=1e-9)

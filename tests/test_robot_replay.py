@@ -15,6 +15,7 @@ from cosim.robots.pour_motion import Pivot, PourMotionSpec, plan_pour_trajectory
 from cosim.robots.replay import Feedforward, replay
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.robots.ur10e import UR10E_PAYLOAD_KG
 
 # Issue 3 acceptance: RMS lip error of a smooth pour under the position servos with the full-vessel payload.
 MAX_LIP_RMS_ERROR_M = 2e-3
@@ -40,6 +41,18 @@ def test_payload_adds_the_liquid_mass(scene):
     added = scene.model.body_mass.sum() - empty.model.body_mass.sum()
     expected = 1000.0 * pourer.capacity * 2  # the pourer full, the catcher holding the same volume
     assert added == pytest.approx(expected, rel=1e-9)
+    for role, arm in scene.arms.items():  # everything beyond the flange: mount, vessel, liquid
+        flange = arm.flange_body
+        carried = sum(scene.model.body_mass[b] for b in range(scene.model.nbody) if _below(scene.model, b, flange))
+        assert 0.0 < carried < UR10E_PAYLOAD_KG, f"{role.value} carries {carried:.2f} kg"
+
+
+def _below(model, body: int, ancestor: int) -> bool:
+    while body > 0:
+        body = int(model.body_parentid[body])
+        if body == ancestor:
+            return True
+    return False
 
 
 def test_holding_home_has_no_tracking_error(scene):

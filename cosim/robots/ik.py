@@ -124,12 +124,6 @@ class ArmIK:
         self._jacp = np.zeros((3, model.nv))
         self._jacr = np.zeros((3, model.nv))
 
-    def site_pose(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Forward kinematics on the private data: site position (3,) m and rotation matrix (3, 3), world frame."""
-        self._data.qpos[self.qpos_adr] = q
-        mujoco.mj_kinematics(self.model, self._data)
-        return self._data.site_xpos[self.site_id].copy(), self._data.site_xmat[self.site_id].reshape(3, 3).copy()
-
     def solve(self, target_pos: np.ndarray, target_quat: np.ndarray, seed_q: np.ndarray) -> IKResult:
         """Solve for the site pose ``target_pos`` (3,) m, ``target_quat`` (4,) [w, x, y, z] from ``seed_q`` (n,) rad.
 

@@ -243,9 +243,6 @@ class RobotScene:
         mujoco.mj_resetDataKeyframe(self.model, self.data, self.home_key)
         mujoco.mj_forward(self.model, self.data)
 
-    def arm(self, role: ArmRole) -> ArmInfo:
-        return self.arms[role]
-
     def joint_positions(self, role: ArmRole) -> np.ndarray:
         """(n,) rad, the arm's current joint angles."""
         return self.data.qpos[self.arms[role].qpos_adr].copy()
