@@ -69,3 +69,23 @@ def test_servo_law_with_velocity_and_torque_feedforward(scene):
     ids = [scene.model.actuator(name).id for name in arm.joints]
     expected = arm.kp * (q_d - q) + arm.kv * (qd_d - 0.05) + tau_ff
     np.testing.assert_allclose(scene.data.actuator_force[ids], expected, rtol=1e-9)
+
+
+def test_wrench_feedforward_cancels_a_known_liquid_load(scene):
+    """The full pourer's water weight (3.65 kg) pushed on the vessel: the servos alone sag, with feedforward they hold."""
+    arm = scene.arms[ArmRole.POUR]
+    weight = np.array([0.0, 0.0, -9.81 * 1000.0 * arm.vessel.capacity])
+
+    def sag(feedforward: bool) -> float:
+        scene.reset_home()
+        scene.apply_vessel_wrench(ArmRole.POUR, weight, np.zeros(3))
+        for _ in range(1000):  # 2 s
+            tau = -scene.wrench_joint_torque(ArmRole.POUR, weight, np.zeros(3)) if feedforward else None
+            scene.set_joint_targets(ArmRole.POUR, arm.home_q, None, tau)
+            mujoco.mj_step(scene.model, scene.data)
+        mujoco.mj_forward(scene.model, scene.data)
+        return float(np.linalg.norm(scene.lip_position(ArmRole.POUR) - arm.home_pos - arm.vessel.lip_local))
+
+    without, with_ff = sag(False), sag(True)
+    assert without > 1e-3  # millimetres of sag from the servo stiffness alone
+    assert with_ff < 1e-6

@@ -211,6 +211,7 @@ class RobotScene:
         self.arms = {role: _arm_info(model, self.data, role, source) for role in ArmRole}
         self._ik: dict[ArmRole, ArmIK] = {}
         self._inverse_data: mujoco.MjData | None = None
+        self._jacobian_data: mujoco.MjData | None = None
 
     # ---- construction --------------------------------------------------------------------------------------------
     @classmethod
@@ -287,6 +288,25 @@ class RobotScene:
         d.qpos[arm.qpos_adr], d.qvel[arm.dof_adr], d.qacc[arm.dof_adr] = q, qd, qdd
         mujoco.mj_inverse(m, d)
         return d.qfrc_inverse[arm.dof_adr] - d.qfrc_gravcomp[arm.dof_adr]
+
+    def wrench_joint_torque(self, role: ArmRole, force: np.ndarray, torque: np.ndarray) -> np.ndarray:
+        """Joint torques (n,) N m that a wrench on the vessel exerts on the arm: ``J_p^T force + J_r^T torque``.
+
+        ``force`` (3,) N and ``torque`` (3,) N m act at the vessel's centre of mass, world frame (as
+        :meth:`apply_vessel_wrench`); the Jacobians are taken at the current joint positions on a private MjData.
+        Pass ``tau_ff = -wrench_joint_torque(...)`` to :meth:`set_joint_targets` to feed forward a known external
+        wrench (e.g. the liquid's reaction), as a controller that knows its payload would.
+        """
+        arm, m = self.arms[role], self.model
+        if self._jacobian_data is None:
+            self._jacobian_data = mujoco.MjData(m)
+        d = self._jacobian_data
+        d.qpos[:] = self.data.qpos
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+        mujoco.mj_jac(m, d, jacp, jacr, d.xipos[arm.vessel_body], arm.vessel_body)
+        return jacp[:, arm.dof_adr].T @ np.asarray(force, dtype=float) + jacr[:, arm.dof_adr].T @ np.asarray(torque, dtype=float)
 
     def vessel_state(self, role: ArmRole) -> VesselState:
         """The held vessel's pose, velocity and centre of mass, world frame (valid after mj_forward/mj_step)."""
