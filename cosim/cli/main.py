@@ -17,6 +17,7 @@ from cosim.errors import InputError, SimulationError
 # Subcommand modules, in the order `cosim --help` lists them.
 SUBCOMMAND_MODULES: list[str] = [
     "cosim.cli.validate",
+    "cosim.cli.replay",
 ]
 
 

@@ -1,0 +1,1 @@
+"""Input/output that observes the simulation: trajectory files, logs, summaries. Reads state, never changes it."""

@@ -1,0 +1,211 @@
+"""Configuration of a two-arm pour scene: which arm models, where they stand, which vessels they hold.
+
+Frozen dataclasses validated in ``__post_init__`` (messages name the field and the allowed range), closed choices
+as enums. Conventions: world z up, SI units, angles in rad. Pour plane = world x-z plane at y = 0; the pour
+direction is world +x. At home each vessel's frame is aligned with the world axes (+x toward its lip, +z up) and its
+origin (centre of the inner floor) is at ``vessel_home``.
+
+:func:`default_scene_config` is the project's scene (``models/scene.xml``): two UR10e-class arms on a table, the
+pour arm behind the pourer (at -x) holding it by the back wall, the catch arm beyond the catcher (at +x) holding it
+by the front wall; the catcher's rim lies :data:`CATCHER_RIM_BELOW_POURER_FLOOR` below the pourer's floor.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+
+from cosim.checks import check_choice, check_number, check_positive, check_vector
+from cosim.errors import InputError
+from cosim.robots.ur10e import UR10E_JOINTS, UR10E_MAX_JOINT_SPEED
+from cosim.vessel import VesselSpec, default_catching_vessel, seed_pouring_vessel
+
+
+class ArmRole(Enum):
+    """The two arms of a pour; the value is the arm's name prefix in the scene (``pour_arm/shoulder_pan``)."""
+
+    POUR = "pour_arm"
+    CATCH = "catch_arm"
+
+
+class MountSide(Enum):
+    """Which vessel wall the arm's flange holds: the flange's z axis points into that wall."""
+
+    BACK = "back"  # the -x wall: the arm reaches from behind (-x), the lip side stays free
+    FRONT = "front"  # the +x wall: the arm reaches from +x
+
+
+@dataclass(frozen=True)
+class ArmModel:
+    """An arm MJCF and how it maps onto the project's conventions.
+
+    mjcf: path of the arm's MJCF; a relative path is resolved against the project's models directory.
+    joints: the arm's joint names in that file, base to tip (n >= 6); each needs a position servo (an actuator
+        with ``biastype="affine"`` and bias -kp on the joint).
+    attachment_site: a site on the last link whose z axis points out of the tool flange; the vessel mount is built
+        on it.
+    max_joint_speed: rad/s per joint (n,), for trajectory generation (MuJoCo models have no speed limits).
+    """
+
+    mjcf: str
+    joints: tuple[str, ...]
+    attachment_site: str
+    max_joint_speed: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.mjcf, str) or not self.mjcf:
+            raise InputError(f"arm.mjcf: must be a path, got {self.mjcf!r}")
+        if len(self.joints) < 6 or not all(isinstance(j, str) and j for j in self.joints):
+            raise InputError(f"arm.joints: must name at least 6 joints, got {list(self.joints)}")
+        if len(set(self.joints)) != len(self.joints):
+            raise InputError(f"arm.joints: names must be unique, got {list(self.joints)}")
+        if not isinstance(self.attachment_site, str) or not self.attachment_site:
+            raise InputError(f"arm.attachment_site: must be a site name, got {self.attachment_site!r}")
+        speeds = check_vector("arm.max_joint_speed", self.max_joint_speed, len(self.joints))
+        for i, v in enumerate(speeds):
+            check_positive(f"arm.max_joint_speed[{i}]", v, "rad/s", 50.0)
+        object.__setattr__(self, "joints", tuple(self.joints))
+        object.__setattr__(self, "max_joint_speed", speeds)
+
+
+def ur10e_arm() -> ArmModel:
+    """The project's UR10e-class arm (``models/ur10e/ur10e.xml``)."""
+    return ArmModel("ur10e/ur10e.xml", UR10E_JOINTS, "flange", UR10E_MAX_JOINT_SPEED)
+
+
+@dataclass(frozen=True)
+class ArmPlacement:
+    """One arm in the scene and the vessel it holds.
+
+    role: :class:`ArmRole`.
+    arm: :class:`ArmModel`.
+    base_pos: (3,) m, world position of the arm's base frame.
+    base_yaw: rad, rotation of the base frame about world z. [-2 pi, 2 pi]
+    vessel: the held vessel's :class:`VesselSpec`.
+    vessel_home: (3,) m, world position of the vessel frame origin at home (y must be 0: the pour plane).
+    mount_side: :class:`MountSide`, the wall the flange holds.
+    home_seed: (n,) rad, the joint configuration the home posture is solved from (picks the IK branch).
+    """
+
+    role: ArmRole
+    arm: ArmModel
+    base_pos: tuple[float, float, float]
+    base_yaw: float
+    vessel: VesselSpec
+    vessel_home: tuple[float, float, float]
+    mount_side: MountSide
+    home_seed: tuple[float, ...]
+
+    def __post_init__(self) -> None:
+        p = f"{getattr(self.role, 'value', self.role)}"
+        object.__setattr__(self, "role", check_choice(f"{p}.role", self.role, ArmRole))
+        object.__setattr__(self, "mount_side", check_choice(f"{p}.mount_side", self.mount_side, MountSide))
+        object.__setattr__(self, "base_pos", check_vector(f"{p}.base_pos", self.base_pos, 3))
+        yaw = check_number(f"{p}.base_yaw", self.base_yaw)
+        if abs(yaw) > 2 * math.pi:
+            raise InputError(f"{p}.base_yaw: must be in [-6.28319, 6.28319] rad, got {yaw:g}")
+        object.__setattr__(self, "base_yaw", yaw)
+        home = check_vector(f"{p}.vessel_home", self.vessel_home, 3)
+        if abs(home[1]) > 1e-9:
+            raise InputError(f"{p}.vessel_home[1]: the vessel must start in the pour plane y = 0, got {home[1]:g} m")
+        object.__setattr__(self, "vessel_home", home)
+        object.__setattr__(self, "home_seed", check_vector(f"{p}.home_seed", self.home_seed, len(self.arm.joints)))
+        if not isinstance(self.vessel, VesselSpec):
+            raise InputError(f"{p}.vessel: must be a VesselSpec, got {type(self.vessel).__name__}")
+
+
+@dataclass(frozen=True)
+class TableSpec:
+    """The table the arms stand on: a box. top: m, height of the top surface; centre_xy, half_size (3,) m."""
+
+    top: float = 0.75
+    centre_xy: tuple[float, float] = (0.15, 0.0)
+    half_size: tuple[float, float, float] = (1.2, 0.6, 0.375)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "top", check_positive("table.top", self.top, "m", 3.0))
+        object.__setattr__(self, "centre_xy", check_vector("table.centre_xy", self.centre_xy, 2))
+        half = check_vector("table.half_size", self.half_size, 3)
+        for i, v in enumerate(half):
+            check_positive(f"table.half_size[{i}]", v, "m", 10.0)
+        object.__setattr__(self, "half_size", half)
+
+
+@dataclass(frozen=True)
+class MountSpec:
+    """The adapter plate between the tool flange and the vessel wall (aluminium, square).
+
+    thickness: m, along the flange axis. (0, 0.05]; half_width: m. (0, 0.2]; density: kg/m^3. (0, 25000]
+    """
+
+    thickness: float = 0.01
+    half_width: float = 0.04
+    density: float = 2700.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "thickness", check_positive("mount.thickness", self.thickness, "m", 0.05))
+        object.__setattr__(self, "half_width", check_positive("mount.half_width", self.half_width, "m", 0.2))
+        object.__setattr__(self, "density", check_positive("mount.density", self.density, "kg/m^3", 25000.0))
+
+
+@dataclass(frozen=True)
+class SceneConfig:
+    """The whole scene: both arm placements, the table, the vessel mount."""
+
+    pour: ArmPlacement
+    catch: ArmPlacement
+    table: TableSpec = field(default_factory=TableSpec)
+    mount: MountSpec = field(default_factory=MountSpec)
+
+    def __post_init__(self) -> None:
+        if self.pour.role is not ArmRole.POUR:
+            raise InputError(f"scene.pour.role: must be {ArmRole.POUR.value!r}, got {self.pour.role.value!r}")
+        if self.catch.role is not ArmRole.CATCH:
+            raise InputError(f"scene.catch.role: must be {ArmRole.CATCH.value!r}, got {self.catch.role.value!r}")
+        if self.pour.vessel.name == self.catch.vessel.name:
+            raise InputError(f"scene: the two vessels need different names, both are {self.pour.vessel.name!r}")
+
+    @property
+    def placements(self) -> tuple[ArmPlacement, ArmPlacement]:
+        return (self.pour, self.catch)
+
+
+# ---- the project's default layout ----------------------------------------------------------------------------------
+# Height of the pourer's inner floor at home, m (table top at 0.75 m).
+POURER_FLOOR_HEIGHT = 1.25
+# The catcher's rim sits this far below the pourer's floor, m. Tilting the pourer 120 deg about its bottom middle
+# brings its lip 0.183 m below the floor (lip_local rotated by R_y(120 deg)); 0.21 m keeps 27 mm of clearance, so
+# the pourer can tilt 0-120 deg about either pivot above the catcher. The lip-to-rim fall at home is then
+# 0.191 + 0.21 = 0.40 m; a controller lowers the pourer (dz < 0) to shorten it.
+CATCHER_RIM_BELOW_POURER_FLOOR = 0.21
+# Catcher centre at home, m along +x from the pourer's centre: under the lip (0.1005 m) plus the stream's throw.
+CATCHER_HOME_X = 0.20
+
+
+def default_scene_config() -> SceneConfig:
+    """The project's scene: UR10e-class arms, the seed's pouring vessel and the default catching vessel."""
+    pourer, catcher = seed_pouring_vessel(), default_catching_vessel()
+    catcher_floor = POURER_FLOOR_HEIGHT - CATCHER_RIM_BELOW_POURER_FLOOR - catcher.inner_height
+    return SceneConfig(
+        pour=ArmPlacement(
+            role=ArmRole.POUR,
+            arm=ur10e_arm(),
+            base_pos=(-0.62, -0.17415, 0.75),
+            base_yaw=math.pi,
+            vessel=pourer,
+            vessel_home=(0.0, 0.0, POURER_FLOOR_HEIGHT),
+            mount_side=MountSide.BACK,
+            home_seed=(0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0),
+        ),
+        catch=ArmPlacement(
+            role=ArmRole.CATCH,
+            arm=ur10e_arm(),
+            base_pos=(0.95, 0.17415, 0.75),
+            base_yaw=0.0,
+            vessel=catcher,
+            vessel_home=(CATCHER_HOME_X, 0.0, catcher_floor),
+            mount_side=MountSide.FRONT,
+            home_seed=(0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0),
+        ),
+    )

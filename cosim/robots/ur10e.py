@@ -1,0 +1,57 @@
+"""Published UR10e data: DH parameters, joint limits, joint speeds, payload; the analytic DH forward kinematics.
+
+Sources (Universal Robots):
+* "DH parameters for calculations of kinematics and dynamics" (universal-robots.com support article; UR10e rows):
+  d1 = 0.1807, a2 = -0.6127, a3 = -0.57155, d4 = 0.17415, d5 = 0.11985, d6 = 0.11655 m,
+  alpha = (pi/2, 0, 0, pi/2, -pi/2, 0), theta offsets 0.
+* UR10e data sheet / user manual: payload 12.5 kg, reach 1300 mm, working range +-360 deg on all joints, maximum
+  joint speed 120 deg/s (base, shoulder) and 180 deg/s (elbow, wrist 1-3).
+
+``models/ur10e/ur10e.xml`` is written from these numbers; ``tests/test_robot_kinematics.py`` checks that its forward
+kinematics equals :func:`dh_forward_kinematics` (no MuJoCo here: numpy only).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+# UR joint names, base to flange, as used in models/ur10e/ur10e.xml (joints and actuators).
+UR10E_JOINTS: tuple[str, ...] = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
+
+# Standard DH parameters (m, rad), UR10e rows of Universal Robots' DH table.
+UR10E_DH_D: tuple[float, ...] = (0.1807, 0.0, 0.0, 0.17415, 0.11985, 0.11655)
+UR10E_DH_A: tuple[float, ...] = (0.0, -0.6127, -0.57155, 0.0, 0.0, 0.0)
+UR10E_DH_ALPHA: tuple[float, ...] = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.pi / 2, 0.0)
+
+# Data sheet: working range +-360 deg on every joint (rad).
+UR10E_JOINT_RANGE: tuple[float, float] = (-2.0 * math.pi, 2.0 * math.pi)
+# Data sheet: maximum joint speed, rad/s (120 deg/s base and shoulder, 180 deg/s elbow and wrists).
+UR10E_MAX_JOINT_SPEED: tuple[float, ...] = tuple(math.radians(v) for v in (120.0, 120.0, 180.0, 180.0, 180.0, 180.0))
+# Data sheet: rated payload, kg.
+UR10E_PAYLOAD_KG = 12.5
+
+
+def dh_forward_kinematics(q: np.ndarray) -> np.ndarray:
+    """Flange pose (4x4 homogeneous transform, m) in the arm's base frame for joint angles ``q`` (6,), rad.
+
+    Standard DH: ``T = prod_i Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``; the result is DH frame 6 (tool flange, z out of
+    the flange).
+    """
+    q = np.asarray(q, dtype=float)
+    if q.shape != (6,):
+        raise ValueError(f"q must have shape (6,), got {q.shape}")
+    transform = np.eye(4)
+    for theta, d, a, alpha in zip(q, UR10E_DH_D, UR10E_DH_A, UR10E_DH_ALPHA):
+        ct, st, ca, sa = math.cos(theta), math.sin(theta), math.cos(alpha), math.sin(alpha)
+        link = np.array(
+            [
+                [ct, -st * ca, st * sa, a * ct],
+                [st, ct * ca, -ct * sa, a * st],
+                [0.0, sa, ca, d],
+                [0.0, 0.0, 0.0, 1.0],
+            ]
+        )
+        transform = transform @ link
+    return transform
