@@ -79,3 +79,10 @@ def check_vector(field: str, value: object, length: int) -> tuple[float, ...]:
     if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != length:  # type: ignore[arg-type]
         raise InputError(f"{field}: must be a list of {length} numbers, got {_fmt(value)}")
     return tuple(check_number(f"{field}[{i}]", x) for i, x in enumerate(value))  # type: ignore[union-attr]
+
+
+def check_device(field: str, value: object) -> str:
+    """A warp device name: 'cpu', 'cuda' or 'cuda:N' (availability is checked when the device is opened)."""
+    if isinstance(value, str) and (value in ("cpu", "cuda") or (value.startswith("cuda:") and value[5:].isdigit())):
+        return value
+    raise InputError(f"{field}: must be 'cpu', 'cuda' or 'cuda:N', got {_fmt(value)}")

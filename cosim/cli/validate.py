@@ -70,7 +70,7 @@ def run(args) -> int:
     unknown = [n for n in names if n not in CASES]
     if unknown:
         raise InputError(f"case {unknown[0]!r}: unknown; choose from {', '.join(CASES)}")
-    jobs = [(name, params) for name in names for params in _case_params(name, args)]
+    jobs = [(name, params) for name in names for params in _case_params(name, args)]  # validates every input first
     results = []
     for name, params in jobs:
         print(f"running {name} ({', '.join(f'{k}={v}' for k, v in vars(params).items() if v is not None)}) ...", file=sys.stderr)

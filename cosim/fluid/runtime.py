@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import os
+import sys
+import tempfile
 
 import warp as wp
 
@@ -22,8 +24,27 @@ def init_warp() -> None:
     cache = os.environ.get("WARP_CACHE_PATH")
     if cache:
         wp.config.kernel_cache_dir = cache
-    wp.init()
+    _init_without_driver_warning()
     _initialised = True
+
+
+def _init_without_driver_warning() -> None:
+    """``wp.init()``, minus the native library's warning that no CUDA driver exists (expected on CPU machines);
+    anything else it writes to stderr is passed through."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as captured:
+        os.dup2(captured.fileno(), 2)
+        try:
+            wp.init()
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+        captured.seek(0)
+        text = captured.read().decode(errors="replace")
+    for line in text.splitlines():
+        if "Could not find or load the NVIDIA CUDA driver" not in line:
+            print(line, file=sys.stderr)
 
 
 def resolve_device(name: str) -> wp.Device:

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from cosim.checks import check_int, check_positive
+from cosim.checks import check_device, check_int, check_positive
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig
 
@@ -68,6 +68,7 @@ class FluidCaseParams:
         if self.spacing is not None:
             check_positive("spacing", self.spacing, "m", 0.05)
         check_int("dim", self.dim, 2, 3)
+        check_device("device", self.device)
         check_positive("depth", self.depth, "m", 2.0)
 
 

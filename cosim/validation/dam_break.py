@@ -79,7 +79,7 @@ class Params(FluidCaseParams):
 
 def run(p: Params) -> CaseResult:
     a, dx = p.width, p.resolved_spacing
-    require_particles_across("spacing", a, dx, 10)
+    require_particles_across("spacing", a, dx, 8)
     length = TANK_LENGTH * a
     tank = VesselSpec(name="tank", inner_width=length, inner_depth=p.depth, inner_height=2.0 * p.height)
     wall = -0.5 * length

@@ -1,0 +1,1 @@
+"""Helpers for the tests (warp kernels must live in real .py files)."""

@@ -1,0 +1,43 @@
+"""`cosim validate` contract: JSON fields for outside checks, table output, bad input exits 2."""
+
+import json
+
+import pytest
+
+from cosim.cli.main import main
+
+
+def test_json_contract_of_each_case(capsys, tmp_path):
+    rc = main(["validate", "hydrostatic", "slosh", "dam-break", "--spacing", "0.0125", "--fill", "0.06", "--width", "0.1",
+               "--json", "--out", str(tmp_path)])
+    assert rc == 0
+    doc = json.loads(capsys.readouterr().out)
+    cases = {c["case"]: c for c in doc["cases"]}
+    assert set(cases) == {"hydrostatic", "slosh", "dam-break"}
+    hydro = cases["hydrostatic"]
+    assert len(hydro["z"]) == len(hydro["pressure"]) > 0 and isinstance(hydro["leaked"], int)
+    assert all(z > 0 for z in hydro["z"]) and all(p > 0 for p in hydro["pressure"])
+    assert cases["slosh"]["frequency_hz"] > 0
+    dam = cases["dam-break"]
+    assert dam["a"] == pytest.approx(0.1)
+    assert len(dam["t"]) == len(dam["front"]) > 10
+    assert dam["front"][0] == pytest.approx(0.1, rel=0.01)  # the column's own width at release
+    assert dam["front"][-1] > 2 * dam["front"][0]
+    for case in doc["cases"]:
+        assert {"passed", "wall_time_s", "parameters", "metrics"} <= set(case)
+        assert case["parameters"]["spacing"] == pytest.approx(0.0125)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dam-break-2d.png", "hydrostatic-2d.png", "slosh-A0.060-2d.png"]
+
+
+def test_table_output(capsys, tmp_path):
+    assert main(["validate", "hydrostatic", "--spacing", "0.0125", "--width", "0.1", "--fill", "0.05", "--no-plot"]) == 0
+    out = capsys.readouterr().out
+    assert "pressure (worst probe)" in out and "vertical reaction" in out
+
+
+@pytest.mark.parametrize("argv", [["validate", "nope"], ["validate", "slosh", "--width", "-1"], ["validate", "--spacing", "nan"],
+                                  ["validate", "hydrostatic", "--device", "tpu"]])
+def test_bad_input_exits_2_with_one_line(argv, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("cosim validate: error:")

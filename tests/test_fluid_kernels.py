@@ -1,0 +1,98 @@
+"""SPH kernels: normalisation and gradient consistency (2-D and 3-D), and the wall guard's geometry."""
+
+import math
+
+import numpy as np
+import pytest
+import warp as wp
+
+from cosim.fluid.boundary import SHAPE_BOX, SHAPE_CYLINDER, VesselGeometry
+from cosim.fluid.config import KernelType
+from cosim.fluid.runtime import init_warp
+from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma
+from tests.support.fluid_probes import apply_guard, evaluate_kernel
+
+# Quadrature of smooth radial functions on 4000 points: errors well below 1e-4 (trapezoid rule, float32 kernel).
+NORMALISATION_TOLERANCE = 1e-4
+
+init_warp()
+
+
+def _radial(kernel: KernelType, dim: int, h: float = 0.01, n: int = 4000):
+    r = np.linspace(0.0, 2.0 * h, n)
+    w = wp.zeros(n, dtype=float)
+    dw = wp.zeros(n, dtype=float)
+    sigma = kernel_sigma(kernel, h, dim)
+    wp.launch(evaluate_kernel, n, inputs=[wp.array(r.astype(np.float32), dtype=float), 1.0 / h, sigma, KERNEL_IDS[kernel], w, dw])
+    return r, w.numpy().astype(float), dw.numpy().astype(float)
+
+
+@pytest.mark.parametrize("kernel", list(KernelType))
+@pytest.mark.parametrize("dim", [2, 3])
+def test_kernel_integrates_to_one(kernel, dim):
+    r, w, _ = _radial(kernel, dim)
+    shell = 2 * math.pi * r if dim == 2 else 4 * math.pi * r**2
+    assert abs(np.trapezoid(w * shell, r) - 1.0) < NORMALISATION_TOLERANCE
+
+
+@pytest.mark.parametrize("kernel", list(KernelType))
+@pytest.mark.parametrize("dim", [2, 3])
+def test_gradient_first_moment_is_minus_identity(kernel, dim):
+    # integral of (x_j - x_i) (x) grad_i W dV = -I: the continuous consistency of the SPH gradient.
+    # For a radial kernel each diagonal entry is -(1/dim) integral r dW/dr dV.
+    r, _, dw = _radial(kernel, dim)
+    shell = 2 * math.pi * r if dim == 2 else 4 * math.pi * r**2
+    diag = -np.trapezoid(r * dw * shell, r) / dim
+    assert abs(diag - 1.0) < NORMALISATION_TOLERANCE
+
+
+@pytest.mark.parametrize("kernel", list(KernelType))
+def test_kernel_has_compact_support_and_decreases(kernel):
+    r, w, dw = _radial(kernel, 2)
+    assert w[-1] == 0.0 and dw[-1] == 0.0
+    assert np.all(np.diff(w) <= 1e-6 * w.max())
+    assert np.all(dw <= 0.0)
+
+
+def _box(shape=SHAPE_BOX):
+    g = VesselGeometry()
+    g.shape, g.half_width, g.half_depth, g.height, g.thickness = shape, 0.1, 0.05, 0.2, 0.01
+    g.com = wp.vec3(0.0, 0.0, 0.05)
+    return g
+
+
+def _guard(geo, dim, q_old, q_new, margin=1e-4):
+    n = len(q_old)
+    outs = [wp.zeros(n, dtype=wp.vec3), wp.zeros(n, dtype=wp.vec3), wp.zeros(n, dtype=float), wp.zeros(n, dtype=int)]
+    wp.launch(apply_guard, n, inputs=[geo, dim, margin, wp.array(np.array(q_old, np.float32), dtype=wp.vec3),
+                                      wp.array(np.array(q_new, np.float32), dtype=wp.vec3), *outs])
+    return [o.numpy() for o in outs]
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_guard_stops_a_particle_tunnelling_through_a_thin_wall(dim):
+    # from inside (x = 0.095) to beyond the +x wall (x = 0.13) in one step: put back just inside the inner face
+    q, n, depth, hits = _guard(_box(), dim, [(0.095, 0.0, 0.1)], [(0.13, 0.0, 0.1)])
+    assert hits[0] >= 1
+    assert q[0][0] == pytest.approx(0.1 - 1e-4, abs=1e-6)
+    np.testing.assert_allclose(n[0], [-1.0, 0.0, 0.0])
+    assert depth[0] == pytest.approx(0.03, abs=1e-6)
+
+
+def test_guard_leaves_free_paths_alone():
+    paths = [
+        ((0.0, 0.0, 0.1), (0.01, 0.0, 0.11)),  # inside, moving freely
+        ((0.105, 0.0, 0.21), (0.13, 0.0, 0.205)),  # over the rim, outside
+        ((0.3, 0.0, 0.1), (0.31, 0.0, 0.0)),  # far outside
+    ]
+    q, _, _, hits = _guard(_box(), 3, [p[0] for p in paths], [p[1] for p in paths])
+    assert list(hits) == [0, 0, 0]
+    np.testing.assert_allclose(q, [p[1] for p in paths], atol=1e-7)
+
+
+def test_guard_pushes_a_particle_out_of_the_floor_and_a_cylinder_wall():
+    q, n, _, hits = _guard(_box(), 3, [(0.0, 0.0, 0.002)], [(0.0, 0.0, -0.004)])
+    assert hits[0] == 1 and q[0][2] > 0.0 and n[0][2] == 1.0
+    cyl = _box(SHAPE_CYLINDER)
+    q, n, _, hits = _guard(cyl, 3, [(0.0, 0.097, 0.1)], [(0.0, 0.104, 0.1)])
+    assert hits[0] == 1 and q[0][1] < 0.1 and n[0][1] == pytest.approx(-1.0)
