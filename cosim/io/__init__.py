@@ -1,0 +1,2 @@
+"""Input/output that observes a run and never changes it: the Rerun recording (``recording``), its geometry,
+blueprint and read-back helpers (``rerun_*``), trajectory export/import and summaries."""
