@@ -16,6 +16,7 @@ from cosim.errors import InputError, SimulationError
 
 # Subcommand modules, in the order `cosim --help` lists them.
 SUBCOMMAND_MODULES: list[str] = [
+    "cosim.cli.view",
 ]
 
 
