@@ -18,6 +18,7 @@ from cosim.errors import InputError, SimulationError
 SUBCOMMAND_MODULES: list[str] = [
     "cosim.cli.validate",
     "cosim.cli.replay",
+    "cosim.cli.view",
 ]
 
 

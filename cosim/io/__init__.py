@@ -1,1 +1,2 @@
-"""Input/output that observes the simulation: trajectory files, logs, summaries. Reads state, never changes it."""
+"""Input/output that observes a run and never changes it: the Rerun recording (``recording``), its geometry,
+blueprint and read-back helpers (``rerun_*``), trajectory files (``trajectory_csv``) and summaries."""
