@@ -11,6 +11,7 @@ access coherent (measured in docs/benchmarks.md).
 from __future__ import annotations
 
 import math
+from typing import Callable
 
 import numpy as np
 import warp as wp
@@ -112,20 +113,28 @@ class CellGrid:
         self.cell_start = wp.zeros(self.n_cells, dtype=wp.int32, device=device)
         self.cell_end = wp.zeros(self.n_cells, dtype=wp.int32, device=device)
 
-    def build(self, x: wp.array, active: wp.array, n: int) -> None:
-        """Sort the first ``n`` points by cell and record the cell ranges."""
+    @property
+    def key_bits(self) -> int:
+        """Bits the sort keys need (cell indices and the n_cells sentinel): the radix sort does no more passes."""
+        return max(1, self.n_cells.bit_length())
+
+    def build_commands(self, x: wp.array, active: wp.array, n: int) -> list[Callable[[], None]]:
+        """The operations that sort the first ``n`` points of ``x`` by cell and record the cell ranges, with their
+        arguments bound once (recorded launches), to be run in order every build."""
         if n == 0:
-            self.cell_start.zero_()
-            self.cell_end.zero_()
-            return
-        wp.launch(compute_cell_keys, dim=n, inputs=[self.spec, x, active], outputs=[self.keys, self.order], device=self.device)
-        wp.utils.radix_sort_pairs(self.keys, self.order, n)
-        self.cell_start.zero_()
-        self.cell_end.zero_()
-        wp.launch(
-            find_cell_ranges,
-            dim=n,
-            inputs=[n, self.n_cells, self.keys],
-            outputs=[self.cell_start, self.cell_end],
-            device=self.device,
+            return [self.cell_start.zero_, self.cell_end.zero_]
+        keys = wp.launch(compute_cell_keys, dim=n, inputs=[self.spec, x, active], outputs=[self.keys, self.order], device=self.device, record_cmd=True)
+        ranges = wp.launch(
+            find_cell_ranges, dim=n, inputs=[n, self.n_cells, self.keys], outputs=[self.cell_start, self.cell_end], device=self.device, record_cmd=True
         )
+        bits = self.key_bits
+
+        def sort() -> None:
+            wp.utils.radix_sort_pairs(self.keys, self.order, n, 0, bits)
+
+        return [keys.launch, sort, self.cell_start.zero_, self.cell_end.zero_, ranges.launch]
+
+    def build(self, x: wp.array, active: wp.array, n: int) -> None:
+        """Sort the first ``n`` points by cell and record the cell ranges (one-off; loops use build_commands)."""
+        for op in self.build_commands(x, active, n):
+            op()

@@ -138,17 +138,20 @@ class FluidSolver:
         self._row = wp.zeros(1, dtype=wp.int32, device=d)
         self._rows_capacity = 0
         self._ensure_rows(64)
+        self._parity = 0
         zero = np.zeros((m.n_vessels, 3))
         self._lin_vel, self._ang_vel = zero, zero
         self._upload_motions(zero, zero, zero, zero)
         self._wrench = np.zeros((m.n_vessels, 6))
 
     def _ensure_rows(self, n: int) -> None:
+        """Room for ``n`` substeps of diagnostics (the recorded operations are rebuilt when the rows grow)."""
         if n <= self._rows_capacity:
             return
         self._rows_capacity = max(n, 2 * self._rows_capacity)
         self._diag_f = wp.zeros((self._rows_capacity, N_DIAG_FLOAT), dtype=float, device=self.device)
         self._diag_i = wp.zeros((self._rows_capacity, N_DIAG_INT_BASE + self.model.n_vessels), dtype=wp.int32, device=self.device)
+        self._ops = None
 
     def _upload_motions(self, lin_vel: np.ndarray, ang_vel: np.ndarray, lin_acc: np.ndarray, ang_acc: np.ndarray) -> None:
         motions = []
@@ -163,8 +166,8 @@ class FluidSolver:
             mo.p_now = mo.p_next = mo.p0
             mo.r_now = mo.r_next = mo.r0
             motions.append(mo)
-        if motions:
-            self._motions = wp.array(motions, dtype=bd.VesselMotion, device=self.device)
+        if motions:  # copied into the existing array: the recorded launches hold it
+            wp.copy(self._motions, wp.array(motions, dtype=bd.VesselMotion, device="cpu"))
 
     # ---- driving ---------------------------------------------------------------------------------------------
     def set_vessel_poses(self, poses: Sequence[Pose]) -> None:
@@ -201,6 +204,9 @@ class FluidSolver:
         self._upload_motions(lin, ang, (lin - self._lin_vel) / duration, (ang - self._ang_vel) / duration)
         self._lin_vel, self._ang_vel = lin, ang
         self._ensure_rows(n_sub)
+        if self._ops is None:
+            even, odd = (self.state, self._spare) if self._parity == 0 else (self._spare, self.state)
+            self._ops = (self._substep_commands(even, odd), self._substep_commands(odd, even))
         self._dt.fill_(dt)
         self._row.zero_()
         self._diag_f.zero_()
@@ -226,70 +232,71 @@ class FluidSolver:
         self._last_report = IntervalReport(n_sub, dt, last)
         return self._last_report
 
-    def _substep(self) -> None:
-        m, d, prm = self.model, self.device, self.model.params
-        cfg = self.config
-        s = self.state
-        # move_vessels; place_wall_particles
-        if m.n_vessels:
-            wp.launch(bd.advance_vessel_poses, dim=m.n_vessels, inputs=[self._row, self._dt], outputs=[self._motions], device=d)
-            wp.launch(bd.place_wall_particles, dim=m.n_boundary, inputs=[m.b_local, m.b_vessel, self._motions], outputs=[self._bx, self._bv], device=d)
-        # find_neighbors (wall samples by indirection, particles reordered into cell order)
-        m.b_grid.build(self._bx, self._b_active, m.n_boundary)
-        m.grid.build(s.x, s.active, self.n_particles)
-        wp.launch(wcsph.gather_particles, dim=self.n_particles, inputs=[m.grid.order, *s.arrays()], outputs=self._spare.arrays(), device=d)
-        self.state, self._spare = self._spare, self.state
-        s = self.state
-        # extrapolate_wall_state (pressure, density, no-slip velocity of the dummy wall particles)
-        if m.n_boundary:
-            wp.launch(
-                bd.extrapolate_wall_state,
-                dim=m.n_boundary,
-                inputs=[prm, m.grid.spec, m.b_vessel, self._motions, self._bx, self._bv, s.x, s.v, s.rho, s.p, m.grid.cell_start, m.grid.cell_end],
-                outputs=[self._b_p, self._b_rho, self._b_v_noslip],
-                device=d,
-            )
-        # compute_forces
-        wp.launch(
-            wcsph.compute_forces,
-            dim=self.n_particles,
-            inputs=[
+    def _substep_commands(self, src: FluidState, dst: FluidState) -> list:
+        """The substep as a list of operations with bound arguments (recorded launches: no per-call argument
+        packing), for the particle state ``src``, which is reordered into ``dst`` and advanced there.
+
+        Stages: move_vessels; place_wall_particles; find_neighbors (wall particles by indirection, liquid
+        reordered into cell order); extrapolate_wall_state; compute_forces; compute_density_rate; integrate (+ wall
+        guard, deactivation, diagnostics); reduce_wrenches (fixed order); next_substep."""
+        m, d, prm, cfg = self.model, self.device, self.model.params, self.config
+        n, nb, nv = self.n_particles, m.n_boundary, m.n_vessels
+
+        def rec(kernel, dim, inputs, outputs=()):
+            return wp.launch(kernel, dim=dim, inputs=inputs, outputs=list(outputs), device=d, record_cmd=True).launch
+
+        ops = []
+        if nv:
+            ops.append(rec(bd.advance_vessel_poses, nv, [self._row, self._dt], [self._motions]))
+            ops.append(rec(bd.place_wall_particles, nb, [m.b_local, m.b_vessel, self._motions], [self._bx, self._bv]))
+        ops += m.b_grid.build_commands(self._bx, self._b_active, nb)
+        ops += m.grid.build_commands(src.x, src.active, n)
+        ops.append(rec(wcsph.gather_particles, n, [m.grid.order, *src.arrays()], dst.arrays()))
+        if nb:
+            ops.append(rec(
+                bd.extrapolate_wall_state, nb,
+                [prm, m.grid.spec, m.b_vessel, self._motions, self._bx, self._bv, dst.x, dst.v, dst.rho, dst.p, m.grid.cell_start, m.grid.cell_end],
+                [self._b_p, self._b_rho, self._b_v_noslip],
+            ))
+        ops.append(rec(
+            wcsph.compute_forces, n,
+            [
                 prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel,
-                self._motions, s.x, s.v, s.rho, s.p, s.active, m.grid.cell_start, m.grid.cell_end,
+                self._motions, dst.x, dst.v, dst.rho, dst.p, dst.active, m.grid.cell_start, m.grid.cell_end,
                 self._bx, self._bv, self._b_p, self._b_rho, self._b_v_noslip,
                 m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, self._row,
             ],
-            outputs=[self._acc, self._wall_force, self._wall_torque, self._diag_f],
-            device=d,
-        )
-        # compute_density_rate (with the kicked velocities)
-        wp.launch(
-            wcsph.compute_density_rate,
-            dim=self.n_particles,
-            inputs=[
-                prm, m.grid.spec, m.b_volume, s.x, s.v, self._acc, s.rho, s.active, self._dt,
+            [self._acc, self._wall_force, self._wall_torque, self._diag_f],
+        ))
+        ops.append(rec(
+            wcsph.compute_density_rate, n,
+            [
+                prm, m.grid.spec, m.b_volume, dst.x, dst.v, self._acc, dst.rho, dst.active, self._dt,
                 m.grid.cell_start, m.grid.cell_end, self._bx, self._bv, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end,
             ],
-            outputs=[self._drho],
-            device=d,
-        )
-        # integrate (+ wall guard, deactivation, diagnostics)
-        wp.launch(
-            wcsph.integrate,
-            dim=self.n_particles,
-            inputs=[
+            [self._drho],
+        ))
+        ops.append(rec(
+            wcsph.integrate, n,
+            [
                 prm, m.vessels, wp.vec3(*cfg.domain_min), wp.vec3(*cfg.domain_max), GUARD_MARGIN * cfg.spacing,
                 cfg.max_wall_penetration * cfg.spacing, self._motions, self._dt, self._row, self._drho, self._acc,
             ],
-            outputs=[s.x, s.v, s.rho, s.p, s.active, self._diag_f, self._diag_i],
-            device=d,
-        )
-        # reduce_wrenches (fixed order)
-        if m.n_vessels:
-            chunk = math.ceil(self.n_particles / WRENCH_CHUNKS)
-            wp.launch(wcsph.sum_wall_wrench_chunks, dim=(m.n_vessels, WRENCH_CHUNKS), inputs=[self.n_particles, chunk, self._wall_force, self._wall_torque], outputs=[self._partial_force, self._partial_torque], device=d)
-            wp.launch(wcsph.accumulate_wall_wrench, dim=m.n_vessels, inputs=[WRENCH_CHUNKS, self._partial_force, self._partial_torque], outputs=[self._force_sum, self._torque_sum], device=d)
-        wp.launch(wcsph.next_substep, dim=1, inputs=[self._row], device=d)
+            [dst.x, dst.v, dst.rho, dst.p, dst.active, self._diag_f, self._diag_i],
+        ))
+        if nv:
+            chunk = math.ceil(n / WRENCH_CHUNKS)
+            ops.append(rec(wcsph.sum_wall_wrench_chunks, (nv, WRENCH_CHUNKS), [n, chunk, self._wall_force, self._wall_torque], [self._partial_force, self._partial_torque]))
+            ops.append(rec(wcsph.accumulate_wall_wrench, nv, [WRENCH_CHUNKS, self._partial_force, self._partial_torque], [self._force_sum, self._torque_sum]))
+        ops.append(rec(wcsph.next_substep, 1, [self._row]))
+        return ops
+
+    def _substep(self) -> None:
+        """One substep: run the recorded operations of the current parity, then swap the particle buffers."""
+        for op in self._ops[self._parity]:
+            op()
+        self._parity ^= 1
+        self.state, self._spare = self._spare, self.state
 
     def _check(self, first: int, t0: float, dt: float, rows_f: np.ndarray, rows_i: np.ndarray) -> None:
         cfg = self.config

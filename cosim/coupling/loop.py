@@ -1,0 +1,229 @@
+"""The co-simulation step loop: MuJoCo arms holding the vessels, the SPH liquid in them, the pour controller.
+
+Exchange order of one MuJoCo step n (t_n -> t_n+1 = t_n + dt, dt = the model's timestep, 2 ms, implicitfast):
+
+  1. every control period (10 ms): measure the liquid at t_n -> controller -> vessel targets -> IK -> the arms'
+     trajectory generators get new joint targets;
+  2. each arm's generator advances one dt -> desired q, qd for the servos (plus, with two-way coupling and
+     feedforward, -J^T w of the liquid wrench measured over the previous interval);
+  3. two-way: the liquid's wrench on each vessel averaged over [t_n-1, t_n] goes into ``xfrc_applied``;
+  4. ``mj_step``: the arms and vessels move to t_n+1;
+  5. the vessel poses at t_n+1 go to the fluid, which moves the walls from their t_n poses to them at constant
+     velocity over as many substeps as its CFL step needs; the wrench averaged over those substeps is kept for
+     step n+1 (explicit staggered coupling).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Protocol
+
+import mujoco
+import numpy as np
+
+from controllers.config import CatcherConfig, PourConfig
+from controllers.geometry import VesselGeometry
+from controllers.measurement import PourCommand
+from controllers.pour import PourController
+from cosim.coupling.exchange import ROLES, vessel_poses, wrench_at_body_com
+from cosim.coupling.measure import MeasurementGeometry, measure
+from cosim.coupling.settings import Coupling, CouplingSettings
+from cosim.fluid.config import FluidConfig
+from cosim.fluid.seeding import fill_vessel
+from cosim.fluid.solver import FluidSolver
+from cosim.robots.planar import PlanarPose
+from cosim.robots.scene import RobotScene
+from cosim.robots.scene_config import ArmRole
+
+CATCHER_TRAVEL = 0.15  # m each way along x: the catcher workspace the robot scene's IK is verified over
+
+
+class JointTrajectoryGenerator(Protocol):
+    """Per-arm joint trajectory generator stepped at the MuJoCo rate."""
+
+    def set_target(self, q: np.ndarray, qd: np.ndarray | None = None) -> None: ...
+
+    def step(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+
+@dataclass
+class PourLog:
+    """Per control step records (lists, turned into arrays by :meth:`arrays`)."""
+
+    rows: dict[str, list] = field(default_factory=dict)
+
+    def append(self, **values) -> None:
+        for k, v in values.items():
+            self.rows.setdefault(k, []).append(v)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {k: np.asarray(v) for k, v in self.rows.items()}
+
+
+class CoupledPour:
+    """One pour: build with :func:`build_pour`, then :meth:`run` (or :meth:`step` repeatedly)."""
+
+    def __init__(
+        self,
+        scene: RobotScene,
+        fluid: FluidSolver,
+        controller: PourController,
+        generators: dict[ArmRole, JointTrajectoryGenerator],
+        geometry: MeasurementGeometry,
+        settings: CouplingSettings,
+    ):
+        self.scene, self.fluid, self.controller = scene, fluid, controller
+        self.generators = generators
+        self.geometry = geometry
+        self.settings = settings
+        self.dt = float(scene.model.opt.timestep)
+        self.control_every = max(1, round(controller.dt / self.dt))
+        self.steps = 0
+        self.time = 0.0
+        self.wrench = np.zeros((2, 6))
+        self.command: PourCommand | None = None
+        self.done_at: float | None = None
+        self.log = PourLog()
+        self.wall_time = 0.0
+        self._seed = {role: scene.joint_positions(role) for role in ROLES}
+
+    # ---- one MuJoCo step -----------------------------------------------------------------------------------------
+    def step(self) -> None:
+        start = time.perf_counter()
+        scene = self.scene
+        if self.steps % self.control_every == 0:
+            self._control()
+        two_way = self.settings.coupling is Coupling.TWO_WAY
+        poses = self.fluid.vessel_poses()
+        for k, role in enumerate(ROLES):
+            q, qd, _ = self.generators[role].step()
+            force, torque = wrench_at_body_com(scene, role, poses[k], self.wrench[k])
+            tau_ff = -scene.wrench_joint_torque(role, force, torque) if two_way and self.settings.wrench_feedforward else None
+            scene.set_joint_targets(role, q, qd, tau_ff)
+            if two_way:
+                scene.apply_vessel_wrench(role, force, torque)
+        mujoco.mj_step(scene.model, scene.data)
+        self.fluid.set_vessel_poses(vessel_poses(scene))
+        self.fluid.advance(self.dt)
+        self.wrench = self.fluid.vessel_wrenches()
+        self.steps += 1
+        self.time = self.steps * self.dt
+        if self.command is not None and self.command.done and self.done_at is None:
+            self.done_at = self.time
+        self.wall_time += time.perf_counter() - start
+
+    def _control(self) -> None:
+        fluid, scene = self.fluid, self.scene
+        poses = fluid.vessel_poses()
+        last = fluid.last_report.last if fluid.last_report else None
+        in_pourer = last.volume_in_vessel[0] if last else self.geometry.initial_volume
+        m = measure(self.time, self.geometry, poses[0], poses[1], fluid.positions(), fluid.velocities(), fluid.active_mask(), in_pourer)
+        cmd = self.controller.step(m)
+        self.command = cmd
+        targets = {ArmRole.POUR: cmd.pourer, ArmRole.CATCH: cmd.catcher}
+        for role in ROLES:
+            t = targets[role]
+            q = scene.solve_vessel_target(role, PlanarPose(t.dx, t.dz, t.theta), self._seed[role])
+            self._seed[role] = q
+            self.generators[role].set_target(q)
+        in_catcher = last.volume_in_vessel[1] if last else 0.0
+        self.log.append(
+            t=self.time, tilt=m.tilt, theta1=m.theta1, h_q=m.h_q, v_q=m.v_q, v_q_z=m.v_q_z,
+            volume_in_pourer=in_pourer, volume_in_catcher=in_catcher, poured_volume=m.poured_volume,
+            spilled_volume=last.spilled_volume if last else 0.0, lip_x=m.lip_x, lip_z=m.lip_z,
+            landing_x=cmd.landing_x, phase=cmd.phase.value, target_theta=cmd.pourer.theta, target_dx=cmd.pourer.dx,
+            target_dz=cmd.pourer.dz, catcher_dx=cmd.catcher.dx, wrench_pourer=self.wrench[0].copy(),
+            wrench_catcher=self.wrench[1].copy(),
+        )
+
+    # ---- whole run -----------------------------------------------------------------------------------------------
+    @property
+    def finished(self) -> bool:
+        if self.time >= self.settings.max_duration - 1e-12:
+            return True
+        return self.done_at is not None and self.time >= self.done_at + self.settings.settle_time - 1e-12
+
+    def run(self, on_step: Callable[["CoupledPour"], None] | None = None) -> dict:
+        while not self.finished:
+            self.step()
+            if on_step is not None:
+                on_step(self)
+        return self.summary()
+
+    def summary(self) -> dict:
+        """Volumes (m^3), phases (name, start s, end s), times (s) of the run so far."""
+        last = self.fluid.last_report.last
+        initial = self.geometry.initial_volume
+        in_pourer, in_catcher = last.volume_in_vessel
+        poured = initial - in_pourer
+        spilled = initial - in_pourer - in_catcher
+        return {
+            "initial_volume": initial,
+            "poured_volume": poured,
+            "caught_volume": in_catcher,
+            "spilled_volume": spilled,
+            "left_domain_volume": last.spilled_volume,
+            "spilled_fraction_of_poured": spilled / poured if poured > 0 else 0.0,
+            "phases": [{"phase": p, "start": a, "end": b} for p, a, b in self.controller.phase_intervals(self.time)],
+            "transitions": [
+                {"time": tr.t, "from": tr.source.value, "to": tr.target.value, "reason": tr.reason}
+                for tr in self.controller.transitions
+            ],
+            "pour_done": self.done_at is not None,
+            "sim_time": self.time,
+            "wall_time": self.wall_time,
+            "real_time_factor": self.time / self.wall_time if self.wall_time > 0 else float("nan"),
+            "mujoco_steps": self.steps,
+            "sph_steps": self.fluid.step_count,
+            "particles": self.fluid.n_particles,
+        }
+
+
+def pour_fluid_config(scene: RobotScene, base: FluidConfig, fill_depth: float) -> FluidConfig:
+    """``base`` with the domain and the expected speed of this scene: the domain spans both vessels and the
+    catcher's travel, its floor just below the catcher (liquid that misses falls out and counts as spilled);
+    the expected speed is the larger of the jet's speed at the catcher floor and 2 sqrt(g A)."""
+    pour, catch = scene.arms[ArmRole.POUR], scene.arms[ArmRole.CATCH]
+    p, c = pour.home_pos, catch.home_pos
+    reach = max(pour.vessel.inner_height, pour.vessel.inner_width) + 0.15
+    lo = (min(p[0], c[0]) - reach, -0.5 * max(pour.vessel.section_depth, catch.vessel.section_depth) - 0.2, c[2] - catch.vessel.wall_thickness - 0.05)
+    hi = (max(p[0], c[0]) + CATCHER_TRAVEL + reach, -lo[1], p[2] + pour.vessel.inner_height + reach)
+    fall = p[2] + pour.vessel.inner_height - c[2]
+    g = base.gravity_magnitude
+    speed = max(math.sqrt(2.0 * g * fall), 2.0 * math.sqrt(g * fill_depth))
+    fields = {f: getattr(base, f) for f in base.__dataclass_fields__}
+    fields.update(domain_min=lo, domain_max=hi, max_expected_speed=speed, depth_2d=pour.vessel.section_depth)
+    return FluidConfig(**fields)
+
+
+def build_pour(
+    scene: RobotScene,
+    fluid_base: FluidConfig,
+    pour_config: Callable[[VesselGeometry, CatcherConfig, float, float], PourConfig],
+    make_generator: Callable[[RobotScene, ArmRole, float], JointTrajectoryGenerator],
+    fill_depth: float,
+    settings: CouplingSettings = CouplingSettings(),
+    device: str = "cpu",
+) -> CoupledPour:
+    """Assemble a pour: the liquid filling the pourer at home to ``fill_depth``, the controller (built by
+    ``pour_config(vessel_geometry, catcher_config, actual_fill_depth, initial_volume)``) and a generator per arm.
+
+    The controller gets the liquid's actual fill (the lattice holds whole layers) and the wall thickness the
+    liquid sees, so its geometry is the simulated one."""
+    cfg = pour_fluid_config(scene, fluid_base, fill_depth)
+    specs = [scene.arms[r].vessel for r in ROLES]
+    poses = vessel_poses(scene)
+    particles = fill_vessel(specs[0], fill_depth, cfg, poses[0])
+    fluid = FluidSolver(cfg, specs, poses, particles, device=device)
+    pourer = specs[0]
+    wall = float(fluid.model.wall_thickness[0])
+    initial_volume = fluid.n_particles * cfg.particle_volume
+    actual_fill = initial_volume / (pourer.inner_width * pourer.section_depth)
+    geometry = VesselGeometry(pourer.inner_width, pourer.inner_height, wall, pourer.section_depth)
+    catcher = CatcherConfig(home_x=float(scene.arms[ArmRole.CATCH].home_pos[0]), travel_min=-CATCHER_TRAVEL, travel_max=CATCHER_TRAVEL)
+    controller = PourController(pour_config(geometry, catcher, actual_fill, initial_volume))
+    mgeo = MeasurementGeometry(pourer, wall, specs[1].inner_height, cfg.smoothing_length, cfg.spacing, initial_volume, cfg.dim)
+    generators = {role: make_generator(scene, role, float(scene.model.opt.timestep)) for role in ROLES}
+    return CoupledPour(scene, fluid, controller, generators, mgeo, settings)
