@@ -44,11 +44,18 @@ def _case_params(name: str, args) -> list:
     common = {"dim": args.dim, "device": args.device, "spacing": args.spacing}
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
-    if name in ("tilt", "shake"):
-        geometry.pop("width", None)  # the seed's vessel
+    if name in ("tilt", "shake", "coupling-static"):
+        geometry.pop("width", None)  # the scene's (seed's) vessel
     if name == "slosh" and args.fill is None:
         return [params(**common, **geometry, fill=fill) for fill in slosh.SEED_FILLS]
     return [params(**common, **geometry)]
+
+
+def _json_value(value):
+    """numpy scalars and arrays as plain JSON numbers and lists."""
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
 
 
 def _table(results: list[CaseResult]) -> str:
@@ -84,7 +91,7 @@ def run(args) -> int:
             print(f"  plot: {path}", file=sys.stderr)
     passed = all(r.passed for r in results)
     if args.json:
-        print(json.dumps({"passed": passed, "cases": [r.to_json() for r in results]}))
+        print(json.dumps({"passed": passed, "cases": [r.to_json() for r in results]}, default=_json_value))
     else:
         print(_table(results))
         print(f"\n{'all validations passed' if passed else 'SOME VALIDATIONS FAILED (see FAIL rows)'}")

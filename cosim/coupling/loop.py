@@ -48,6 +48,32 @@ class JointTrajectoryGenerator(Protocol):
     def step(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
 
 
+def coupled_step(
+    scene: RobotScene,
+    fluid: FluidSolver,
+    wrench: np.ndarray,
+    targets: dict[ArmRole, tuple[np.ndarray, np.ndarray | None]],
+    settings: CouplingSettings,
+) -> np.ndarray:
+    """Steps 2-5 of the exchange order above for one MuJoCo step: servo targets ``(q, qd)`` per arm (+ the
+    feedforward of ``wrench``, the liquid's (2, 6) wrench from the previous interval), the wrench into MuJoCo
+    (two-way), ``mj_step``, then the fluid over the same dt; returns the new averaged wrench (2, 6)."""
+    two_way = settings.coupling is Coupling.TWO_WAY
+    poses = fluid.vessel_poses()
+    for k, role in enumerate(ROLES):
+        q, qd = targets[role]
+        force, torque = wrench_at_body_com(scene, role, poses[k], wrench[k])
+        tau_ff = -scene.wrench_joint_torque(role, force, torque) if two_way and settings.wrench_feedforward else None
+        scene.set_joint_targets(role, q, qd, tau_ff)
+        if two_way:
+            scene.apply_vessel_wrench(role, force, torque)
+    dt = float(scene.model.opt.timestep)
+    mujoco.mj_step(scene.model, scene.data)
+    fluid.set_vessel_poses(vessel_poses(scene))
+    fluid.advance(dt)
+    return fluid.vessel_wrenches()
+
+
 @dataclass
 class PourLog:
     """Per control step records (lists, turned into arrays by :meth:`arrays`)."""
@@ -95,19 +121,11 @@ class CoupledPour:
         scene = self.scene
         if self.steps % self.control_every == 0:
             self._control()
-        two_way = self.settings.coupling is Coupling.TWO_WAY
-        poses = self.fluid.vessel_poses()
-        for k, role in enumerate(ROLES):
+        targets = {}
+        for role in ROLES:
             q, qd, _ = self.generators[role].step()
-            force, torque = wrench_at_body_com(scene, role, poses[k], self.wrench[k])
-            tau_ff = -scene.wrench_joint_torque(role, force, torque) if two_way and self.settings.wrench_feedforward else None
-            scene.set_joint_targets(role, q, qd, tau_ff)
-            if two_way:
-                scene.apply_vessel_wrench(role, force, torque)
-        mujoco.mj_step(scene.model, scene.data)
-        self.fluid.set_vessel_poses(vessel_poses(scene))
-        self.fluid.advance(self.dt)
-        self.wrench = self.fluid.vessel_wrenches()
+            targets[role] = (q, qd)
+        self.wrench = coupled_step(scene, self.fluid, self.wrench, targets, self.settings)
         self.steps += 1
         self.time = self.steps * self.dt
         if self.command is not None and self.command.done and self.done_at is None:

@@ -16,7 +16,8 @@ DIAG_MAX_SPEED = wp.constant(0)  # m/s
 DIAG_MAX_ACCEL = wp.constant(1)  # m/s^2 (total, gravity included)
 DIAG_MAX_DENSITY_ERROR = wp.constant(2)  # max |rho - rho0| / rho0
 DIAG_KINETIC_ENERGY = wp.constant(3)  # J (3-D equivalent)
-N_DIAG_FLOAT = 4
+DIAG_MAX_COMPRESSION = wp.constant(4)  # max (rho - rho0) / rho0 (the part an instability shows in)
+N_DIAG_FLOAT = 5
 # int row
 DIAG_NONFINITE = wp.constant(0)  # particles with a non-finite position, velocity or density
 DIAG_BREACHES = wp.constant(1)  # wall contacts deeper than max_wall_penetration (instability)
@@ -36,6 +37,7 @@ class StepDiagnostics:
     max_speed: float  # m/s
     max_acceleration: float  # m/s^2
     max_density_error: float  # max |rho - rho0| / rho0
+    max_compression: float  # max (rho - rho0) / rho0
     kinetic_energy: float  # J
     nonfinite: int
     wall_breaches: int
@@ -60,6 +62,7 @@ def rows_to_records(
                 max_speed=float(f[0]),
                 max_acceleration=float(f[1]),
                 max_density_error=float(f[2]),
+                max_compression=float(f[4]),
                 kinetic_energy=float(f[3]),
                 nonfinite=int(i[0]),
                 wall_breaches=int(i[1]),

@@ -224,7 +224,8 @@ class FluidSolver:
         self._poses = list(self._targets)
         self._history.append((np.full(n_sub, dt), rows_f, rows_i))
         scale = 1.0 / n_sub
-        self._wrench = np.concatenate([self._force_sum.numpy(), self._torque_sum.numpy()], axis=1)[: m.n_vessels] * scale
+        wrench = np.concatenate([self._force_sum.numpy(), self._torque_sum.numpy()], axis=1)[: m.n_vessels]
+        self._wrench = wrench.astype(np.float64) * scale
         self._check(first, t0, dt, rows_f, rows_i)
         self._last_max_speed = float(rows_f[:, 0].max())
         self._last_max_accel = float(rows_f[:, 1].max())
@@ -305,7 +306,8 @@ class FluidSolver:
             (rows_i[:, 1] > 0, lambda s: f"{rows_i[s, 1]} particles inside a vessel wall (deeper than {cfg.max_wall_penetration:g} dx)"),
             (
                 rows_f[:, 2] > cfg.max_density_error,
-                lambda s: f"density error {rows_f[s, 2]:.3f} exceeds fluid.max_density_error = {cfg.max_density_error:g}",
+                lambda s: f"density error {rows_f[s, 2]:.3f} ({'compression' if rows_f[s, 4] >= rows_f[s, 2] else 'expansion'}) "
+                f"exceeds fluid.max_density_error = {cfg.max_density_error:g}",
             ),
         ]
         bad = [(int(np.argmax(mask)), describe) for mask, describe in checks if mask.any()]
@@ -377,6 +379,7 @@ class FluidSolver:
             "max_speed": f[:, 0],
             "max_acceleration": f[:, 1],
             "max_density_error": f[:, 2],
+            "max_compression": f[:, 4],
             "kinetic_energy": f[:, 3],
             "nonfinite": i[:, 0],
             "wall_breaches": i[:, 1],

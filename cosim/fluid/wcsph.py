@@ -10,7 +10,7 @@ compute_density_rate: continuity equation (liquid and wall particles) evaluated 
   delta-SPH diffusion (Molteni & Colagrossi 2009) of the density minus its hydrostatic part (Fourtakas et al.
   2019, here with the EOS's local slope dp/drho), so a resting column keeps its hydrostatic density profile.
 integrate: symplectic Euler, i.e. leapfrog with velocities at half steps: v += dt a(rho_n); rho += dt
-  Drho(v_new); x += dt v_new. (Updating rho with the old velocity instead would be forward Euler for the acoustic
+  Drho(v_new), floored at rho0 (no tension, see the kernel); x += dt v_new. (Updating rho with the old velocity instead would be forward Euler for the acoustic
   waves and amplify them every step.) Then the wall guard, deactivation outside the domain, the equation of
   state and the substep's diagnostics.
 """
@@ -27,6 +27,7 @@ from cosim.fluid.diagnostics import (
     DIAG_INSIDE0,
     DIAG_KINETIC_ENERGY,
     DIAG_MAX_ACCEL,
+    DIAG_MAX_COMPRESSION,
     DIAG_MAX_DENSITY_ERROR,
     DIAG_MAX_SPEED,
     DIAG_NONFINITE,
@@ -238,7 +239,10 @@ def integrate(
     x_old = x[i]
     vi = v[i] + h * acc[i]
     xi = x_old + h * vi
-    rhoi = rho[i] + h * drho[i]
+    # no tension: a liquid particle's density never drops below rho0 (p >= 0). Continuity density drifts low
+    # where a jet stretches or breaks up (kernel support emptying), which would otherwise pull the fragments
+    # together with an artificial tension of order rho0 c0^2 that water in an open pour does not carry.
+    rhoi = wp.max(rho[i] + h * drho[i], prm.rest_density)
     if prm.dim == 2:
         vi[1] = 0.0
         xi[1] = 0.0
@@ -281,6 +285,7 @@ def integrate(
     wp.atomic_add(diag_i, s, DIAG_ACTIVE, 1)
     wp.atomic_max(diag_f, s, DIAG_MAX_SPEED, speed)
     wp.atomic_max(diag_f, s, DIAG_MAX_DENSITY_ERROR, wp.abs(rhoi - prm.rest_density) / prm.rest_density)
+    wp.atomic_max(diag_f, s, DIAG_MAX_COMPRESSION, (rhoi - prm.rest_density) / prm.rest_density)
     wp.atomic_add(diag_f, s, DIAG_KINETIC_ENERGY, 0.5 * prm.mass_out * speed * speed)
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from cosim.validation import dam_break, hydrostatic, moving_vessel, slosh
+from cosim.validation import coupling_static, dam_break, hydrostatic, moving_vessel, slosh
 from cosim.validation.common import CaseResult
 
 
@@ -26,6 +26,9 @@ CASES: dict[str, Case] = {
     "slosh": Case(slosh.Params, slosh.run, slosh.plot, "first sloshing mode vs seed Eq. 17"),
     "dam-break": Case(dam_break.Params, dam_break.run, dam_break.plot, "surge front vs Martin & Moyce (1952)"),
     "tilt": Case(moving_vessel.Params, moving_vessel.run_tilt, moving_vessel.plot, "full vessel tilted about its lip"),
+    "coupling-static": Case(
+        coupling_static.Params, coupling_static.run, coupling_static.plot, "held full vessel: reaction and joint torques"
+    ),
     "shake": Case(moving_vessel.Params, moving_vessel.run_shake, moving_vessel.plot, "full vessel shaken at resonance"),
 }
-DEFAULT_CASES = ("hydrostatic", "slosh", "dam-break")
+DEFAULT_CASES = ("hydrostatic", "slosh", "dam-break", "coupling-static")

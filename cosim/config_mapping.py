@@ -1,0 +1,148 @@
+"""TOML tables <-> frozen configuration dataclasses, 1:1.
+
+``from_mapping(cls, table, path)`` builds ``cls`` from a (nested) mapping: keys are field names, nested dataclasses
+are sub-tables, enums are given by their string value, tuples as arrays, ``None`` fields are left out of the
+file. An unknown key, a wrong type or a value out of range is one :class:`InputError` line naming the dotted field
+(range checks are the dataclasses' own ``__post_init__``). ``to_toml(obj)`` writes the TOML document of a
+configuration with every field's documentation (unit and range, from the dataclass docstrings) as a comment.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import inspect
+import re
+import types
+import typing
+from typing import Any
+
+import tomlkit
+
+from cosim.errors import InputError
+
+_FIELD_DOC = re.compile(r"^\s*([a-z_][a-z0-9_]*)\s*:\s*(.*)$")
+
+
+def field_docs(cls: type) -> dict[str, str]:
+    """Field name -> its description, read from lines ``name: text`` in the class docstring (continuation lines,
+    indented deeper, are joined)."""
+    doc = inspect.getdoc(cls) or ""
+    names = {f.name for f in dataclasses.fields(cls)}
+    out: dict[str, str] = {}
+    current = None
+    for line in doc.splitlines():
+        m = _FIELD_DOC.match(line)
+        if m and m.group(1) in names:
+            current = m.group(1)
+            out[current] = m.group(2).strip()
+        elif current and line.startswith("  ") and line.strip():
+            out[current] += " " + line.strip()
+        else:
+            current = None
+    # several fields documented on one line ("max_rate: rad/s. (0, 2]   max_accel: ...")
+    for name, text in list(out.items()):
+        out[name] = re.split(r"\s{3,}[a-z_]+:", text)[0].strip()
+    return out
+
+
+def _type_name(tp: Any) -> str:
+    return getattr(tp, "__name__", str(tp).replace("typing.", ""))
+
+
+def _convert(value: Any, tp: Any, path: str) -> Any:
+    origin = typing.get_origin(tp)
+    if origin in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(tp) if a is not type(None)]
+        if len(args) == 1:
+            return _convert(value, args[0], path)
+        raise TypeError(f"unsupported union at {path}")
+    if dataclasses.is_dataclass(tp):
+        if not isinstance(value, dict):
+            raise InputError(f"{path}: must be a table, got {type(value).__name__}")
+        return from_mapping(tp, value, path)
+    if isinstance(tp, type) and issubclass(tp, enum.Enum):
+        allowed = [m.value for m in tp]
+        if value not in allowed:
+            raise InputError(f"{path}: must be one of {', '.join(map(repr, allowed))}, got {value!r}")
+        return tp(value)
+    if origin is tuple or tp is tuple:
+        if not isinstance(value, list):
+            raise InputError(f"{path}: must be an array, got {type(value).__name__}")
+        args = typing.get_args(tp)
+        item = args[0] if args else Any
+        return tuple(_convert(v, item, f"{path}[{i}]") for i, v in enumerate(value))
+    if tp is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise InputError(f"{path}: must be a number, got {value!r} ({type(value).__name__})")
+        return float(value)
+    if tp is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise InputError(f"{path}: must be an integer, got {value!r} ({type(value).__name__})")
+        return value
+    if tp is bool:
+        if not isinstance(value, bool):
+            raise InputError(f"{path}: must be true or false, got {value!r}")
+        return value
+    if tp is str:
+        if not isinstance(value, str):
+            raise InputError(f"{path}: must be a string, got {value!r} ({type(value).__name__})")
+        return value
+    return value
+
+
+def from_mapping(cls: type, table: dict[str, Any], path: str) -> Any:
+    """Build the dataclass ``cls`` from ``table``; fields missing from the table keep their defaults."""
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
+    unknown = sorted(set(table) - set(fields))
+    if unknown:
+        raise InputError(f"{path}.{unknown[0]}: unknown key (known keys: {', '.join(sorted(fields))})")
+    kwargs = {name: _convert(value, hints[name], f"{path}.{name}") for name, value in table.items()}
+    try:
+        return cls(**kwargs)
+    except InputError:
+        raise
+    except TypeError as exc:  # a required field is missing
+        raise InputError(f"{path}: {exc}") from None
+    except ValueError as exc:  # a range check of a layer with its own error type (e.g. controllers)
+        raise InputError(f"{path}: {exc}" if not str(exc).startswith(path.split(".")[-1]) else str(exc)) from None
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, enum.Enum):
+        return value.value
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _fill_table(table, obj: Any) -> None:
+    docs = field_docs(type(obj))
+    nested = []
+    for f in dataclasses.fields(obj):
+        value = getattr(obj, f.name)
+        if dataclasses.is_dataclass(value):
+            nested.append((f.name, value, docs.get(f.name, "")))
+            continue
+        if value is None:
+            table.add(tomlkit.comment(f"{f.name} = (not set)  # {docs.get(f.name, '')}".rstrip("# ")))
+            continue
+        table.add(f.name, _plain(value))
+        if docs.get(f.name):
+            table[f.name].comment(docs[f.name])
+    for name, value, doc in nested:
+        sub = tomlkit.table()
+        if doc:
+            sub.add(tomlkit.comment(doc))
+        _fill_table(sub, value)
+        table.add(name, sub)
+
+
+def to_toml(obj: Any, header: str = "") -> str:
+    """The TOML document of the configuration ``obj`` (a dataclass), every field commented with its docs."""
+    doc = tomlkit.document()
+    for line in header.splitlines():
+        doc.add(tomlkit.comment(line))
+    _fill_table(doc, obj)
+    return tomlkit.dumps(doc)

@@ -1,0 +1,153 @@
+"""Fluid throughput benchmark: particle-steps per second of the SPH step, side by side with warp's bundled
+``example_sph`` at the same particle count (a benchmark, not a test).
+
+    python -m cosim.fluid.benchmark [--device cpu|cuda] [--counts2d 1000 4000 16000] [--counts3d 4000 16000 62500]
+                                    [--repeats 3] [--out docs/benchmarks.md]
+
+Ours: a resting box of liquid in a tank (the hydrostatic case), every stage of a substep (walls, neighbour sort,
+reorder, wall extrapolation, forces, density rate, integration, wrench reduction). ``example_sph``: warp's own
+3-D toy (Mueller 2003 kernels on ``wp.HashGrid``, a handful of neighbours per particle), re-sized to the same
+count by reallocating its particle arrays with its own initialisation kernel. Both are timed after a warm-up
+step (kernel compilation excluded); the median of ``repeats`` timed batches is reported. Appends a dated section
+to the Markdown file with the machine and versions.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import platform
+import statistics
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+import warp as wp
+
+from cosim.fluid.config import FluidConfig
+from cosim.fluid.runtime import resolve_device
+from cosim.fluid.seeding import liquid_block
+from cosim.fluid.solver import FluidSolver
+from cosim.frames import Pose
+from cosim.vessel import VesselSpec
+
+TANK_ASPECT = 1.0  # the liquid block is as tall as it is wide
+
+
+def _ours(n: int, dim: int, device: str, steps: int, repeats: int) -> tuple[float, int]:
+    """(median particle-steps/s, actual particle count) of our solver on a resting liquid block of ~n particles."""
+    width = 0.2
+    depth = width if dim == 3 else 0.1
+    cells = n ** (1.0 / dim)
+    dx = width / cells
+    tank = VesselSpec(name="tank", inner_width=width, inner_depth=depth, inner_height=1.5 * width)
+    m = 0.1 * width
+    cfg = FluidConfig(
+        dim=dim, spacing=dx, max_expected_speed=2 * math.sqrt(9.81 * width),
+        domain_min=(-0.5 * width - m, -0.5 * depth - m, -m), domain_max=(0.5 * width + m, 0.5 * depth + m, 1.5 * width + m),
+    )
+    block = liquid_block((-0.5 * width, -0.5 * depth, 0.0), (0.5 * width, 0.5 * depth, width * TANK_ASPECT), cfg)
+    solver = FluidSolver(cfg, [tank], [Pose()], block, device=device)
+    dt = cfg.cfl * cfg.smoothing_length / cfg.sound_speed
+    solver.advance(dt)  # warm-up: compiles and records
+    rates = []
+    for _ in range(repeats):
+        wp.synchronize_device(solver.device)
+        start = time.perf_counter()
+        solver.advance(steps * dt * 0.999)
+        wp.synchronize_device(solver.device)
+        rates.append(solver.n_particles * solver.last_report.substeps / (time.perf_counter() - start))
+    return statistics.median(rates), solver.n_particles
+
+
+def _example_sph(n: int, device: str, steps: int, repeats: int) -> float:
+    """Median particle-steps/s of warp's bundled example_sph re-sized to n particles."""
+    from warp.examples.core import example_sph
+
+    with wp.ScopedDevice(device):
+        ex = example_sph.Example(stage_path=None)
+        h = (ex.height * (ex.width / 4.0) * (ex.height / 4.0) / n) ** (1.0 / 3.0)
+        scale = h / ex.smoothing_length
+        ex.smoothing_length = h
+        ex.n = n
+        ex.particle_mass *= scale**3
+        ex.dt *= scale
+        ex.density_normalization = (315.0 * ex.particle_mass) / (64.0 * np.pi * h**9)
+        ex.pressure_normalization = -(45.0 * ex.particle_mass) / (np.pi * h**6)
+        ex.viscous_normalization = (45.0 * ex.dynamic_visc * ex.particle_mass) / (np.pi * h**6)
+        ex.x, ex.v, ex.rho, ex.a = (wp.empty(n, dtype=wp.vec3), wp.zeros(n, dtype=wp.vec3), wp.zeros(n, dtype=float), wp.zeros(n, dtype=wp.vec3))
+        wp.launch(example_sph.initialize_particles, dim=n, inputs=[ex.x, h, ex.width, ex.height, ex.length])
+        grid_size = int(ex.height / (4.0 * h))
+        ex.grid = wp.HashGrid(grid_size, grid_size, grid_size)
+        ex.sim_step_to_frame_ratio = steps
+        wp.config.verbose_warnings = False
+        ex.step()  # warm-up
+        rates = []
+        for _ in range(repeats):
+            wp.synchronize_device()
+            start = time.perf_counter()
+            ex.step()
+            wp.synchronize_device()
+            rates.append(n * steps / (time.perf_counter() - start))
+    return statistics.median(rates)
+
+
+def _machine() -> str:
+    cpu = platform.processor() or "unknown CPU"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    import os
+
+    return f"{cpu}, {os.cpu_count()} logical cores, {platform.system()} {platform.release()}"
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--device", default="cpu")
+    p.add_argument("--counts2d", type=int, nargs="*", default=[1000, 4000, 16000])
+    p.add_argument("--counts3d", type=int, nargs="*", default=[4000, 16000, 62500])
+    p.add_argument("--steps", type=int, default=20, help="steps per timed batch")
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--out", type=Path, default=None, help="append the table to this Markdown file")
+    args = p.parse_args(argv)
+    device = resolve_device(args.device)
+    rows = []
+    for dim, counts in ((2, args.counts2d), (3, args.counts3d)):
+        for n in counts:
+            ours, actual = _ours(n, dim, str(device), args.steps, args.repeats)
+            theirs = _example_sph(actual, str(device), args.steps, args.repeats) if dim == 3 else float("nan")
+            rows.append((dim, actual, ours, theirs))
+            print(f"{dim}-D {actual:>8d} particles: cosim {ours / 1e6:8.3f} M particle-steps/s"
+                  + (f"   example_sph {theirs / 1e6:8.3f} M   ratio {ours / theirs:5.2f}" if dim == 3 else ""), flush=True)
+    table = ["| dim | particles | cosim WCSPH (M particle-steps/s) | warp example_sph (M particle-steps/s) | cosim / example |",
+             "|---|---|---|---|---|"]
+    for dim, n, ours, theirs in rows:
+        ex = f"{theirs / 1e6:.3f}" if not math.isnan(theirs) else "- (3-D only)"
+        ratio = f"{ours / theirs:.2f}" if not math.isnan(theirs) else "-"
+        table.append(f"| {dim}-D | {n} | {ours / 1e6:.3f} | {ex} | {ratio} |")
+    header = (
+        f"\n## Fluid step throughput, {device} ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
+        f"Machine: {_machine()}. Versions: Python {platform.python_version()}, warp {wp.__version__}, numpy {np.__version__}.\n"
+        f"Command: `python -m cosim.fluid.benchmark --device {args.device} --counts2d {' '.join(map(str, args.counts2d))} "
+        f"--counts3d {' '.join(map(str, args.counts3d))} --steps {args.steps} --repeats {args.repeats}`. Median of "
+        f"{args.repeats} batches of {args.steps} steps after a warm-up step; one step of cosim is the full substep "
+        "(walls, neighbour sort and reorder, wall pressure extrapolation, forces, density rate, integration, wrench "
+        "reduction); example_sph is warp's bundled toy (Mueller 2003 kernels, few neighbours) re-sized to the same count.\n\n"
+    )
+    text = header + "\n".join(table) + "\n"
+    print(text)
+    if args.out:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        with args.out.open("a") as f:
+            f.write(text)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
