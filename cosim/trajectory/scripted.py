@@ -55,6 +55,8 @@ class ScriptedRun:
     limits: the arms' limits, column order. sample_rate_hz: Hz.
     targets: per arm, (K, n) rad, the IK joint target sent at ``k * target_period``.
     clamped_targets: per joint, targets clamped onto the joint range.
+    late_targets, max_target_error: per arm, :attr:`TrajectoryGenerator.late_targets` and
+    :attr:`TrajectoryGenerator.max_target_error` (rad).
     """
 
     trajectory: JointTrajectory
@@ -62,6 +64,8 @@ class ScriptedRun:
     sample_rate_hz: float
     targets: dict[ArmRole, np.ndarray]
     clamped_targets: dict[str, int]
+    late_targets: dict[ArmRole, int]
+    max_target_error: dict[ArmRole, float]
 
 
 def generate_scripted(
@@ -131,6 +135,8 @@ def generate_scripted(
         sample_rate_hz=recorder.sample_rate_hz,
         targets={r: np.array(v) for r, v in targets.items()},
         clamped_targets=clamped,
+        late_targets={r: g.late_targets for r, g in generators.items()},
+        max_target_error={r: g.max_target_error for r, g in generators.items()},
     )
 
 
@@ -170,6 +176,11 @@ def main(argv: list[str] | None = None) -> int:
         print(
             f"{role.value}: lip deviation from the scripted path: max {deviation.max() * 1e3:.4f} mm, "
             f"RMS {np.sqrt(np.mean(deviation**2)) * 1e3:.4f} mm"
+        )
+    for role in ArmRole:
+        print(
+            f"{role.value}: targets missed by the arm: {run.late_targets[role]}, largest joint distance to a target on "
+            f"arrival: {run.max_target_error[role]:.2e} rad"
         )
     print(f"targets clamped to the joint range: {sum(run.clamped_targets.values())}")
     return 0
