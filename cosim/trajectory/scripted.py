@@ -19,7 +19,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -147,7 +147,7 @@ def pour_poses(scene: RobotScene, spec: PourMotionSpec, target_period: float = 0
     return {role: [s[role] for s in samples] for role in ArmRole}
 
 
-def pour_path(scene: RobotScene, spec: PourMotionSpec):
+def pour_path(scene: RobotScene, spec: PourMotionSpec) -> dict[ArmRole, Callable[[float], PlanarPose]]:
     """Per arm, the pour's vessel path ``t -> PlanarPose`` (at rest before 0 and after the end)."""
     return {role: (lambda t, role=role: task_poses(scene, spec, min(max(t, 0.0), spec.duration))[role]) for role in ArmRole}
 
