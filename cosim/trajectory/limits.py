@@ -1,0 +1,199 @@
+"""Per-joint kinematic limits of an arm for trajectory generation and checking.
+
+Units: positions rad, velocities rad/s, accelerations rad/s^2, jerks rad/s^3; all limits are symmetric
+(``|qd| <= max_velocity`` and so on); joint positions must stay in ``[min_position, max_position]``.
+
+Defaults for a UR10e-class arm (:func:`arm_limits`):
+
+* ``max_velocity``: the arm's data-sheet joint speed as recorded in the scene (``ArmInfo.max_joint_speed``; UR10e:
+  120 deg/s base and shoulder, 180 deg/s elbow and wrists, see :mod:`cosim.robots.ur10e`).
+* ``max_acceleration``: :data:`DEFAULT_MAX_ACCELERATION`. Universal Robots publish no joint acceleration limit (the
+  joints are torque-limited); their own ROS 2 driver gives MoveIt 5.0 rad/s^2 on every joint, values "chosen
+  conservatively to work in most use cases" (UniversalRobots/Universal_Robots_ROS2_Driver,
+  ``ur_moveit_config/config/joint_limits.yaml``).
+* ``max_jerk``: :data:`DEFAULT_MAX_JERK`. No arm maker in this class publishes one; 100 rad/s^3 is MoveIt's default
+  for its ruckig smoothing (moveit/moveit, ``moveit_core/trajectory_processing/src/ruckig_traj_smoothing.cpp``,
+  ``DEFAULT_MAX_JERK``), far below the thousands of rad/s^3 that arms with published jerk limits allow. It ramps the
+  acceleration from 0 to 5 rad/s^2 in 50 ms.
+* ``min_position``/``max_position``: the MuJoCo model's joint range (UR10e: +-360 deg). ruckig's community build
+  ignores position limits, so :class:`cosim.trajectory.generator.TrajectoryGenerator` clamps its targets to them
+  and :func:`cosim.trajectory.checks.check_trajectory` verifies the result.
+
+Every default can be overridden per joint with :class:`JointLimitOverride` (the scene file's trajectory limits map
+onto it); overrides may not widen the position range beyond the model's joint range.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from cosim.checks import check_positive, check_range
+from cosim.errors import InputError
+from cosim.robots.scene_config import ArmRole
+
+if TYPE_CHECKING:
+    from cosim.robots.scene import RobotScene
+
+DEFAULT_MAX_ACCELERATION = 5.0  # rad/s^2, see the module docstring
+DEFAULT_MAX_JERK = 100.0  # rad/s^3, see the module docstring
+DEFAULT_ARM_MODEL = "UR10e"  # the arm of the project's scene (models/ur10e/ur10e.xml)
+
+# Accepted ranges of the limit values (units as above): generous bounds that still reject typos by orders of magnitude.
+MAX_VELOCITY_BOUND = 50.0
+MAX_ACCELERATION_BOUND = 1000.0
+MAX_JERK_BOUND = 1.0e6
+POSITION_BOUND = 100.0  # |min_position|, |max_position|
+
+LIMIT_FIELDS = ("max_velocity", "max_acceleration", "max_jerk", "min_position", "max_position")
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    """Limits of one joint. name: full joint name ``<arm>/<joint>``.
+
+    max_velocity: rad/s, (0, 50]. max_acceleration: rad/s^2, (0, 1000]. max_jerk: rad/s^3, (0, 1e6].
+    min_position < max_position: rad, within [-100, 100].
+    """
+
+    name: str
+    max_velocity: float
+    max_acceleration: float
+    max_jerk: float
+    min_position: float
+    max_position: float
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise InputError(f"limits: joint name must be a non-empty string, got {self.name!r}")
+        p = f"limits.{self.name}"
+        object.__setattr__(self, "max_velocity", check_positive(f"{p}.max_velocity", self.max_velocity, "rad/s", MAX_VELOCITY_BOUND))
+        object.__setattr__(
+            self, "max_acceleration",
+            check_positive(f"{p}.max_acceleration", self.max_acceleration, "rad/s^2", MAX_ACCELERATION_BOUND),
+        )
+        object.__setattr__(self, "max_jerk", check_positive(f"{p}.max_jerk", self.max_jerk, "rad/s^3", MAX_JERK_BOUND))
+        lo = check_range(f"{p}.min_position", self.min_position, -POSITION_BOUND, POSITION_BOUND, "rad")
+        hi = check_range(f"{p}.max_position", self.max_position, lo, POSITION_BOUND, "rad", lo_open=True)
+        object.__setattr__(self, "min_position", lo)
+        object.__setattr__(self, "max_position", hi)
+
+
+@dataclass(frozen=True)
+class ArmLimits:
+    """Limits of every joint of one arm, base to tip.
+
+    arm: the arm's name prefix (``pour_arm``). arm_model: what arm the limits describe (e.g. ``UR10e``), for export.
+    joints: one :class:`JointLimits` per joint, names ``<arm>/<joint>`` in the scene's joint order.
+    """
+
+    arm: str
+    arm_model: str
+    joints: tuple[JointLimits, ...]
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.arm, str) or not self.arm or "/" in self.arm:
+            raise InputError(f"limits.arm: must be an arm name without '/', got {self.arm!r}")
+        if not isinstance(self.arm_model, str) or not self.arm_model:
+            raise InputError(f"limits.{self.arm}.arm_model: must be a non-empty string, got {self.arm_model!r}")
+        joints = tuple(self.joints)
+        if not joints or not all(isinstance(j, JointLimits) for j in joints):
+            raise InputError(f"limits.{self.arm}.joints: must be a non-empty sequence of JointLimits")
+        names = [j.name for j in joints]
+        if len(set(names)) != len(names) or not all(n.startswith(f"{self.arm}/") for n in names):
+            raise InputError(f"limits.{self.arm}.joints: names must be unique and start with '{self.arm}/', got {names}")
+        object.__setattr__(self, "joints", joints)
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """Full joint names, base to tip."""
+        return tuple(j.name for j in self.joints)
+
+    def array(self, field: str) -> np.ndarray:
+        """(n,) values of one limit field (one of :data:`LIMIT_FIELDS`), base to tip."""
+        if field not in LIMIT_FIELDS:
+            raise ValueError(f"unknown limit field {field!r}; one of {LIMIT_FIELDS}")
+        return np.array([getattr(j, field) for j in self.joints])
+
+
+@dataclass(frozen=True)
+class JointLimitOverride:
+    """Replacements for some of a joint's default limits; ``None`` keeps the default. Units as :class:`JointLimits`;
+    values are validated when applied (:func:`arm_limits`)."""
+
+    max_velocity: float | None = None
+    max_acceleration: float | None = None
+    max_jerk: float | None = None
+    min_position: float | None = None
+    max_position: float | None = None
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+                raise InputError(f"limits override {f.name}: must be a number or None, got {value!r}")
+
+
+def _model_range(scene: RobotScene, joint: str) -> tuple[float, float]:
+    model = scene.model
+    jid = model.joint(joint).id
+    if not model.jnt_limited[jid]:
+        return -math.inf, math.inf
+    lo, hi = model.jnt_range[jid]
+    return float(lo), float(hi)
+
+
+def arm_limits(
+    scene: RobotScene,
+    role: ArmRole,
+    overrides: Mapping[str, JointLimitOverride] | None = None,
+    arm_model: str = DEFAULT_ARM_MODEL,
+) -> ArmLimits:
+    """Default limits of ``role``'s arm in ``scene`` (see the module docstring), with per-joint ``overrides``.
+
+    overrides: joint name (short, ``elbow``, or full, ``pour_arm/elbow``) -> :class:`JointLimitOverride`. An unknown
+    joint, a bad value or a position range wider than the model's joint range raises ``InputError``.
+    """
+    arm = scene.arms[role]
+    prefix = f"{role.value}/"
+    full = {name.removeprefix(prefix): name for name in arm.joints}
+    by_joint: dict[str, JointLimitOverride] = {}
+    for key, override in (overrides or {}).items():
+        name = key if key in arm.joints else full.get(key)
+        if name is None:
+            raise InputError(f"limits.{role.value}: unknown joint {key!r}; the arm has {', '.join(full)}")
+        if not isinstance(override, JointLimitOverride):
+            raise InputError(f"limits.{name}: must be a JointLimitOverride, got {type(override).__name__}")
+        by_joint[name] = override
+    joints = []
+    for i, name in enumerate(arm.joints):
+        override = by_joint.get(name, JointLimitOverride())
+        lo, hi = _model_range(scene, name)
+        values = {
+            "max_velocity": float(arm.max_joint_speed[i]),
+            "max_acceleration": DEFAULT_MAX_ACCELERATION,
+            "max_jerk": DEFAULT_MAX_JERK,
+            "min_position": lo,
+            "max_position": hi,
+        }
+        values.update({f: getattr(override, f) for f in LIMIT_FIELDS if getattr(override, f) is not None})
+        for f in ("min_position", "max_position"):
+            if not math.isfinite(values[f]) and getattr(override, f) is None:
+                raise InputError(f"limits.{name}.{f}: the model's joint has no range; give one in the overrides")
+            check_range(f"limits.{name}.{f}", values[f], lo, hi, "rad (the model's joint range)")
+        joints.append(JointLimits(name=name, **values))
+    return ArmLimits(arm=role.value, arm_model=arm_model, joints=tuple(joints))
+
+
+def scene_limits(
+    scene: RobotScene,
+    overrides: Mapping[ArmRole, Mapping[str, JointLimitOverride]] | None = None,
+    arm_model: str = DEFAULT_ARM_MODEL,
+) -> dict[ArmRole, ArmLimits]:
+    """:func:`arm_limits` of both arms, in :class:`ArmRole` order (the trajectory files' column order)."""
+    overrides = overrides or {}
+    return {role: arm_limits(scene, role, overrides.get(role), arm_model) for role in ArmRole}

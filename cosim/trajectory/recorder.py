@@ -1,0 +1,73 @@
+"""Sample the motion of the arms' trajectory generators at a fixed rate into one :class:`JointTrajectory`.
+
+Samples lie at ``t_n = t_0 + n / sample_rate_hz`` (s), ``t_0`` the generators' time when the recorder is made; each is
+the generator's exact motion at that time (:meth:`TrajectoryGenerator.state_at`), so any rate is supported exactly,
+not only divisors of the cycle rate. Columns: the generators' joints in the order given (pass them in
+:class:`cosim.robots.scene_config.ArmRole` order for the trajectory files' column order), base to tip.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from cosim.checks import check_positive
+from cosim.io.trajectory_csv import JointTrajectory
+from cosim.trajectory.generator import TIME_EPSILON, TrajectoryGenerator
+from cosim.trajectory.limits import ArmLimits
+
+DEFAULT_SAMPLE_RATE_HZ = 500.0
+MAX_SAMPLE_RATE_HZ = 10_000.0
+
+
+class TrajectoryRecorder:
+    """Records ``generators`` (all with the same cycle time and clock) at ``sample_rate_hz`` (0, 10000] Hz.
+
+    Call :meth:`record` after every :meth:`TrajectoryGenerator.step` of all generators; :meth:`trajectory` returns
+    what was recorded so far.
+    """
+
+    def __init__(self, generators: Sequence[TrajectoryGenerator], sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ) -> None:
+        self.sample_rate_hz = check_positive("trajectory.sample_rate_hz", sample_rate_hz, "Hz", MAX_SAMPLE_RATE_HZ)
+        self.generators = tuple(generators)
+        if not self.generators:
+            raise ValueError("TrajectoryRecorder needs at least one generator")
+        first = self.generators[0]
+        for g in self.generators[1:]:
+            if g.settings.cycle_time != first.settings.cycle_time or g.time != first.time:
+                raise ValueError("TrajectoryRecorder: the generators must share their cycle time and clock")
+        self.joint_names = tuple(name for g in self.generators for name in g.limits.joint_names)
+        self._t0 = first.time
+        self._times: list[float] = []
+        self._rows: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        self.record()
+
+    @property
+    def limits(self) -> tuple[ArmLimits, ...]:
+        """The generators' limits, in column order."""
+        return tuple(g.limits for g in self.generators)
+
+    def _sample_time(self, n: int) -> float:
+        return self._t0 + n / self.sample_rate_hz
+
+    def record(self) -> None:
+        """Take every sample due up to the generators' current time (inside their last step)."""
+        now = self.generators[0].time
+        if any(g.time != now for g in self.generators):
+            raise ValueError("TrajectoryRecorder.record: the generators are at different times; step them all first")
+        while self._sample_time(len(self._times)) <= now + TIME_EPSILON:
+            t = self._sample_time(len(self._times))
+            states = [g.state_at(t) for g in self.generators]
+            self._rows.append(tuple(np.concatenate([s[i] for s in states]) for i in range(3)))  # type: ignore[arg-type]
+            self._times.append(t)
+
+    def trajectory(self) -> JointTrajectory:
+        """The samples so far (at least two are needed)."""
+        return JointTrajectory(
+            time=np.array(self._times),
+            joint_names=self.joint_names,
+            positions=np.array([r[0] for r in self._rows]),
+            velocities=np.array([r[1] for r in self._rows]),
+            accelerations=np.array([r[2] for r in self._rows]),
+        )
