@@ -81,7 +81,9 @@ class PidDesignSpec:
     """Closed-loop target: poles of (s^2 + 2 zeta wn s + wn^2)(s + wn)^2 with wn = bandwidth_ratio * omega1.
 
     damping: zeta of the complex pair, [0.3, 0.95] (1 would make a fourfold pole, which floating point cannot
-    verify to better than 1e-4). bandwidth_ratio: wn / omega1, [0.3, 3].
+      verify to better than 1e-4).
+    bandwidth_ratio: wn / omega1, [0.3, 3].
+
     The defaults (zeta = 0.7, wn = omega1) give the seed's vessel a sensitivity peak Ms = 1.29, a 0.65 s
     settling time and a derivative filter Tf = 27 ms, which a 100 Hz loop resolves (see the report figures).
     """

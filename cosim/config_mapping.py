@@ -32,17 +32,19 @@ def field_docs(cls: type) -> dict[str, str]:
     out: dict[str, str] = {}
     current = None
     for line in doc.splitlines():
-        m = _FIELD_DOC.match(line)
-        if m and m.group(1) in names:
-            current = m.group(1)
-            out[current] = m.group(2).strip()
-        elif current and line.startswith("  ") and line.strip():
+        # several fields may share a line, separated by 3+ spaces ("max_rate: rad/s. (0, 2]   max_accel: ...")
+        segments = [(seg, _FIELD_DOC.match(seg)) for seg in re.split(r"\s{3,}", line.strip())]
+        if segments[0][1] and segments[0][1].group(1) in names:
+            for seg, m in segments:
+                if m and m.group(1) in names:
+                    current = m.group(1)
+                    out[current] = m.group(2).strip()
+                elif current:
+                    out[current] += " " + seg
+        elif current and line.startswith(" ") and line.strip():
             out[current] += " " + line.strip()
         else:
             current = None
-    # several fields documented on one line ("max_rate: rad/s. (0, 2]   max_accel: ...")
-    for name, text in list(out.items()):
-        out[name] = re.split(r"\s{3,}[a-z_]+:", text)[0].strip()
     return out
 
 
@@ -66,6 +68,11 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
         if value not in allowed:
             raise InputError(f"{path}: must be one of {', '.join(map(repr, allowed))}, got {value!r}")
         return tp(value)
+    if origin is dict:
+        if not isinstance(value, dict):
+            raise InputError(f"{path}: must be a table, got {type(value).__name__}")
+        key_type, item = typing.get_args(tp)
+        return {str(k): _convert(v, item, f"{path}.{k}") for k, v in value.items()}
     if origin is tuple or tp is tuple:
         if not isinstance(value, list):
             raise InputError(f"{path}: must be an array, got {type(value).__name__}")
@@ -125,13 +132,30 @@ def _fill_table(table, obj: Any) -> None:
         if dataclasses.is_dataclass(value):
             nested.append((f.name, value, docs.get(f.name, "")))
             continue
+        if isinstance(value, dict):
+            sub = tomlkit.table()
+            if docs.get(f.name):
+                sub.add(tomlkit.comment(docs[f.name]))
+            for key, item in value.items():
+                entry = tomlkit.table()
+                _fill_table(entry, item)
+                sub.add(key, entry)
+            nested.append((f.name, sub, None))
+            continue
         if value is None:
             table.add(tomlkit.comment(f"{f.name} = (not set)  # {docs.get(f.name, '')}".rstrip("# ")))
             continue
-        table.add(f.name, _plain(value))
-        if docs.get(f.name):
-            table[f.name].comment(docs[f.name])
+        item = tomlkit.item(_plain(value))
+        text = docs.get(f.name, "")
+        if isinstance(value, enum.Enum):
+            text = f"{text} One of: {', '.join(repr(m.value) for m in type(value))}.".strip()
+        if text:
+            item.comment(text)
+        table.add(f.name, item)
     for name, value, doc in nested:
+        if doc is None:  # an already built table (a dict field)
+            table.add(name, value)
+            continue
         sub = tomlkit.table()
         if doc:
             sub.add(tomlkit.comment(doc))

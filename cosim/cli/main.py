@@ -1,8 +1,9 @@
 """Entry point of the ``cosim`` command.
 
 Each subcommand lives in its own module under ``cosim.cli`` and provides ``register(subparsers)`` (adds its parser,
-sets ``func``) and a ``run(args) -> int``. Bad input (:class:`InputError`) prints one line and exits with 2; a
-simulation that broke (:class:`SimulationError`) prints one line and exits with 1.
+sets ``func``) and a ``run(args) -> int``. Bad input (:class:`InputError`, or the controllers' own
+``ControllerInputError``) prints one line and exits with 2; a simulation that broke (:class:`SimulationError`, the
+controllers' ``MeasurementError``) prints one line and exits with 1; Ctrl-C exits with 130.
 """
 
 from __future__ import annotations
@@ -11,11 +12,14 @@ import argparse
 import importlib
 import sys
 
+from controllers.errors import ControllerInputError, MeasurementError
 from cosim import __version__
 from cosim.errors import InputError, SimulationError
 
 # Subcommand modules, in the order `cosim --help` lists them.
 SUBCOMMAND_MODULES: list[str] = [
+    "cosim.cli.pour",
+    "cosim.cli.scene",
     "cosim.cli.validate",
     "cosim.cli.replay",
     "cosim.cli.view",
@@ -43,12 +47,15 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return int(args.func(args) or 0)
-    except InputError as exc:
+    except (InputError, ControllerInputError) as exc:
         print(f"cosim {args.command}: error: {exc}", file=sys.stderr)
         return 2
-    except SimulationError as exc:
+    except (SimulationError, MeasurementError) as exc:
         print(f"cosim {args.command}: simulation failed: {exc}", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:
+        print(f"cosim {args.command}: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Callable, Protocol
+from typing import Callable
 
 import mujoco
 import numpy as np
@@ -29,23 +29,24 @@ from controllers.measurement import PourCommand
 from controllers.pour import PourController
 from cosim.coupling.exchange import ROLES, vessel_poses, wrench_at_body_com
 from cosim.coupling.measure import MeasurementGeometry, measure
+from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
 from cosim.coupling.settings import Coupling, CouplingSettings
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
+from cosim.robots.ik import ArmIK, IKSettings
 from cosim.robots.planar import PlanarPose
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.robots.vessel_mjcf import frame_site
+from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
+from cosim.trajectory.limits import ArmLimits
+from cosim.trajectory.recorder import TrajectoryRecorder
 
 CATCHER_TRAVEL = 0.15  # m each way along x: the catcher workspace the robot scene's IK is verified over
-
-
-class JointTrajectoryGenerator(Protocol):
-    """Per-arm joint trajectory generator stepped at the MuJoCo rate."""
-
-    def set_target(self, q: np.ndarray, qd: np.ndarray | None = None) -> None: ...
-
-    def step(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+# IK of the smoothed vessel targets: converged far below the trajectory checks' tolerances (looser solves add
+# solver noise that shows up as joint acceleration, trajectory tests).
+TARGET_IK = IKSettings(position_tolerance=1e-10, rotation_tolerance=1e-10, max_iterations=200)
 
 
 def coupled_step(
@@ -96,12 +97,22 @@ class CoupledPour:
         scene: RobotScene,
         fluid: FluidSolver,
         controller: PourController,
-        generators: dict[ArmRole, JointTrajectoryGenerator],
+        limits: dict[ArmRole, ArmLimits],
         geometry: MeasurementGeometry,
         settings: CouplingSettings,
+        pose_limits: PoseFilterLimits = PoseFilterLimits(),
+        sample_rate_hz: float = 500.0,
     ):
         self.scene, self.fluid, self.controller = scene, fluid, controller
-        self.generators = generators
+        dt = float(scene.model.opt.timestep)
+        gen_settings = GeneratorSettings(cycle_time=dt, control_period=controller.dt)
+        self.generators = {r: TrajectoryGenerator(limits[r], scene.joint_positions(r), gen_settings) for r in ROLES}
+        self.recorder = TrajectoryRecorder([self.generators[r] for r in ROLES], sample_rate_hz)
+        self.filters = {
+            ArmRole.POUR: PoseFilter("pourer_pose", ("dx", "dz", "theta"), pose_limits, controller.dt),
+            ArmRole.CATCH: PoseFilter("catcher_pose", ("dx",), pose_limits, controller.dt),
+        }
+        self._ik = {r: ArmIK(scene.model, scene.arms[r].joints, frame_site(scene.arms[r].vessel), scene.arms[r].home_q, TARGET_IK) for r in ROLES}
         self.geometry = geometry
         self.settings = settings
         self.dt = float(scene.model.opt.timestep)
@@ -125,6 +136,7 @@ class CoupledPour:
         for role in ROLES:
             q, qd, _ = self.generators[role].step()
             targets[role] = (q, qd)
+        self.recorder.record()
         self.wrench = coupled_step(scene, self.fluid, self.wrench, targets, self.settings)
         self.steps += 1
         self.time = self.steps * self.dt
@@ -141,9 +153,14 @@ class CoupledPour:
         cmd = self.controller.step(m)
         self.command = cmd
         targets = {ArmRole.POUR: cmd.pourer, ArmRole.CATCH: cmd.catcher}
+        smoothed = {}
         for role in ROLES:
             t = targets[role]
-            q = scene.solve_vessel_target(role, PlanarPose(t.dx, t.dz, t.theta), self._seed[role])
+            pose = self.filters[role](PlanarPose(t.dx, t.dz, t.theta))
+            smoothed[role] = pose
+            pos, quat = scene.vessel_target(role, pose)
+            label = f"{scene.arms[role].vessel.name} target (dx={pose.dx:.3f} m, dz={pose.dz:.3f} m, tilt={math.degrees(pose.theta):.1f} deg)"
+            q = self._ik[role].solve_or_raise(pos, quat, self._seed[role], label)
             self._seed[role] = q
             self.generators[role].set_target(q)
         in_catcher = last.volume_in_vessel[1] if last else 0.0
@@ -152,7 +169,8 @@ class CoupledPour:
             volume_in_pourer=in_pourer, volume_in_catcher=in_catcher, poured_volume=m.poured_volume,
             spilled_volume=last.spilled_volume if last else 0.0, lip_x=m.lip_x, lip_z=m.lip_z,
             landing_x=cmd.landing_x, phase=cmd.phase.value, target_theta=cmd.pourer.theta, target_dx=cmd.pourer.dx,
-            target_dz=cmd.pourer.dz, catcher_dx=cmd.catcher.dx, wrench_pourer=self.wrench[0].copy(),
+            target_dz=cmd.pourer.dz, smoothed_theta=smoothed[ArmRole.POUR].theta, catcher_dx=cmd.catcher.dx,
+            smoothed_catcher_dx=smoothed[ArmRole.CATCH].dx, wrench_pourer=self.wrench[0].copy(),
             wrench_catcher=self.wrench[1].copy(),
         )
 
@@ -220,13 +238,16 @@ def build_pour(
     scene: RobotScene,
     fluid_base: FluidConfig,
     pour_config: Callable[[VesselGeometry, CatcherConfig, float, float], PourConfig],
-    make_generator: Callable[[RobotScene, ArmRole, float], JointTrajectoryGenerator],
+    limits: dict[ArmRole, ArmLimits],
     fill_depth: float,
     settings: CouplingSettings = CouplingSettings(),
     device: str = "cpu",
+    pose_limits: PoseFilterLimits = PoseFilterLimits(),
+    sample_rate_hz: float = 500.0,
 ) -> CoupledPour:
     """Assemble a pour: the liquid filling the pourer at home to ``fill_depth``, the controller (built by
-    ``pour_config(vessel_geometry, catcher_config, actual_fill_depth, initial_volume)``) and a generator per arm.
+    ``pour_config(vessel_geometry, catcher_config, actual_fill_depth, initial_volume)``), the arms' trajectory
+    generators under ``limits``.
 
     The controller gets the liquid's actual fill (the lattice holds whole layers) and the wall thickness the
     liquid sees, so its geometry is the simulated one."""
@@ -243,5 +264,4 @@ def build_pour(
     catcher = CatcherConfig(home_x=float(scene.arms[ArmRole.CATCH].home_pos[0]), travel_min=-CATCHER_TRAVEL, travel_max=CATCHER_TRAVEL)
     controller = PourController(pour_config(geometry, catcher, actual_fill, initial_volume))
     mgeo = MeasurementGeometry(pourer, wall, specs[1].inner_height, cfg.smoothing_length, cfg.spacing, initial_volume, cfg.dim)
-    generators = {role: make_generator(scene, role, float(scene.model.opt.timestep)) for role in ROLES}
-    return CoupledPour(scene, fluid, controller, generators, mgeo, settings)
+    return CoupledPour(scene, fluid, controller, limits, mgeo, settings, pose_limits, sample_rate_hz)

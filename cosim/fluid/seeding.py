@@ -1,7 +1,7 @@
 """Initial particle sets: lattices filling a vessel or a box of liquid, with hydrostatic densities.
 
-Particles start on a square (cubic) lattice of spacing dx, at least dx/2 from every wall, with the density of a
-resting column (inverse Tait equation under the liquid above), so a vessel that starts full starts in
+Particles start on a square (cubic) lattice of spacing dx, at least dx/2 from the side walls and the floor, in
+the whole number of layers nearest to the requested depth, with the density of a resting column (inverse Tait equation under the liquid above), so a vessel that starts full starts in
 equilibrium instead of exploding.
 """
 
@@ -47,6 +47,12 @@ def _centred_axis(lo: float, hi: float, dx: float) -> np.ndarray:
     return start + dx * np.arange(n)
 
 
+def _layers(height: float, dx: float) -> int:
+    """Whole particle layers that represent a liquid ``height`` (m): the nearest count, so the represented height
+    n dx is within dx/2 of the requested one (rounding down would lose up to a layer)."""
+    return max(1, int(round(height / dx)))
+
+
 def hydrostatic_density(depth: np.ndarray, cfg: FluidConfig) -> np.ndarray:
     """Density (kg/m^3) at ``depth`` (m) below the free surface of a resting liquid: inverse Tait equation."""
     b = cfg.rest_density * cfg.sound_speed**2 / cfg.gamma
@@ -62,7 +68,7 @@ def liquid_block(lo, hi, cfg: FluidConfig, pose: Pose | None = None) -> Particle
     dx = cfg.spacing
     xs = _centred_axis(lo[0], hi[0], dx)
     ys = np.zeros(1) if cfg.dim == 2 else _centred_axis(lo[1], hi[1], dx)
-    n_z = int(math.floor((hi[2] - lo[2]) / dx + 1e-9))
+    n_z = _layers(hi[2] - lo[2], dx)
     zs = lo[2] + dx * (0.5 + np.arange(n_z))
     if len(xs) == 0 or len(ys) == 0 or n_z == 0:
         raise InputError(f"liquid block {lo.tolist()}..{hi.tolist()} m holds no particle at spacing {dx:g} m")
@@ -87,7 +93,8 @@ def fill_vessel(spec: VesselSpec, fill_depth: float, cfg: FluidConfig, pose: Pos
         local = block.positions
         keep = np.hypot(local[:, 0], local[:, 1]) <= r - 0.5 * dx
         local = local[keep]
-    n_z = int(math.floor(fill_depth / dx + 1e-9))
+    n_z = min(_layers(fill_depth, dx), int(math.floor(spec.inner_height / dx + 1e-9)))  # never above the rim
+    local = local[local[:, 2] < n_z * dx]
     return _place(local, n_z * dx - local[:, 2], cfg, pose)
 
 

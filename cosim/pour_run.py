@@ -1,0 +1,231 @@
+"""``cosim pour``: run one pour scene and write its outputs.
+
+Outputs, in a new run folder (``recordings/<UTC time>-<scene name>/``, never an earlier run's) or ``--out DIR``:
+``pour.rrd`` (Rerun recording, unless logging is off), ``trajectory.csv`` and ``trajectory.json`` (the arms' checked
+jerk-limited joint trajectories), ``summary.json`` (volumes, phases, timings, versions, the scene). Everything is
+written into a hidden temporary folder next to the destination and renamed into place only when the run
+succeeded, so a failed or interrupted run leaves no half-written folder behind.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import platform
+import shutil
+import tempfile
+import time
+from dataclasses import asdict, replace
+from datetime import datetime, timezone
+from importlib import metadata
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from tqdm import tqdm
+
+from controllers.config import CatcherConfig, CfsConfig, PourConfig
+from controllers.geometry import VesselGeometry
+from cosim.coupling.exchange import ROLES
+from cosim.coupling.loop import CoupledPour, build_pour
+from cosim.errors import InputError
+from cosim.frames import tilt_about_y
+from cosim.io.recording import PourRecorder
+from cosim.pour_scene import PourScene
+from cosim.robots.scene import RobotScene
+from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.export import write_trajectory_files
+from cosim.trajectory.limits import scene_limits
+
+DEFAULT_RECORDINGS = Path("recordings")
+VERSIONED_PACKAGES = ("cosim", "warp-lang", "mujoco", "numpy", "control", "ruckig", "rerun-sdk")
+
+
+def _controller_config(scene: PourScene, spacing: float):
+    """``pour_config`` callback of :func:`build_pour`: the scene's controller settings on the simulated geometry."""
+    c = scene.controller
+
+    def make(geometry: VesselGeometry, catcher: CatcherConfig, fill: float, volume: float) -> PourConfig:
+        h_q_ref = max(c.cfs.h_q_ref, c.stream_particles * spacing)
+        catcher = replace(
+            catcher, travel_min=-c.catcher.travel, travel_max=c.catcher.travel, max_speed=c.catcher.max_speed,
+            max_accel=c.catcher.max_accel, discharge_coefficient=c.catcher.discharge_coefficient,
+        )
+        target = scene.liquid.pour_fraction * volume if scene.liquid.pour_fraction < 1.0 else None
+        return PourConfig(
+            catcher=catcher, vessel=geometry, fill_depth=fill, target_volume=target, control_rate=c.control_rate,
+            start_time=scene.coupling.start_delay, sim=c.sim, approach=c.approach, cfs=replace(c.cfs, h_q_ref=h_q_ref),
+            returning=c.returning,
+        )
+
+    return make
+
+
+def prepare(scene: PourScene) -> CoupledPour:
+    """Build the pour (robots, liquid, controller, trajectory generators) for ``scene``; InputError on bad input."""
+    robots = RobotScene.load(scene.robots.scene or None)
+    pourer = robots.arms[ArmRole.POUR].vessel
+    if not scene.liquid.fill_depth < pourer.inner_height:
+        raise InputError(
+            f"liquid.fill_depth: must be in (0, {pourer.inner_height:g}) m (below the pourer's rim), got {scene.liquid.fill_depth:g}"
+        )
+    overrides = {}
+    for name, override in scene.trajectory.limits.items():
+        arm = name.split("/", 1)[0]
+        roles = {r.value: r for r in ArmRole}
+        if arm not in roles or "/" not in name:
+            raise InputError(f"trajectory.limits.{name}: must be '<arm>/<joint>' with <arm> one of {', '.join(roles)}")
+        overrides.setdefault(roles[arm], {})[name] = override
+    limits = scene_limits(robots, overrides)
+    base = scene.fluid.fluid_config(pourer.inner_width)
+    return build_pour(
+        robots, base, _controller_config(scene, base.spacing), limits, scene.liquid.fill_depth, scene.coupling,
+        scene.device, scene.controller.pose_filter, scene.trajectory.sample_rate_hz,
+    )
+
+
+def _new_run_folder(root: Path, name: str) -> Path:
+    stamp = datetime.now(timezone.utc).strftime("%Y%m%d-%H%M%S")
+    candidate = root / f"{stamp}-{name}"
+    k = 1
+    while candidate.exists():
+        k += 1
+        candidate = root / f"{stamp}-{name}-{k}"
+    return candidate
+
+
+def destination(out: Path | None, name: str) -> Path:
+    """The run folder to create: ``out`` (must not exist or be empty) or a new one under recordings/."""
+    if out is None:
+        return _new_run_folder(DEFAULT_RECORDINGS, name)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        raise InputError(f"--out: {out} already exists and is not an empty folder (runs never overwrite each other)")
+    return out
+
+
+class _SignalLogger:
+    """Feeds the recorder from the pour: states at the recording rate, signals and phases at control steps."""
+
+    def __init__(self, pour: CoupledPour, recorder: PourRecorder):
+        self.pour, self.rec = pour, recorder
+        self.fk = mujoco.MjData(pour.scene.model)
+        self.phase = None
+        self.rows = 0
+
+    def commanded_tilt(self) -> float:
+        """Pourer tilt (rad) of the commanded joint trajectory at its current time (forward kinematics)."""
+        scene, fk = self.pour.scene, self.fk
+        for role in ROLES:
+            fk.qpos[scene.arms[role].qpos_adr] = self.pour.generators[role].state[0]
+        mujoco.mj_kinematics(scene.model, fk)
+        return tilt_about_y(fk.xmat[scene.arms[ArmRole.POUR].vessel_body].reshape(3, 3))
+
+    def __call__(self, pour: CoupledPour) -> None:
+        t, step = pour.time, pour.steps
+        if self.rec.state_due(t):
+            fluid = pour.fluid
+            self.rec.log_state(t, step, pour.scene.data, fluid.positions(), np.linalg.norm(fluid.velocities(), axis=1), active=fluid.active_mask())
+        rows = pour.log.rows
+        if len(rows.get("t", ())) == self.rows:
+            return
+        self.rows = len(rows["t"])
+        values = {
+            "pourer/theta": self.commanded_tilt(),
+            "pourer/theta_measured": rows["tilt"][-1],
+            "pourer/theta1": rows["theta1"][-1],
+            "slosh/h_q": rows["h_q"][-1],
+            "slosh/v_q": rows["v_q"][-1],
+            "volume/in_pourer": rows["volume_in_pourer"][-1],
+            "volume/in_catcher": rows["volume_in_catcher"][-1],
+            "volume/outside": pour.geometry.initial_volume - rows["volume_in_pourer"][-1] - rows["volume_in_catcher"][-1],
+            "catcher/landing_x": rows["landing_x"][-1],
+        }
+        for vessel, w in (("pourer", rows["wrench_pourer"][-1]), ("catcher", rows["wrench_catcher"][-1])):
+            for k, axis in enumerate(("force_x", "force_y", "force_z", "torque_x", "torque_y", "torque_z")):
+                values[f"wrench/{vessel}/{axis}"] = float(w[k])
+        for role in ROLES:
+            q, qd, _ = pour.generators[role].state
+            for j, name in enumerate(pour.scene.arms[role].joints):
+                values[f"joints/{name}.pos"] = float(q[j])
+                values[f"joints/{name}.vel"] = float(qd[j])
+        self.rec.log_scalars(pour.generators[ArmRole.POUR].time, step, values)
+        if rows["phase"][-1] != self.phase:
+            self.phase = rows["phase"][-1]
+            reason = pour.command.reason if pour.command else ""
+            self.rec.log_phase(t, step, self.phase, reason)
+
+
+def _versions() -> dict[str, str]:
+    out = {"python": platform.python_version()}
+    for name in VERSIONED_PACKAGES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = "not installed"
+    return out
+
+
+def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -> tuple[Path, dict]:
+    """Run ``scene`` and write its outputs; returns (run folder, summary)."""
+    final = destination(out, scene.name)
+    pour = prepare(scene)
+    final.parent.mkdir(parents=True, exist_ok=True)
+    work = Path(tempfile.mkdtemp(prefix=f".{final.name}.partial-", dir=final.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(work, 0o777 & ~umask)  # mkdtemp makes it private; the run folder gets the usual permissions
+    recorder = None
+    try:
+        callbacks = []
+        if scene.logging.enabled:
+            recorder = PourRecorder(work / "pour.rrd", pour.scene.model, scene.logging.recording, particle_radius=0.5 * pour.fluid.config.spacing)
+            callbacks.append(_SignalLogger(pour, recorder))
+        bar = tqdm(total=round(scene.coupling.max_duration, 3), unit="s sim", disable=not progress, mininterval=1.0,
+                   bar_format="{l_bar}{bar}| {n:.2f}/{total:.1f} s sim [{elapsed}<{remaining}{postfix}]")
+        shown = [0.0]
+
+        def on_step(p: CoupledPour) -> None:
+            for cb in callbacks:
+                cb(p)
+            if progress and p.time - shown[0] >= 0.1:
+                bar.update(p.time - shown[0])
+                shown[0] = p.time
+                rtf = p.time / p.wall_time if p.wall_time else 0.0
+                bar.set_postfix_str(f"{p.command.phase.value if p.command else 'start'}, RTF {rtf:.3f}", refresh=False)
+
+        summary = pour.run(on_step)
+        bar.close()
+        if recorder is not None:
+            recorder.log_state(pour.time, pour.steps, pour.scene.data, pour.fluid.positions(),
+                               np.linalg.norm(pour.fluid.velocities(), axis=1), active=pour.fluid.active_mask(), force=True)
+            recorder.close()
+        trajectory = pour.recorder.trajectory()
+        write_trajectory_files(trajectory, pour.recorder.limits, pour.recorder.sample_rate_hz, work / "trajectory.csv", work / "trajectory.json")
+        summary.update(
+            scene_name=scene.name,
+            device=str(pour.fluid.device),
+            dim=pour.fluid.config.dim,
+            particle_spacing=pour.fluid.config.spacing,
+            trajectory={
+                "duration": float(trajectory.time[-1]),
+                "samples": int(len(trajectory.time)),
+                "sample_rate_hz": pour.recorder.sample_rate_hz,
+                "late_targets": {r.value: pour.generators[r].late_targets for r in ROLES},
+                "max_target_error_rad": {r.value: pour.generators[r].max_target_error for r in ROLES},
+                "clamped_targets": {r.value: pour.generators[r].clamped_targets for r in ROLES},
+            },
+            versions=_versions(),
+            outputs=sorted(p.name for p in work.iterdir()) + ["summary.json"],
+            scene=json.loads(json.dumps(asdict(scene), default=lambda o: getattr(o, "value", str(o)))),
+        )
+        (work / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
+        if final.exists():
+            final.rmdir()  # an empty --out folder
+        os.replace(work, final)
+        return final, summary
+    except BaseException:
+        if recorder is not None:
+            recorder.abort()
+        shutil.rmtree(work, ignore_errors=True)
+        raise

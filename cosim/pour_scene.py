@@ -1,0 +1,210 @@
+"""The pour scene: everything ``cosim pour`` needs, as frozen dataclasses that map 1:1 onto a TOML file.
+
+``cosim scene --dump`` prints the embedded default (:class:`PourScene` with its defaults) as TOML, every field
+commented with its unit and range; a user's file only needs the keys it changes. Sections: ``liquid`` (fill and how
+much to pour), ``fluid`` (SPH resolution and numerics), ``controller`` (the seed's SIM, PID, CFS and catcher, from
+``controllers.config``), ``coupling``, ``trajectory`` (sampling and joint-limit overrides), ``logging`` (Rerun),
+``robots`` (the MuJoCo scene).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from controllers.config import ApproachConfig, CfsConfig, ReturnConfig, SimConfig
+from cosim.checks import check_device, check_int, check_positive, check_range
+from cosim.config_mapping import from_mapping, to_toml
+from cosim.coupling.pose_filter import PoseFilterLimits
+from cosim.coupling.settings import CouplingSettings
+from cosim.errors import InputError
+from cosim.fluid.config import FluidConfig, KernelType
+from cosim.io.recording import RecordingConfig
+from cosim.trajectory.limits import JointLimitOverride
+
+
+@dataclass(frozen=True)
+class LiquidSettings:
+    """fill_depth: m, liquid depth in the upright pourer; the seed's A = 0.1591 m. (0, pourer inner height)
+    pour_fraction: fraction of the liquid to pour; 1 pours until the pourer is empty. (0, 1]
+    """
+
+    fill_depth: float = 0.1591
+    pour_fraction: float = 1.0
+
+    def __post_init__(self) -> None:
+        check_positive("liquid.fill_depth", self.fill_depth, "m", 2.0)
+        check_range("liquid.pour_fraction", self.pour_fraction, 0.0, 1.0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class FluidSettings:
+    """dim: 2 (liquid in the pour plane, times the pourer's depth) or 3. [2, 3]
+    particles_across: particles across the pourer's inner width; sets the spacing dx = B / n. [8, 400]
+    kernel: 'wendland_c2' or 'cubic_spline' (the seed's).
+    smoothing_ratio: h / dx. [1.0, 2.5]
+    cfl: Courant number of the acoustic time step. (0, 0.6]
+    sound_speed_factor: c0 / expected maximum speed (>= 10 keeps density errors near 1 %). [10, 100]
+    artificial_viscosity: Monaghan alpha. [0, 1]
+    density_diffusion: delta-SPH delta. [0, 1]
+    kinematic_viscosity: m^2/s (water 1e-6). [0, 0.01]
+    max_density_error: compression that counts as an instability (impacts reach about v / c0). (0, 1]
+    """
+
+    dim: int = 2
+    particles_across: int = 32
+    kernel: KernelType = KernelType.WENDLAND_C2
+    smoothing_ratio: float = 1.5
+    cfl: float = 0.25
+    sound_speed_factor: float = 10.0
+    artificial_viscosity: float = 0.01
+    density_diffusion: float = 0.1
+    kinematic_viscosity: float = 1.0e-6
+    max_density_error: float = 0.3
+
+    def __post_init__(self) -> None:
+        check_int("fluid.dim", self.dim, 2, 3)
+        check_int("fluid.particles_across", self.particles_across, 8, 400)
+
+    def fluid_config(self, pourer_width: float) -> FluidConfig:
+        """The solver configuration (domain and expected speed are set from the robot scene by the coupling)."""
+        return FluidConfig(
+            dim=self.dim,
+            spacing=pourer_width / self.particles_across,
+            kernel=self.kernel,
+            smoothing_ratio=self.smoothing_ratio,
+            cfl=self.cfl,
+            sound_speed_factor=self.sound_speed_factor,
+            artificial_viscosity=self.artificial_viscosity,
+            density_diffusion=self.density_diffusion,
+            kinematic_viscosity=self.kinematic_viscosity,
+            max_density_error=self.max_density_error,
+        )
+
+
+@dataclass(frozen=True)
+class CatcherSettings:
+    """travel: m, how far vessel B may move each way along x from home (the robot scene verifies +-0.15 m). (0, 0.15]
+    max_speed: m/s. (0, 2]   max_accel: m/s^2. (0, 20]
+    discharge_coefficient: C_d of the weir estimate used to place vessel B before the outflow starts. (0, 1]
+    """
+
+    travel: float = 0.15
+    max_speed: float = 0.2
+    max_accel: float = 0.5
+    discharge_coefficient: float = 0.6
+
+    def __post_init__(self) -> None:
+        check_positive("controller.catcher.travel", self.travel, "m", 0.15)
+
+
+@dataclass(frozen=True)
+class ControllerSettings:
+    """control_rate: Hz, rate of the pour controller. [20, 500]
+    stream_particles: the CFS liquid height over the crest is at least this many particle spacings, so that the
+      stream is resolved (the seed holds it near the smoothing length). [0, 10]
+    sim: slosh induction (seed Fig. 7).
+    approach: tilt toward the crest without SIM.
+    cfs: constant-flow stage (seed Sec. 3.2).
+    returning: back upright after the pour.
+    catcher: vessel B's motion.
+    pose_filter: task-space limits of the vessel targets before inverse kinematics.
+    """
+
+    control_rate: float = 100.0
+    stream_particles: float = 2.5
+    sim: SimConfig = field(default_factory=SimConfig)
+    approach: ApproachConfig = field(default_factory=ApproachConfig)
+    cfs: CfsConfig = field(default_factory=CfsConfig)
+    returning: ReturnConfig = field(default_factory=ReturnConfig)
+    catcher: CatcherSettings = field(default_factory=CatcherSettings)
+    pose_filter: PoseFilterLimits = field(default_factory=PoseFilterLimits)
+
+    def __post_init__(self) -> None:
+        check_range("controller.control_rate", self.control_rate, 20.0, 500.0, "Hz")
+        check_range("controller.stream_particles", self.stream_particles, 0.0, 10.0)
+
+
+@dataclass(frozen=True)
+class TrajectorySettings:
+    """sample_rate_hz: Hz, rate of the exported joint trajectories. (0, 10000]
+    limits: per-joint overrides of the arms' limits, keyed '<arm>/<joint>' (e.g. 'pour_arm/elbow'), each with
+      max_velocity (rad/s), max_acceleration (rad/s^2), max_jerk (rad/s^3), min_position, max_position (rad).
+    """
+
+    sample_rate_hz: float = 500.0
+    limits: dict[str, JointLimitOverride] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        check_positive("trajectory.sample_rate_hz", self.sample_rate_hz, "Hz", 10000.0)
+
+
+@dataclass(frozen=True)
+class LoggingSettings:
+    """enabled: write the Rerun recording pour.rrd.
+    recording: what goes into it (particle decimation, rate, colour scale).
+    """
+
+    enabled: bool = True
+    recording: RecordingConfig = field(default_factory=lambda: RecordingConfig(particle_rate_hz=30.0))
+
+
+@dataclass(frozen=True)
+class RobotSettings:
+    """scene: path of a MuJoCo scene written by the project's scene builder ('' = the default two-UR10e scene)."""
+
+    scene: str = ""
+
+
+@dataclass(frozen=True)
+class PourScene:
+    """name: used in the run folder's name. [letters, digits, '-', '_']
+    device: 'cpu' or 'cuda[:N]'.
+    liquid: fill and pour amount.
+    fluid: SPH resolution and numerics.
+    controller: the pour controller.
+    coupling: MuJoCo <-> liquid coupling and run length.
+    trajectory: exported joint trajectories.
+    logging: the Rerun recording.
+    robots: the MuJoCo scene.
+    """
+
+    name: str = "seed-pour"
+    device: str = "cpu"
+    liquid: LiquidSettings = field(default_factory=LiquidSettings)
+    fluid: FluidSettings = field(default_factory=FluidSettings)
+    controller: ControllerSettings = field(default_factory=ControllerSettings)
+    coupling: CouplingSettings = field(default_factory=lambda: CouplingSettings(max_duration=60.0))
+    trajectory: TrajectorySettings = field(default_factory=TrajectorySettings)
+    logging: LoggingSettings = field(default_factory=LoggingSettings)
+    robots: RobotSettings = field(default_factory=RobotSettings)
+
+    def __post_init__(self) -> None:
+        if not self.name or not all(c.isalnum() or c in "-_" for c in self.name):
+            raise InputError(f"scene.name: must be letters, digits, '-' or '_', got {self.name!r}")
+        check_device("scene.device", self.device)
+
+
+def load_scene(path: str | Path) -> PourScene:
+    """Read a scene TOML file; any problem is one InputError line naming the file and the field."""
+    path = Path(path)
+    try:
+        table = tomllib.loads(path.read_text())
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read the scene file ({exc.strerror})") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not a valid TOML file ({exc})") from None
+    try:
+        return from_mapping(PourScene, table, "scene")
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
+
+
+def dump_scene(scene: PourScene) -> str:
+    """The scene as a documented TOML document."""
+    header = (
+        "cosim pour scene. Units: SI (m, s, kg, rad). Every key is optional: a file only needs what it changes.\n"
+        "Run it with: cosim pour THIS_FILE.toml"
+    )
+    return to_toml(scene, header)
