@@ -101,7 +101,7 @@ def test_instability_is_raised_naming_the_step_and_the_cause():
         for _ in range(100):
             solver.advance(0.01)
     assert isinstance(err.value.step, int) and err.value.time > 0.0
-    assert str(err.value).startswith(f"SPH step {err.value.step} ") and "density error" in str(err.value)
+    assert str(err.value).startswith(f"SPH step {err.value.step} ") and "compression" in str(err.value)
 
 
 @pytest.mark.parametrize(
