@@ -63,7 +63,7 @@ class VesselGeometry:
 
     inner_width: B, along the pour direction (vessel x). (0, 2]
     inner_height: L, floor to rim (vessel z). (0, 2]
-    wall_thickness: t. [0, 0.05]
+    wall_thickness: t. [0, 0.2]
     inner_depth: perpendicular to the pour plane (vessel y); volume = area in the pour plane * inner_depth. (0, 2]
     """
 
@@ -75,7 +75,7 @@ class VesselGeometry:
     def __post_init__(self) -> None:
         check_range("vessel.inner_width", self.inner_width, 0.0, 2.0, "m", lo_open=True)
         check_range("vessel.inner_height", self.inner_height, 0.0, 2.0, "m", lo_open=True)
-        check_range("vessel.wall_thickness", self.wall_thickness, 0.0, 0.05, "m")
+        check_range("vessel.wall_thickness", self.wall_thickness, 0.0, 0.2, "m")
         check_range("vessel.inner_depth", self.inner_depth, 0.0, 2.0, "m", lo_open=True)
 
     @property

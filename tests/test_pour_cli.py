@@ -1,0 +1,164 @@
+"""`cosim pour` contract on a coarse, short pour: outputs, recording read-back, exported trajectory (independent
+numerical differentiation, limits, replay), determinism, and bad input (one line, exit 2, nothing written)."""
+
+import json
+import subprocess
+import sys
+
+import mujoco
+import numpy as np
+import pytest
+
+from cosim.cli.main import main
+from cosim.frames import tilt_about_y
+from cosim.io.rerun_read import entity_paths, read_scalar_series
+from cosim.io.trajectory_csv import read_trajectory_csv
+from cosim.io.trajectory_json import read_trajectory_json
+from cosim.robots.scene import RobotScene
+from cosim.robots.scene_config import ArmRole
+
+COARSE = """
+name = "test-pour"
+[fluid]
+particles_across = 10
+[coupling]
+max_duration = {duration}
+[logging.recording]
+particle_rate_hz = 20.0
+"""
+# Central differences of samples h = 1/500 s apart of a trajectory whose jerk is bounded by J (Taylor with integral
+# remainder): positions -> velocity within J h^2 / 6 (the second-order terms cancel); velocities -> acceleration within
+# J h / 2 (the remainders only cancel where the jerk does not change over [t - h, t + h]; ruckig switches it at every
+# re-plan); plus float round-off of the CSV's 9 significant digits.
+SAMPLE_SPACING = 1.0 / 500.0
+ROUND_OFF = 1e-6
+LIMIT_TOLERANCE = 1e-6  # relative slack on the limits (float round-off of the checks)
+REPLAY_TOLERANCE_M = 0.002  # issue "The main job": replay tracks the vessel path within 2 mm
+
+
+def _pour(tmp_path, name, duration=0.6, extra=()):
+    scene = tmp_path / f"{name}.toml"
+    scene.write_text(COARSE.format(duration=duration))
+    out = tmp_path / name
+    assert main(["pour", str(scene), "--out", str(out), "--quiet", *extra]) == 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    return _pour(tmp_path_factory.mktemp("pour"), "run", duration=0.8)
+
+
+def test_outputs_and_summary(run):
+    assert sorted(p.name for p in run.iterdir()) == ["pour.rrd", "summary.json", "trajectory.csv", "trajectory.json"]
+    summary = json.loads((run / "summary.json").read_text())
+    for key in ("initial_volume", "poured_volume", "spilled_volume", "phases", "sim_time", "wall_time", "real_time_factor", "device", "versions"):
+        assert key in summary
+    assert summary["initial_volume"] > 0 and summary["sim_time"] == pytest.approx(0.8)
+    assert [p["phase"] for p in summary["phases"]][0] == "idle"
+
+
+def test_recording_verifies_and_its_theta_is_the_trajectorys(run):
+    rrd = run / "pour.rrd"
+    verify = subprocess.run([sys.executable, "-m", "rerun", "rrd", "verify", str(rrd)], capture_output=True, text=True)
+    assert verify.returncode == 0, verify.stderr
+    paths = entity_paths(rrd)
+    assert "/world/liquid" in paths and "/signals/pourer/theta" in paths and "/events/phase" in paths
+    theta = read_scalar_series(rrd, "pourer/theta")
+    traj = read_trajectory_csv(run / "trajectory.csv")
+    scene = RobotScene.load()
+    arm = scene.arms[ArmRole.POUR]
+    cols = [traj.joint_names.index(j) for j in arm.joints]
+    data = mujoco.MjData(scene.model)
+    checked = 0
+    for t, logged in zip(theta.sim_time, theta.values):
+        k = int(np.argmin(np.abs(traj.time - t)))
+        if abs(traj.time[k] - t) > 1e-9:
+            continue
+        data.qpos[arm.qpos_adr] = traj.positions[k, cols]
+        mujoco.mj_kinematics(scene.model, data)
+        assert logged == pytest.approx(tilt_about_y(data.xmat[arm.vessel_body].reshape(3, 3)), abs=1e-9)
+        checked += 1
+    assert checked >= 0.9 * len(theta.values) > 50
+
+
+def test_exported_trajectory_differentiates_consistently_and_holds_every_limit(run):
+    traj = read_trajectory_csv(run / "trajectory.csv")
+    doc = json.loads((run / "trajectory.json").read_text())
+    h = float(np.diff(traj.time).mean())
+    assert h == pytest.approx(SAMPLE_SPACING)
+    q, qd, qdd = traj.positions, traj.velocities, traj.accelerations
+    qd_fd = (q[2:] - q[:-2]) / (2 * h)
+    qdd_fd = (qd[2:] - qd[:-2]) / (2 * h)
+    limits = {}
+    for arm in doc["arms"].values():
+        for k, name in enumerate(arm["joint_names"]):
+            limits[name] = {f: arm["limits"][f][k] for f in arm["limits"]}
+    for j, name in enumerate(traj.joint_names):
+        lim = limits[name]
+        jerk = lim["max_jerk"]
+        assert np.abs(qd_fd[:, j] - qd[1:-1, j]).max() <= jerk * h * h / 6 + ROUND_OFF
+        assert np.abs(qdd_fd[:, j] - qdd[1:-1, j]).max() <= jerk * h / 2 + ROUND_OFF
+        assert np.abs(qd[:, j]).max() <= lim["max_velocity"] * (1 + LIMIT_TOLERANCE)
+        assert np.abs(qdd[:, j]).max() <= lim["max_acceleration"] * (1 + LIMIT_TOLERANCE)
+        assert np.abs(np.diff(qdd[:, j]) / h).max() <= jerk * (1 + LIMIT_TOLERANCE)
+        assert lim["min_position"] <= q[:, j].min() and q[:, j].max() <= lim["max_position"]
+    assert read_trajectory_json(run / "trajectory.json") is not None
+
+
+def test_replay_tracks_the_vessel_path(run, capsys):
+    assert main(["replay", str(run / "trajectory.csv"), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["max_error_m"] <= REPLAY_TOLERANCE_M
+
+
+def test_same_scene_twice_gives_byte_identical_trajectories(tmp_path):
+    a = _pour(tmp_path, "a", 0.4, ("--no-log",))
+    b = _pour(tmp_path, "b", 0.4, ("--no-log",))
+    for name in ("trajectory.csv", "trajectory.json"):
+        assert (a / name).read_bytes() == (b / name).read_bytes()
+    assert not (a / "pour.rrd").exists()
+
+
+@pytest.mark.parametrize(
+    "toml, field",
+    [
+        ("[fluid]\nparticle_across = 10\n", "scene.fluid.particle_across"),
+        ("[fluid]\nparticles_across = 'ten'\n", "scene.fluid.particles_across"),
+        ("[liquid]\nfill_depth = -0.1\n", "liquid.fill_depth"),
+        ("[liquid]\nfill_depth = 0.5\n", "liquid.fill_depth"),
+        ("[liquid]\nfill_depth = nan\n", "liquid.fill_depth"),
+        ("[controller.cfs]\nh_q_ref = 1.0\n", "cfs.h_q_ref"),
+        ("device = 'tpu'\n", "scene.device"),
+        ("this is not toml", "not a valid TOML file"),
+    ],
+)
+def test_bad_scene_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, toml, field):
+    scene = tmp_path / "bad.toml"
+    scene.write_text(toml)
+    out = tmp_path / "out"
+    assert main(["pour", str(scene), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and field in err[0]
+    assert not out.exists() and not list(tmp_path.glob(".out*"))
+
+
+def test_unreadable_scene_file_and_busy_output_folder(tmp_path, capsys):
+    assert main(["pour", str(tmp_path / "missing.toml"), "--quiet"]) == 2
+    busy = tmp_path / "busy"
+    busy.mkdir()
+    (busy / "x").write_text("earlier run")
+    assert main(["pour", "--out", str(busy), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and "missing.toml" in err[0] and "busy" in err[1]
+    assert (busy / "x").read_text() == "earlier run"
+
+
+def test_scene_dump_round_trips(tmp_path, capsys):
+    assert main(["scene", "--dump"]) == 0
+    text = capsys.readouterr().out
+    assert "particles_across" in text and "# m, liquid depth" in text
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    assert main(["scene", "--check", str(path)]) == 0
+    assert capsys.readouterr().out == text
