@@ -125,5 +125,5 @@ def test_height_above_is_the_world_vertical_distance() -> None:
 def test_vessel_validation() -> None:
     from controllers.errors import ControllerInputError
 
-    with pytest.raises(ControllerInputError, match=r"^vessel\.wall_thickness: must be in \[0, 0\.05\] m, got 0\.1$"):
-        VesselGeometry(wall_thickness=0.1)
+    with pytest.raises(ControllerInputError, match=r"^vessel\.wall_thickness: must be in \[0, 0\.2\] m, got 0\.3$"):
+        VesselGeometry(wall_thickness=0.3)

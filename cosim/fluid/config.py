@@ -46,8 +46,7 @@ class FluidConfig:
     sound_speed_factor: c0 / max_expected_speed. [10, 100] (>= 10 keeps |rho - rho0|/rho0 ~ 1 %)
     kinematic_viscosity: m^2/s, laminar viscosity (water 1.0e-6 at 20 C). [0, 0.01]
     artificial_viscosity: Monaghan alpha (dimensionless), also applied against walls. [0, 1]
-    density_diffusion: delta of delta-SPH (Molteni & Colagrossi 2009; hydrostatic correction of Fourtakas et
-        al. 2019). [0, 1]
+    density_diffusion: delta of delta-SPH (Antuono et al. 2010, renormalised density gradient). [0, 1]
     cfl: Courant number of the acoustic CFL step; 0.25 x of it for the force criterion. (0, 0.6]
     depth_2d: m, liquid thickness perpendicular to the pour plane in 2-D (the pouring vessel's depth): masses,
         volumes and wrenches reported to the outside are per unit depth times this. (0, 2]

@@ -120,6 +120,7 @@ class FluidSolver:
         wp.launch(wcsph.equation_of_state, dim=n, inputs=[m.params, self.state.rho], outputs=[self.state.p], device=d)
         self._drho = wp.zeros(n, dtype=float, device=d)
         self._acc = wp.zeros(n, dtype=wp.vec3, device=d)
+        self._rho_grad = wp.zeros(n, dtype=wp.vec3, device=d)
         self._wall_force = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
         self._wall_torque = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
         self._partial_force = wp.zeros((v_count, WRENCH_CHUNKS), dtype=wp.vec3, device=d)
@@ -267,12 +268,12 @@ class FluidSolver:
                 self._bx, self._bv, self._b_p, self._b_rho, self._b_v_noslip,
                 m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, self._row,
             ],
-            [self._acc, self._wall_force, self._wall_torque, self._diag_f],
+            [self._acc, self._rho_grad, self._wall_force, self._wall_torque, self._diag_f],
         ))
         ops.append(rec(
             wcsph.compute_density_rate, n,
             [
-                prm, m.grid.spec, m.b_volume, dst.x, dst.v, self._acc, dst.rho, dst.active, self._dt,
+                prm, m.grid.spec, m.b_volume, dst.x, dst.v, self._acc, dst.rho, self._rho_grad, dst.active, self._dt,
                 m.grid.cell_start, m.grid.cell_end, self._bx, self._bv, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end,
             ],
             [self._drho],

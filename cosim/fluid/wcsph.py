@@ -7,10 +7,10 @@ compute_forces: per particle, over fluid and wall neighbours,
   - the reaction on each vessel: -m a_ib summed per particle, and its moment about the vessel's centre of mass,
     stored per particle so they can be reduced in a fixed order (deterministic on every device).
 compute_density_rate: continuity equation (liquid and wall particles) evaluated with the kicked velocities, plus
-  delta-SPH diffusion (Molteni & Colagrossi 2009) of the density minus its hydrostatic part (Fourtakas et al.
-  2019, here with the EOS's local slope dp/drho), so a resting column keeps its hydrostatic density profile.
+  delta-SPH diffusion with the renormalised density gradient of Antuono et al. (2010), so a resting column keeps
+  its hydrostatic density profile and loose liquid exchanges nothing.
 integrate: symplectic Euler, i.e. leapfrog with velocities at half steps: v += dt a(rho_n); rho += dt
-  Drho(v_new), floored at rho0 (no tension, see the kernel); x += dt v_new. (Updating rho with the old velocity instead would be forward Euler for the acoustic
+  Drho(v_new) (safety floor 0.8 rho0, see the kernel); x += dt v_new; p from the Tait equation. (Updating rho with the old velocity instead would be forward Euler for the acoustic
   waves and amplify them every step.) Then the wall guard, deactivation outside the domain, the equation of
   state and the substep's diagnostics.
 """
@@ -35,6 +35,11 @@ from cosim.fluid.diagnostics import (
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_dw
+
+# The renormalisation matrix L^-1 (identity for a full kernel support) is used only where det L exceeds this:
+# near-empty supports (spray, a lone particle) give no meaningful density gradient.
+RENORMALISATION_MIN_DET = wp.constant(0.05)
+MIN_DENSITY_RATIO = wp.constant(0.8)
 
 
 @wp.func
@@ -71,24 +76,33 @@ def compute_forces(
     row: wp.array(dtype=wp.int32),
     # Out
     acc: wp.array(dtype=wp.vec3),
+    rho_grad: wp.array(dtype=wp.vec3),
     wall_force: wp.array2d(dtype=wp.vec3),
     wall_torque: wp.array2d(dtype=wp.vec3),
     diag_f: wp.array2d(dtype=float),
 ):
-    """Acceleration of each particle and the reaction it exerts on each vessel (per particle, reduced later)."""
+    """Acceleration of each particle, the reaction it exerts on each vessel (per particle, reduced later) and its
+    renormalised density gradient <grad rho>^L = L^-1 sum_j V_j (rho_j - rho_i) grad W, L = sum_j V_j (x_j - x_i)
+    (x) grad W (Antuono et al. 2010; liquid neighbours only; zero where L is too ill-conditioned to invert)."""
     i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
     if active[i] == 0:
         acc[i] = wp.vec3(0.0)
+        rho_grad[i] = wp.vec3(0.0)
         return
     xi = x[i]
     vi = v[i]
     rhoi = rho[i]
     pi_term = p[i] / (rhoi * rhoi)
+    # walls only push: a particle's tension (p < 0) must not pull it onto a wall (it would crawl along overhanging
+    # outer faces, an artificial teapot effect); the walls' own pressure is clamped at 0 when extrapolated
+    pi_wall_term = wp.max(p[i], 0.0) / (rhoi * rhoi)
     support2 = prm.support * prm.support
     a = wp.vec3(0.0)
+    moment = wp.mat33(0.0)
+    gsum = wp.vec3(0.0)
     c = grid_cell(g, xi)
     for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
         for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
@@ -103,6 +117,9 @@ def compute_forces(
                     gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
                     vij = vi - v[j]
                     rhoj = rho[j]
+                    vol = prm.mass / rhoj
+                    moment += vol * wp.outer(-r, gw)
+                    gsum += (vol * (rhoj - rhoi)) * gw
                     a -= prm.mass * (pi_term + p[j] / (rhoj * rhoj)) * gw
                     vr = wp.dot(vij, r)
                     if vr < 0.0:
@@ -120,7 +137,7 @@ def compute_forces(
                     gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
                     mw = prm.rest_density * b_volume[b]
                     rhob = b_rho[b]
-                    ab = -(mw * (pi_term + b_p[b] / (rhob * rhob))) * gw
+                    ab = -(mw * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
                     vr = wp.dot(vi - bv[b], r)
                     if vr < 0.0:
                         mu = prm.h * vr / (r2 + prm.eta2)
@@ -135,6 +152,12 @@ def compute_forces(
                     wall_torque[kv, i] = wall_torque[kv, i] + wp.cross(xb - com, f_vessel)
     a += prm.gravity
     acc[i] = a
+    if prm.dim == 2:
+        moment[1, 1] = 1.0
+    grad = wp.vec3(0.0)
+    if wp.determinant(moment) > RENORMALISATION_MIN_DET:
+        grad = wp.inverse(moment) @ gsum
+    rho_grad[i] = grad
     wp.atomic_max(diag_f, row[0], DIAG_MAX_ACCEL, wp.length(a))
 
 
@@ -149,6 +172,7 @@ def compute_density_rate(
     v: wp.array(dtype=wp.vec3),
     acc: wp.array(dtype=wp.vec3),
     rho: wp.array(dtype=float),
+    rho_grad: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
     dt: wp.array(dtype=float),
     cell_start: wp.array(dtype=wp.int32),
@@ -162,7 +186,9 @@ def compute_density_rate(
     drho: wp.array(dtype=float),
 ):
     """Density rate from the continuity equation with the KICKED velocities v + dt a (symplectic: the density
-    sees the velocity it is integrated with), plus delta-SPH diffusion with the hydrostatic correction."""
+    sees the velocity it is integrated with), plus delta-SPH diffusion (Antuono et al. 2010):
+    delta h c0 sum_j V_j [2 (rho_i - rho_j) r_ij . grad W / (r^2 + eta^2) - (<grad rho>_i + <grad rho>_j) . grad W],
+    which vanishes for any linear density field (a resting column) and conserves mass between pairs."""
     i = wp.tid()
     if active[i] == 0:
         drho[i] = 0.0
@@ -172,10 +198,8 @@ def compute_density_rate(
     vi = v[i] + h * acc[i]
     rhoi = rho[i]
     support2 = prm.support * prm.support
-    # hydrostatic density difference per metre along gravity at this density: rho / (dp/drho), with
-    # dp/drho = c0^2 (rho/rho0)^(gamma-1) from the Tait EOS (the local slope, not c0^2: keeps deep water exact)
-    hydro_slope = rhoi / (prm.sound_speed * prm.sound_speed * wp.pow(rhoi / prm.rest_density, prm.gamma - 1.0))
-    diffusion = 2.0 * prm.delta * prm.h * prm.sound_speed
+    grad_i = rho_grad[i]
+    diffusion = prm.delta * prm.h * prm.sound_speed
     dr = float(0.0)
     c = grid_cell(g, xi)
     for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
@@ -192,8 +216,8 @@ def compute_density_rate(
                     vij = vi - (v[j] + h * acc[j])
                     rhoj = rho[j]
                     dr += prm.mass * wp.dot(vij, gw)
-                    hydro = hydro_slope * wp.dot(prm.gravity, r)
-                    dr += diffusion * (prm.mass / rhoj) * ((rhoi - rhoj) - hydro) * wp.dot(r, gw) / (r2 + prm.eta2)
+                    psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + rho_grad[j], gw)
+                    dr += diffusion * (prm.mass / rhoj) * psi
                 for kk in range(b_cell_start[cell], b_cell_end[cell]):
                     b = b_order[kk]
                     r = xi - bx[b]
@@ -239,10 +263,12 @@ def integrate(
     x_old = x[i]
     vi = v[i] + h * acc[i]
     xi = x_old + h * vi
-    # no tension: a liquid particle's density never drops below rho0 (p >= 0). Continuity density drifts low
-    # where a jet stretches or breaks up (kernel support emptying), which would otherwise pull the fragments
-    # together with an artificial tension of order rho0 c0^2 that water in an open pour does not carry.
-    rhoi = wp.max(rho[i] + h * drho[i], prm.rest_density)
+    # Tension is kept (continuity WCSPH: it holds jets together and pulls loose particles back into the liquid);
+    # a floor at rho0 instead would ratchet: in an agitated bed every expansion is clipped and every collision
+    # compresses from there, so the density climbs and props the liquid up as a "gas". The safety floor below only
+    # stops the rare runaway expansion of a fragment whose support emptied (its density would otherwise fall
+    # without bound, even below zero).
+    rhoi = wp.max(rho[i] + h * drho[i], MIN_DENSITY_RATIO * prm.rest_density)
     if prm.dim == 2:
         vi[1] = 0.0
         xi[1] = 0.0

@@ -1,0 +1,100 @@
+"""Side-view pictures of a finished pour, from its run folder (a tool for docs and debugging; it only reads).
+
+    python -m cosim.io.snapshot RUN [--times 2.0 5.0 8.0] [--out RUN/snapshot.png]
+
+Each panel is the pour plane (world x-z): the liquid particles logged in ``pour.rrd`` at the nearest logged time
+(coloured by speed, viridis), and the vessels and arm links of the scene posed by forward kinematics of the joint
+trajectory in ``trajectory.csv`` at that time (every box geom as its outline in the plane, capsules and cylinders as
+their axis). Without ``--times``, four times spread over the controller's pouring phases are taken from
+``summary.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from cosim.atomic_files import atomic_path
+from cosim.io.rerun_read import read_component
+from cosim.io.rerun_paths import LIQUID
+from cosim.io.trajectory_csv import read_trajectory_csv
+from cosim.robots.scene import RobotScene
+
+BOX_CORNERS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]], dtype=float)
+
+
+def _default_times(summary: dict) -> list[float]:
+    pouring = [p for p in summary["phases"] if p["phase"] not in ("idle", "done")]
+    start, end = (pouring[0]["start"], pouring[-1]["end"]) if pouring else (0.0, summary["sim_time"])
+    return list(np.linspace(start, end, 6)[1:5])
+
+
+def _draw_scene(ax, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+    for g in range(model.ngeom):
+        if model.geom_group[g] > 2 or model.geom_rgba[g, 3] == 0.0 or model.geom_type[g] == mujoco.mjtGeom.mjGEOM_PLANE:
+            continue
+        pos, rot, size = data.geom_xpos[g], data.geom_xmat[g].reshape(3, 3), model.geom_size[g]
+        color = model.geom_rgba[g, :3]
+        if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX and abs(rot[1, 1]) > 0.99:  # boxes seen edge-on in x-z
+            local = np.stack([BOX_CORNERS[:, 0] * size[0], np.zeros(5), BOX_CORNERS[:, 1] * size[2]], axis=1)
+            world = local @ rot.T + pos
+            ax.fill(world[:, 0], world[:, 2], color=color, alpha=0.5, lw=0.5)
+        elif model.geom_type[g] in (mujoco.mjtGeom.mjGEOM_CAPSULE, mujoco.mjtGeom.mjGEOM_CYLINDER):
+            ends = pos + np.outer([-1.0, 1.0], rot[:, 2] * size[1])
+            ax.plot(ends[:, 0], ends[:, 2], color=color, lw=max(1.0, 200 * size[0]), alpha=0.6, solid_capstyle="round")
+
+
+def render(run: Path, times: list[float] | None, out: Path) -> Path:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    summary = json.loads((run / "summary.json").read_text())
+    times = times or _default_times(summary)
+    liquid = read_component(run / "pour.rrd", LIQUID, "Points3D:positions")
+    traj = read_trajectory_csv(run / "trajectory.csv")
+    scene = RobotScene.load(summary.get("scene", {}).get("robots", {}).get("scene") or None)
+    model, data = scene.model, mujoco.MjData(scene.model)
+    mujoco.mj_resetDataKeyframe(model, data, scene.home_key)
+    columns = {name: k for k, name in enumerate(traj.joint_names)}
+    fig, axes = plt.subplots(1, len(times), figsize=(4.2 * len(times), 4.6), dpi=110, squeeze=False)
+    for ax, t in zip(axes[0], times):
+        k = int(np.argmin(np.abs(traj.time - t)))
+        for arm in scene.arms.values():
+            data.qpos[arm.qpos_adr] = [traj.positions[k, columns[j]] for j in arm.joints]
+        mujoco.mj_kinematics(model, data)
+        _draw_scene(ax, model, data)
+        i = int(np.argmin(np.abs(liquid.sim_time - t)))
+        points = liquid.values[i]
+        ax.scatter(points[:, 0], points[:, 2], s=4, c="tab:blue", zorder=3)
+        ax.set_title(f"t = {liquid.sim_time[i]:.2f} s")
+        ax.set_aspect("equal")
+        ax.set_xlim(-0.45, 0.75)
+        ax.set_ylim(0.7, 1.6)
+        ax.set_xlabel("world x (m)")
+    axes[0][0].set_ylabel("world z (m)")
+    fig.suptitle(f"{summary['scene_name']}: {summary['dim']}-D liquid, {summary['particles']} particles")
+    fig.tight_layout()
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp)
+    plt.close(fig)
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("run", type=Path)
+    p.add_argument("--times", type=float, nargs="*")
+    p.add_argument("--out", type=Path)
+    args = p.parse_args(argv)
+    print(render(args.run, args.times, args.out or args.run / "snapshot.png"))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
