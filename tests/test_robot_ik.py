@@ -10,7 +10,8 @@ import pytest
 
 from cosim.errors import InputError
 from cosim.robots.ik import rotation_error
-from cosim.robots.planar import PlanarPose, planar_to_world, quat_to_mat, rot_y, tilt_about_pivot
+from cosim.frames import quat_wxyz_to_matrix, rotation_y
+from cosim.robots.planar import PlanarPose, planar_to_world, tilt_about_pivot
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 
@@ -33,7 +34,7 @@ def _fk_errors(scene: RobotScene, role: ArmRole, q: np.ndarray, pose: PlanarPose
     mujoco.mj_kinematics(scene.model, data)
     pos, quat = scene.vessel_target(role, pose)
     e_pos = float(np.linalg.norm(data.site_xpos[arm.frame_site] - pos))
-    e_rot = float(np.linalg.norm(rotation_error(quat_to_mat(quat), data.site_xmat[arm.frame_site].reshape(3, 3))))
+    e_rot = float(np.linalg.norm(rotation_error(quat_wxyz_to_matrix(quat), data.site_xmat[arm.frame_site].reshape(3, 3))))
     return e_pos, e_rot
 
 
@@ -72,8 +73,8 @@ def test_planar_pose_convention():
     home_pos, home_quat = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0, 0.0])
     lip = np.array([0.1, 0.0, 0.2])
     pos, quat = planar_to_world(home_pos, home_quat, PlanarPose(theta=math.radians(30.0)))
-    assert (pos + quat_to_mat(quat) @ lip)[2] < (home_pos + lip)[2]
-    np.testing.assert_allclose(rot_y(0.3) @ rot_y(0.4), rot_y(0.7), atol=1e-15)
+    assert (pos + quat_wxyz_to_matrix(quat) @ lip)[2] < (home_pos + lip)[2]
+    np.testing.assert_allclose(rotation_y(0.3) @ rotation_y(0.4), rotation_y(0.7), atol=1e-15)
     first = tilt_about_pivot(home_quat, lip, 0.4)
     second = tilt_about_pivot(home_quat, lip, 0.5, current=first)
     both = tilt_about_pivot(home_quat, lip, 0.9)

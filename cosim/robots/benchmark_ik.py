@@ -27,7 +27,8 @@ import numpy as np
 
 from cosim.errors import InputError
 from cosim.robots.ik import rotation_error
-from cosim.robots.planar import PlanarPose, quat_to_mat, tilt_about_pivot
+from cosim.frames import quat_wxyz_to_matrix
+from cosim.robots.planar import PlanarPose, tilt_about_pivot
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 
@@ -76,7 +77,7 @@ def run_benchmark(scene: RobotScene) -> dict:
                 check.qpos[arm.qpos_adr] = q
                 mujoco.mj_kinematics(scene.model, check)
                 results[mode]["pos"].append(float(np.linalg.norm(check.site_xpos[arm.frame_site] - target_pos)))
-                rot = rotation_error(quat_to_mat(target_quat), check.site_xmat[arm.frame_site].reshape(3, 3))
+                rot = rotation_error(quat_wxyz_to_matrix(target_quat), check.site_xmat[arm.frame_site].reshape(3, 3))
                 results[mode]["rot"].append(math.degrees(float(np.linalg.norm(rot))))
                 if mode == "warm":
                     previous = q

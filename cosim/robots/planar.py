@@ -13,12 +13,12 @@ the lip (``VesselSpec.lip_local``) during CFS.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from cosim.checks import check_number, check_vector
+from cosim.frames import matrix_to_quat_wxyz, quat_wxyz_to_matrix, rotation_y
 
 
 @dataclass(frozen=True)
@@ -39,44 +39,6 @@ class PlanarPose:
             object.__setattr__(self, name, check_number(f"planar_pose.{name}", getattr(self, name)))
 
 
-def rot_y(theta: float) -> np.ndarray:
-    """``R_y(theta)`` (3x3): rotation by ``theta`` rad about +y."""
-    c, s = math.cos(theta), math.sin(theta)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def quat_to_mat(quat: np.ndarray) -> np.ndarray:
-    """Rotation matrix (3x3) of a unit quaternion [w, x, y, z]."""
-    w, x, y, z = np.asarray(quat, dtype=float) / np.linalg.norm(quat)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def mat_to_quat(mat: np.ndarray) -> np.ndarray:
-    """Unit quaternion [w, x, y, z] (w >= 0) of a rotation matrix (3x3)."""
-    m = np.asarray(mat, dtype=float)
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    if trace > 0.0:
-        s = 2.0 * math.sqrt(1.0 + trace)
-        q = np.array([0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s])
-    else:
-        i = int(np.argmax(np.diag(m)))
-        j, k = (i + 1) % 3, (i + 2) % 3
-        s = 2.0 * math.sqrt(max(1.0 + m[i, i] - m[j, j] - m[k, k], 1e-300))
-        q = np.empty(4)
-        q[0] = (m[k, j] - m[j, k]) / s
-        q[1 + i] = 0.25 * s
-        q[1 + j] = (m[j, i] + m[i, j]) / s
-        q[1 + k] = (m[k, i] + m[i, k]) / s
-    q /= np.linalg.norm(q)
-    return q if q[0] >= 0.0 else -q
-
-
 def planar_to_world(home_pos: np.ndarray, home_quat: np.ndarray, pose: PlanarPose) -> tuple[np.ndarray, np.ndarray]:
     """World pose of the vessel frame for ``pose`` relative to home.
 
@@ -84,8 +46,8 @@ def planar_to_world(home_pos: np.ndarray, home_quat: np.ndarray, pose: PlanarPos
     ``R = R_y(theta) @ R_home``.
     """
     pos = np.asarray(home_pos, dtype=float) + np.array([pose.dx, 0.0, pose.dz])
-    rot = rot_y(pose.theta) @ quat_to_mat(home_quat)
-    return pos, mat_to_quat(rot)
+    rot = rotation_y(pose.theta) @ quat_wxyz_to_matrix(home_quat)
+    return pos, matrix_to_quat_wxyz(rot)
 
 
 def tilt_about_pivot(
@@ -110,7 +72,7 @@ def tilt_about_pivot(
     pivot = np.asarray(check_vector("tilt.pivot_local", tuple(np.asarray(pivot_local, dtype=float)), 3))
     tx, tz = check_vector("tilt.translation", tuple(translation), 2)
     dtheta = check_number("tilt.dtheta", dtheta)
-    r_current = rot_y(current.theta) @ quat_to_mat(home_quat)
+    r_current = rotation_y(current.theta) @ quat_wxyz_to_matrix(home_quat)
     offset = r_current @ pivot  # pivot minus current origin, world frame
-    moved = offset - rot_y(dtheta) @ offset  # displacement of the origin caused by the tilt about the pivot
+    moved = offset - rotation_y(dtheta) @ offset  # displacement of the origin caused by the tilt about the pivot
     return PlanarPose(current.dx + moved[0] + tx, current.dz + moved[2] + tz, current.theta + dtheta)

@@ -16,7 +16,8 @@ import mujoco
 import numpy as np
 
 from cosim.io.trajectory_csv import JointTrajectory
-from cosim.robots.planar import PlanarPose, quat_to_mat
+from cosim.frames import quat_wxyz_to_matrix
+from cosim.robots.planar import PlanarPose
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 
@@ -43,5 +44,5 @@ def path_deviation(
         mujoco.mj_kinematics(scene.model, data)
         frame = data.site_xpos[arm.frame_site] + data.site_xmat[arm.frame_site].reshape(3, 3) @ point
         pos, quat = scene.vessel_target(role, path(float(t) - delay))
-        out[i] = np.linalg.norm(frame - (pos + quat_to_mat(quat) @ point))
+        out[i] = np.linalg.norm(frame - (pos + quat_wxyz_to_matrix(quat) @ point))
     return out
