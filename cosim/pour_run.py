@@ -182,7 +182,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
             recorder = PourRecorder(work / "pour.rrd", pour.scene.model, scene.logging.recording, particle_radius=0.5 * pour.fluid.config.spacing)
             callbacks.append(_SignalLogger(pour, recorder))
         bar = tqdm(total=round(scene.coupling.max_duration, 3), unit="s sim", disable=not progress, mininterval=1.0,
-                   bar_format="{desc}{n:.2f} s simulated (at most {total:.0f}) [{elapsed}{postfix}]")
+                   bar_format="{desc}{n:.2f} s simulated (at most {total:.1f}) [{elapsed}{postfix}]")
         shown = [0.0]
 
         def on_step(p: CoupledPour) -> None:
