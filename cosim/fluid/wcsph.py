@@ -43,6 +43,13 @@ MIN_DENSITY_RATIO = wp.constant(0.8)
 
 
 @wp.func
+def kernel_gradient(prm: SPHParams, r: wp.vec3, r2: float) -> wp.vec3:
+    """grad_i W(x_i - x_j) for r = x_i - x_j, |r|^2 = r2 > 0 (1/m^(dim+1))."""
+    rl = wp.sqrt(r2)
+    return r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+
+
+@wp.func
 def tait_pressure(prm: SPHParams, rho: float) -> float:
     """Tait equation of state (seed Eq. 5) with the artificial sound speed: p = B ((rho/rho0)^gamma - 1)."""
     return prm.eos_b * (wp.pow(rho / prm.rest_density, prm.gamma) - 1.0)
@@ -113,8 +120,7 @@ def compute_forces(
                     r2 = wp.dot(r, r)
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
-                    rl = wp.sqrt(r2)
-                    gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+                    gw = kernel_gradient(prm, r, r2)
                     vij = vi - v[j]
                     rhoj = rho[j]
                     vol = prm.mass / rhoj
@@ -133,8 +139,7 @@ def compute_forces(
                     r2 = wp.dot(r, r)
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
-                    rl = wp.sqrt(r2)
-                    gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+                    gw = kernel_gradient(prm, r, r2)
                     mw = prm.rest_density * b_volume[b]
                     rhob = b_rho[b]
                     ab = -(mw * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
@@ -211,8 +216,7 @@ def compute_density_rate(
                     r2 = wp.dot(r, r)
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
-                    rl = wp.sqrt(r2)
-                    gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+                    gw = kernel_gradient(prm, r, r2)
                     vij = vi - (v[j] + h * acc[j])
                     rhoj = rho[j]
                     dr += prm.mass * wp.dot(vij, gw)
@@ -224,8 +228,7 @@ def compute_density_rate(
                     r2 = wp.dot(r, r)
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
-                    rl = wp.sqrt(r2)
-                    gw = r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+                    gw = kernel_gradient(prm, r, r2)
                     dr += prm.rest_density * b_volume[b] * wp.dot(vi - bv[b], gw)
     drho[i] = dr
 
