@@ -16,6 +16,7 @@ from enum import Enum
 
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
+from cosim.fluid.seeding import fill_layers
 from cosim.frames import Pose
 from cosim.validation.common import case_fluid_config
 from cosim.validation.scripted import FALL_HEIGHT, PoseScript, domain_around, shake_sideways, tilt_about_lip
@@ -107,6 +108,11 @@ class StressConfig:
     def spacing(self) -> float:
         """m, dx."""
         return self.spec().inner_width / self.across
+
+    @property
+    def layers(self) -> int:
+        """Particle layers the fill is seeded with (the liquid's resolution in depth)."""
+        return fill_layers(self.spec(), self.fill_depth, self.spacing)
 
     @property
     def shake_omega(self) -> float:

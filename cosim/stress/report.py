@@ -13,7 +13,7 @@ from cosim.stress.matrix import DURATION
 
 OUTCOME_COLOURS = {"clean": "tab:green", "instability": "tab:orange", "silent": "tab:red", "error": "tab:purple"}
 AXES = [("motion", "motion"), ("level", "level (rad/s, m or m/s)"), ("fill", "fill (of the height)"),
-        ("across", "particles across"), ("cfl_factor", "CFL factor"), ("dim", "dim"), ("solver", "solver")]
+        ("across", "particles across"), ("layers", "particle layers of liquid"), ("cfl_factor", "CFL factor"), ("dim", "dim"), ("solver", "solver")]
 OUTCOMES = [o.value for o in Outcome]
 
 
@@ -82,12 +82,12 @@ def markdown(rows: list[dict], commands: list[str]) -> str:
         "its maximum, final energy change and wall work, same unit; smallest substep / the planned step at rest; "
         "wall-guard corrections; fraction spilled out of the domain; wall time (s).",
         "",
-        "| id | motion | level | fill | across | CFL x | dim | solver | particles | outcome | leaked | rho err "
+        "| id | motion | level | fill | across | layers | CFL x | dim | solver | particles | outcome | leaked | rho err "
         "| E created | dE | W | dt min/nom | guard | spilled | wall s | message |",
-        "|---" * 20 + "|",
+        "|---" * 21 + "|",
     ]
     for r in rows:
-        cells = [r["id"], r["motion"], _fmt(r["level"]), _fmt(r["fill"]), r["across"], _fmt(r["cfl_factor"]), r["dim"],
+        cells = [r["id"], r["motion"], _fmt(r["level"]), _fmt(r["fill"]), r["across"], r["layers"], _fmt(r["cfl_factor"]), r["dim"],
                  r["solver"], _fmt(r["particles"]), f"**{r['outcome']}**" if r["outcome"] in ("silent", "error") else r["outcome"],
                  _fmt(r["leaked"]), _fmt(r["max_density_error"]), _fmt(r["energy_excess"]), _fmt(r["energy_change"]),
                  _fmt(r["work_in"]), _fmt(r["dt_ratio_min"]), _fmt(r["guard_corrections"]), _fmt(r["spilled_fraction"], 2),

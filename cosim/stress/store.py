@@ -14,11 +14,11 @@ from cosim.stress.classify import Outcome
 from cosim.stress.matrix import StressConfig
 from cosim.stress.runner import Measurement
 
-CONFIG_COLUMNS = ["id", "motion", "level", "fill", "across", "cfl_factor", "dim", "solver", "can_spill"]
+CONFIG_COLUMNS = ["id", "motion", "level", "fill", "across", "cfl_factor", "dim", "solver", "layers", "can_spill"]
 MEASUREMENT_COLUMNS = [f.name for f in dataclasses.fields(Measurement) if f.name != "failure"]
 COLUMNS = CONFIG_COLUMNS + ["outcome"] + MEASUREMENT_COLUMNS + ["message"]
 FLOAT_COLUMNS = {f.name for f in dataclasses.fields(Measurement) if f.type in ("float", float)} | {"level", "fill", "cfl_factor"}
-INT_COLUMNS = {f.name for f in dataclasses.fields(Measurement) if f.type in ("int", int)} | {"across", "dim"}
+INT_COLUMNS = {f.name for f in dataclasses.fields(Measurement) if f.type in ("int", int)} | {"across", "dim", "layers"}
 
 
 def make_row(config: StressConfig, outcome: Outcome, message: str, m: Measurement | None) -> dict:
@@ -26,7 +26,7 @@ def make_row(config: StressConfig, outcome: Outcome, message: str, m: Measuremen
     row = {
         "id": config.id, "motion": config.motion.value, "level": config.level, "fill": config.fill,
         "across": config.across, "cfl_factor": config.cfl_factor, "dim": config.dim, "solver": config.solver,
-        "can_spill": int(config.can_spill), "outcome": outcome.value, "message": message,
+        "layers": config.layers, "can_spill": int(config.can_spill), "outcome": outcome.value, "message": message,
     }
     for name in MEASUREMENT_COLUMNS:
         row[name] = getattr(m, name) if m is not None else ""
@@ -64,7 +64,8 @@ class ResultStore:
         return config_id in self.rows
 
     def add(self, row: dict) -> None:
-        self.rows[row["id"]] = row
+        """Record ``row`` (from :func:`make_row`), held as it reads back from the file, and rewrite the file."""
+        self.rows[row["id"]] = _parse({k: str(v) for k, v in row.items()})
         with atomic_path(self.path) as tmp, tmp.open("w", newline="") as f:
             writer = csv.DictWriter(f, fieldnames=COLUMNS)
             writer.writeheader()

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Protocol
 
 import numpy as np
 
@@ -133,7 +133,13 @@ class ScriptedRun:
     volume_in_vessel: list[float] = field(default_factory=list)
 
 
-SampleHook = Callable[[FluidSolver, Pose, Pose, np.ndarray, np.ndarray], None]  # solver, pose before, after, x, active
+class RunObserver(Protocol):
+    """Sees the run: ``start`` once the solver holds the initial liquid, ``sample`` after each interval with the
+    vessel poses at the interval's start and end, world positions (N, 3) m and the active mask (N,)."""
+
+    def start(self, solver: FluidSolver) -> None: ...
+
+    def sample(self, solver: FluidSolver, before: Pose, after: Pose, x: np.ndarray, active: np.ndarray) -> None: ...
 
 
 def run_scripted(
@@ -144,17 +150,18 @@ def run_scripted(
     duration: float,
     device: str = "cpu",
     can_spill: bool = True,
-    on_sample: SampleHook | None = None,
+    observer: RunObserver | None = None,
 ) -> ScriptedRun:
     """Fill ``spec`` to ``fill`` (m), move it along ``pose_at`` for ``duration`` (s) in intervals of
     :data:`SAMPLE_INTERVAL`, checking leaks after each; a :class:`FluidInstabilityError` ends the run and is
-    returned as ``failure``. ``on_sample`` sees the solver, the poses at the interval's start and end, the world
-    positions (N, 3) and active mask after each interval."""
+    returned as ``failure``. ``can_spill`` False counts any particle out of the vessel as a leak."""
     pose0 = pose_at(0.0)
     solver = FluidSolver(cfg, [spec], [pose0], fill_vessel(spec, fill, cfg, pose0), device=device)
     regions = WallRegions.of(spec, solver)
     leaks = LeakMonitor.start(regions, cfg.spacing, pose0.inverse_transform(solver.positions()), can_spill)
     run = ScriptedRun(solver, leaks, "", 0.0)
+    if observer is not None:
+        observer.start(solver)
     start = time.perf_counter()
     try:
         while solver.time < duration - 1e-9:
@@ -166,8 +173,8 @@ def run_scripted(
             leaks.update(after.inverse_transform(x), active)
             run.t.append(solver.time)
             run.volume_in_vessel.append(solver.last_report.last.volume_in_vessel[0])
-            if on_sample is not None:
-                on_sample(solver, before, after, x, active)
+            if observer is not None:
+                observer.sample(solver, before, after, x, active)
     except FluidInstabilityError as exc:
         run.failure = str(exc)
     run.wall_time = time.perf_counter() - start
