@@ -9,7 +9,7 @@ import pytest
 import cosim.cli.stress as stress_cli
 from cosim.cli.main import main
 from cosim.stress.classify import DENSITY_ERROR_BOUND, ENERGY_EXCESS_BOUND
-from cosim.stress.matrix import quick_matrix
+from cosim.stress.matrix import DURATION, quick_matrix
 from tests.test_stress_matrix import CLEAN
 
 
@@ -31,7 +31,7 @@ def test_quick_run_writes_rows_and_report(quick_run):
     assert [r["id"] for r in rows] == [c.id for c in quick_matrix()]
     for r in rows:
         assert r["outcome"] in ("clean", "instability", "silent")
-        assert float(r["simulated_time"]) == pytest.approx(0.8) or r["outcome"] == "instability"
+        assert float(r["simulated_time"]) == pytest.approx(DURATION) or r["outcome"] == "instability"
         assert 0 < float(r["dt_ratio_min"]) <= 1.0 and int(r["particles"]) > 0 and float(r["wall_time"]) > 0
         garbage = (int(r["nonfinite"]) > 0 or int(r["leaked"]) > 0 or float(r["max_density_error"]) > DENSITY_ERROR_BOUND
                    or float(r["energy_excess"]) > ENERGY_EXCESS_BOUND)

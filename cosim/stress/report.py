@@ -9,7 +9,7 @@ from pathlib import Path
 
 from cosim.atomic_files import atomic_path, write_text_atomic
 from cosim.stress.classify import DENSITY_ERROR_BOUND, ENERGY_EXCESS_BOUND, Outcome
-from cosim.stress.matrix import DURATION
+from cosim.stress.matrix import CARRY_TIME, DEFAULT_CFL, DURATION
 
 OUTCOME_COLOURS = {"clean": "tab:green", "instability": "tab:orange", "silent": "tab:red", "error": "tab:purple"}
 AXES = [("motion", "motion"), ("level", "level (rad/s, m or m/s)"), ("fill", "fill (of the height)"),
@@ -44,9 +44,9 @@ def markdown(rows: list[dict], commands: list[str]) -> str:
         f"{len(rows)} configurations of the SPH liquid in the seed's vessel (0.191 x 0.1 x 0.191 m), each "
         f"simulated for {DURATION:g} s under a scripted motion: `tilt` about the pour lip at a constant rate (rad/s) "
         "up to 90 deg, `shake` sideways at the first sloshing mode (seed Eq. 17) with an amplitude (m), `carry` "
-        "sideways with a cosine speed profile reaching a peak speed (m/s) and stopping after 0.4 s. "
+        f"sideways with a cosine speed profile reaching a peak speed (m/s) and stopping after {CARRY_TIME:g} s. "
         "Axes: fill (fraction of the inner height), particles across the inner width (dx = 0.191 m / across), "
-        "CFL factor (x the default Courant number 0.25), dimension and pressure solver. See `cosim stress --help` "
+        f"CFL factor (x the default Courant number {DEFAULT_CFL:g}), dimension and pressure solver. See `cosim stress --help` "
         "and `cosim/stress/` for the definitions.",
         "",
         "Outcomes: **clean**; **instability** (the solver stopped with its clear `FluidInstabilityError`; its "
