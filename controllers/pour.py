@@ -231,6 +231,11 @@ class PourController:
         stop = self._check_stop(m)
         if stop:
             return stop
+        if m.h_q > 0.0:
+            # seed Sec. 3.1: "at the beginning of t3, where the slosh finds free exit to flow out of the vessel,
+            # AFS will end and CFS will begin". From here the crest clamps the surface, theta1 no longer follows
+            # the pendulum plant Gp, and a PID on theta1 would keep tilting into the outflow.
+            return Phase.CFS, f"t3: the slosh found free exit over the crest (h_q = {1e3 * m.h_q:.2f} mm)"
         sim = self.config.sim
         if abs(m.slosh_angle) > sim.settle_tolerance:
             self._since = math.nan
