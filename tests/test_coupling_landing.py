@@ -51,3 +51,16 @@ def test_series_csv_round_trip(tmp_path) -> None:
     assert back["phase"] == ["cfs", "return"]
     assert math.isnan(back["landing_measured_x"][0]) and back["landing_measured_x"][1] == 0.3
     assert back["t"] == [0.1, 0.2]
+
+
+def test_outflow_timing_finds_the_start_of_a_steady_rate() -> None:
+    from cosim.coupling.outflow import outflow_timing
+
+    t = np.arange(0.0, 10.0, 0.01)
+    rate = np.where(t < 2.0, 0.0, np.where(t < 4.0, 3e-4 * (1 + np.sin(6 * t)), 2e-4))  # a burst, then steady
+    poured = np.concatenate([[0.0], np.cumsum(rate[:-1] * 0.01)])
+    timing = outflow_timing(t, poured, t >= 4.0, start=0.5)
+    assert timing["first_outflow"] == pytest.approx(2.01 - 0.5, abs=0.011)
+    assert timing["cfs_median_rate"] == pytest.approx(2e-4, rel=1e-6)
+    # steady from t = 4 s (the window needs RATE_WINDOW of the steady rate, within the tolerance a bit earlier)
+    assert 3.0 <= timing["steady_outflow"] + 0.5 <= 4.05

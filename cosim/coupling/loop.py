@@ -30,6 +30,7 @@ from controllers.pour import PourController
 from controllers.catcher import fall_time
 from cosim.coupling.exchange import ROLES, vessel_poses, wrench_at_body_com
 from cosim.coupling.landing import landing_accuracy, stream_crossing_x
+from cosim.coupling.outflow import outflow_timing
 from cosim.coupling.measure import MeasurementGeometry, measure
 from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
 from cosim.coupling.settings import Coupling, CouplingSettings
@@ -205,6 +206,13 @@ class CoupledPour:
         return landing_accuracy(rows["t"], rows["landing_x"], rows["landing_fall_time"], rows["landing_measured_x"],
                                 rows["phase"] == "cfs")
 
+    def outflow_timing(self) -> dict:
+        """First and steady outflow (s after the pour's start), :func:`cosim.coupling.outflow.outflow_timing`."""
+        rows = self.log.arrays()
+        if "t" not in rows:
+            return outflow_timing([], [], [], 0.0)
+        return outflow_timing(rows["t"], rows["poured_volume"], rows["phase"] == "cfs", self.controller.config.start_time)
+
     def summary(self) -> dict:
         """Volumes (m^3), phases (name, start s, end s), times (s) of the run so far."""
         last = self.fluid.last_report.last
@@ -225,6 +233,7 @@ class CoupledPour:
                 for tr in self.controller.transitions
             ],
             "landing": self.landing_accuracy(),
+            "outflow": self.outflow_timing(),
             "pour_done": self.done_at is not None,
             "sim_time": self.time,
             "wall_time": self.wall_time,
