@@ -173,6 +173,10 @@ class PourController:
         elif phase is Phase.APPROACH:
             self._reference = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
             self._approach.reset(self.pose.theta)
+        elif phase is Phase.CFS and self._transitions[-1].source is Phase.SIM_DAMP and m.tilt < self.pose.theta:
+            # The PID's command runs ahead of the arm (task-space filter lag); CFS starts from the measured tilt, so
+            # the stream does not begin with the command's lead as an overshoot of h_q.
+            self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
         elif phase is Phase.RETURN:
             self._return_from = self.pose
             self._return.reset(self.pose.theta)
