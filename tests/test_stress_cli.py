@@ -10,7 +10,7 @@ import cosim.cli.stress as stress_cli
 from cosim.cli.main import main
 from cosim.stress.classify import DENSITY_ERROR_BOUND, ENERGY_EXCESS_BOUND
 from cosim.stress.matrix import DURATION, quick_matrix
-from tests.test_stress_matrix import CLEAN
+from tests.support.stress import CLEAN
 
 
 @pytest.fixture(scope="module")

@@ -11,13 +11,8 @@ from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig, PressureSolver
 from cosim.stress.classify import DENSITY_ERROR_BOUND, ENERGY_EXCESS_BOUND, Outcome, classify
 from cosim.stress.matrix import Motion, StressConfig, build_matrix, select, solver_field
-from cosim.stress.runner import Measurement
 from cosim.validation.scripted import LeakMonitor, WallRegions
-
-CLEAN = Measurement(particles=100, simulated_time=0.8, steps=4000, failure="", nonfinite=0, leaked=0, worst_inside=0,
-                    worst_through=0, worst_escaped=0, max_density_error=0.02, energy_excess=0.01, energy_change=0.1,
-                    work_in=0.12, dt_ratio_min=0.9, guard_corrections=0, spilled_fraction=0.0, wall_time=1.0)
-
+from tests.support.stress import CLEAN
 
 def test_matrix_covers_the_required_ranges():
     configs = build_matrix()
@@ -91,3 +86,51 @@ def test_leak_monitor_counts_crafted_leaks():
     spilling = LeakMonitor.start(regions, 0.01, start, can_spill=True)
     spilling.update(np.array([[0.0, 0, 0.25], [0.15, 0, 0.25], [-0.05, 0, 0.05]]), np.ones(3, bool))  # over the rim
     assert spilling.leaked_count == 0
+
+
+class _CraftedSolver:
+    """Stand-in for FluidSolver: two particles at rest, then whatever the test sets (energy account inputs only)."""
+
+    def __init__(self):
+        self.config = FluidConfig(dim=3, spacing=0.01)
+        self.n_particles = 2
+        self.x = np.array([[0.0, 0.0, 0.05], [0.01, 0.0, 0.05]])
+        self.v = np.zeros((2, 3))
+        self.wrench = np.zeros((1, 6))
+
+    def positions(self):
+        return self.x.copy()
+
+    def velocities(self):
+        return self.v.copy()
+
+    def vessel_wrenches(self):
+        return self.wrench.copy()
+
+    def plan_time_step(self, duration, wall_speed):
+        return 1, duration
+
+
+def test_energy_account_flags_energy_no_wall_supplied_and_balances_wall_work():
+    from cosim.frames import Pose
+    from cosim.stress.runner import EnergyAccount
+    from cosim.validation.scripted import SAMPLE_INTERVAL
+
+    mass = 1000.0 * 0.01**3
+    length = 0.2
+    scale = 2 * mass * 9.81 * length
+    # a particle kicked to 1 m/s by a still vessel: all of its kinetic energy is created
+    s = _CraftedSolver()
+    acc = EnergyAccount(np.zeros(3), length)
+    acc.start(s)
+    s.v[0] = (1.0, 0.0, 0.0)
+    acc.sample(s, Pose(), Pose(), s.x, np.ones(2, bool))
+    assert acc.excess / acc.scale == pytest.approx(0.5 * mass / scale)
+    # the same kick by a vessel moving at 1 m/s that pushed with the reaction force -m dv/dt: balanced by its work
+    s = _CraftedSolver()
+    acc = EnergyAccount(np.zeros(3), length)
+    acc.start(s)
+    s.v[0] = (1.0, 0.0, 0.0)
+    s.wrench[0, 0] = -0.5 * mass * 1.0**2 / (1.0 * SAMPLE_INTERVAL)  # work F v dt = kinetic energy gained
+    acc.sample(s, Pose(), Pose((SAMPLE_INTERVAL * 1.0, 0.0, 0.0)), s.x, np.ones(2, bool))
+    assert acc.work == pytest.approx(0.5 * mass) and acc.excess == pytest.approx(0.0, abs=1e-12)
