@@ -26,10 +26,11 @@ from cosim.vessel import VesselSpec, seed_pouring_vessel
 DURATION = 0.6  # s simulated per configuration (the budget: the whole matrix, two solvers, in 25 min on 2 CPU cores)
 TILT_ANGLE = math.pi / 2  # rad, a tilt stops (and is held) at 90 deg
 CARRY_TIME = 0.4  # s, a carry accelerates and stops within this time, then the vessel is held
-# Dynamic amplification of a suddenly applied load on an undamped oscillator (Clough & Penzien, Dynamics of
-# Structures, Sec. 4-4: step load, response = 2 x static): the slosh rise a carry can cause is bounded by twice the
-# quasi-static rise (B/2) a/g.
-SLOSH_AMPLIFICATION = 2.0
+# Bound on the linear slosh response of a carry, in units of the quasi-static surface rise (B/2) a_max / g. By
+# Duhamel's integral an undamped oscillator driven by a(t) (a(0-) = 0) stays within (max|a| + total variation of a)
+# / omega^2; the carry's acceleration a_max cos(pi t / T) jumps by a_max at the start and at the stop and sweeps 2
+# a_max between, so max|a| + TV = 5 a_max.
+SLOSH_AMPLIFICATION = 5.0
 
 
 class Motion(Enum):
@@ -46,8 +47,8 @@ MOTIONS: tuple[tuple[Motion, float], ...] = (
     (Motion.TILT, 5.0),
     (Motion.SHAKE, 0.005),
     (Motion.SHAKE, 0.02),
-    (Motion.CARRY, 0.25),
-    (Motion.CARRY, 0.5),
+    (Motion.CARRY, 0.1),
+    (Motion.CARRY, 0.3),
     (Motion.CARRY, 1.0),
 )
 FILLS = (0.10, 0.50, 0.95)  # fraction of the vessel's inner height
@@ -140,20 +141,15 @@ class StressConfig:
 
     @property
     def can_spill(self) -> bool:
-        """Whether the motion can bring liquid over the rim: a resonant shake always can (linear resonance has no
-        bound); a tilt or a carry can when the fill plus SLOSH_AMPLIFICATION x the quasi-static rise of the surface
-        at the wall, (B/2) tan(theta_max) or (B/2) a_max / g, reaches the rim (a tilt to 90 deg always can)."""
-        spec = self.spec()
-        if self.motion is Motion.SHAKE:
+        """Whether the motion may bring liquid over the rim. Tilts and resonant shakes are taken to always spill;
+        a carry cannot when the fill plus SLOSH_AMPLIFICATION x the quasi-static rise (B/2) a_max / g stays below
+        the rim (then any particle out of the vessel is a leak)."""
+        if self.motion is not Motion.CARRY:
             return True
-        if self.motion is Motion.TILT:
-            angle = min(self.level * DURATION, TILT_ANGLE)
-            if angle >= TILT_ANGLE - 1e-12:
-                return True
-            slope = math.tan(angle)
-        else:
-            slope = 0.5 * self.carry_distance * (math.pi / CARRY_TIME) ** 2 / GRAVITY
-        return self.fill_depth + SLOSH_AMPLIFICATION * 0.5 * spec.inner_width * slope >= spec.inner_height
+        spec = self.spec()
+        a_max = 0.5 * self.carry_distance * (math.pi / CARRY_TIME) ** 2
+        rise = SLOSH_AMPLIFICATION * 0.5 * spec.inner_width * a_max / GRAVITY
+        return self.fill_depth + rise >= spec.inner_height
 
     def fluid_config(self) -> FluidConfig:
         """The validation cases' fluid set-up (project defaults, c0 from the liquid height including the fall),
@@ -188,7 +184,7 @@ def build_matrix() -> list[StressConfig]:
 QUICK = (  # a few cheap, coarse configurations of each motion (tests, smoke runs)
     (Motion.TILT, 5.0, 0.5, 12, 2.0, 2),
     (Motion.SHAKE, 0.02, 0.95, 12, 1.0, 2),
-    (Motion.CARRY, 0.25, 0.10, 12, 1.0, 2),
+    (Motion.CARRY, 0.3, 0.10, 12, 1.0, 2),
 )
 
 
