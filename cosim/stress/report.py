@@ -80,17 +80,18 @@ def markdown(rows: list[dict], commands: list[str]) -> str:
         "",
         "Columns: particles; leaked particles; max |rho - rho0| / rho0; energy created (E - E0 - W) / (M g L) at "
         "its maximum, final energy change and wall work, same unit; smallest substep / the planned step at rest; "
+        "largest particle speed / the expected maximum speed that sets c0 (v/v_max); "
         "wall-guard corrections; fraction spilled out of the domain; wall time (s).",
         "",
         "| id | motion | level | fill | across | layers | CFL x | dim | solver | particles | outcome | leaked | rho err "
-        "| E created | dE | W | dt min/nom | guard | spilled | wall s | message |",
-        "|---" * 21 + "|",
+        "| E created | dE | W | dt min/nom | v/v_max | guard | spilled | wall s | message |",
+        "|---" * 22 + "|",
     ]
     for r in rows:
         cells = [r["id"], r["motion"], _fmt(r["level"]), _fmt(r["fill"]), r["across"], r["layers"], _fmt(r["cfl_factor"]), r["dim"],
                  r["solver"], _fmt(r["particles"]), f"**{r['outcome']}**" if r["outcome"] in ("silent", "error") else r["outcome"],
                  _fmt(r["leaked"]), _fmt(r["max_density_error"]), _fmt(r["energy_excess"]), _fmt(r["energy_change"]),
-                 _fmt(r["work_in"]), _fmt(r["dt_ratio_min"]), _fmt(r["guard_corrections"]), _fmt(r["spilled_fraction"], 2),
+                 _fmt(r["work_in"]), _fmt(r["dt_ratio_min"]), _fmt(r["speed_ratio"]), _fmt(r["guard_corrections"]), _fmt(r["spilled_fraction"], 2),
                  _fmt(r["wall_time"], 2), (r["message"] or "").replace("|", "/")]
         lines.append("| " + " | ".join(str(c) for c in cells) + " |")
     return "\n".join(lines) + "\n"

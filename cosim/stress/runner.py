@@ -30,8 +30,9 @@ class Measurement:
     value (solver diagnostics plus the final state). leaked: particles ever inside a wall, through a wall, or (when
     the motion cannot spill) out of the vessel. max_density_error: max |rho - rho0| / rho0 over all substeps.
     energy_excess: max over samples of (E - E0 - W) / (M g L). energy_change, work_in: final E - E0 and W.
-    dt_ratio_min: smallest substep / the step planned for the liquid at rest. spilled_fraction: particles
-    deactivated (left the domain) / all.
+    dt_ratio_min: smallest substep / the step planned for the liquid at rest. speed_ratio: the largest particle
+    speed / FluidConfig.max_expected_speed (c0 = sound_speed_factor x that speed assumes it stays <= 1).
+    spilled_fraction: particles deactivated (left the domain) / all.
     """
 
     particles: int
@@ -48,6 +49,7 @@ class Measurement:
     energy_change: float
     work_in: float
     dt_ratio_min: float
+    speed_ratio: float
     guard_corrections: int
     spilled_fraction: float
     wall_time: float
@@ -119,6 +121,7 @@ def measure(config: StressConfig, device: str = "cpu") -> Measurement:
         energy_change=energy.change / energy.scale,
         work_in=energy.work / energy.scale,
         dt_ratio_min=float(hist["dt"].min()) / energy.nominal_dt if hist else 1.0,
+        speed_ratio=float(hist["max_speed"].max()) / solver.config.max_expected_speed if hist else 0.0,
         guard_corrections=int(hist["wall_corrections"].sum()) if hist else 0,
         spilled_fraction=1.0 - float(solver.active_mask().mean()),
         wall_time=time.perf_counter() - start,
