@@ -5,7 +5,7 @@ appending one row per configuration to ``OUT/stress.csv`` (rewritten atomically 
 configurations already in the file, so an interrupted run continues where it stopped (``--fresh`` starts over).
 Then writes ``OUT/stability.md`` and ``OUT/stability.png``. ``--docs DIR`` runs nothing and writes the report
 from ``OUT/stress.csv`` into DIR. Exit status 1 when any configuration is ``silent`` (garbage without an error)
-or ``error`` (an unexpected exception).
+``refused`` (the solver's one-line input error at set-up) or ``error`` (an unexpected exception).
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from pathlib import Path
 
 from cosim.atomic_files import write_text_atomic
 from cosim.checks import check_device
+from cosim.errors import InputError
 from cosim.errors import InputError
 from cosim.stress.classify import FAILURES, Outcome, classify
 from cosim.stress.matrix import FILTER_FIELDS, build_matrix, quick_matrix, select
@@ -70,6 +71,8 @@ def _run_one(config, device: str) -> dict:
     """The row of one configuration; an unexpected exception becomes an ``error`` row, not a crash."""
     try:
         m = measure(config, device)  # returns the solver's instability as a result; Ctrl-C is no Exception
+    except InputError as exc:  # refused at set-up with the one-line message a user would get
+        return make_row(config, Outcome.REFUSED, str(exc), None)
     except Exception as exc:  # noqa: BLE001 - any other failure is recorded as this configuration's outcome
         message = f"{type(exc).__name__}: {exc} ({traceback.extract_tb(exc.__traceback__)[-1].filename.split('/')[-1]})"
         return make_row(config, Outcome.ERROR, message, None)

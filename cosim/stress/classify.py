@@ -3,8 +3,10 @@
 ``instability``: the solver stopped with its :class:`~cosim.fluid.solver.FluidInstabilityError` (a clear error:
 acceptable). ``silent``: the run finished but produced garbage (the outcome that must never occur): any of
 non-finite values, a leaked particle, a density error past the solver's own bound, or energy the numerics created
-past :data:`ENERGY_EXCESS_BOUND`. ``clean``: none of these. ``error``: anything else went wrong (an unexpected
-exception: a failure of the product, recorded by the caller).
+past :data:`ENERGY_EXCESS_BOUND`. ``clean``: none of these. ``refused``: the solver refused the configuration
+at set-up with its one-line input error (a liquid the particles cannot resolve, cosim.fluid.seeding.check_resolution;
+acceptable: nothing was simulated). ``error``: anything else went wrong (an unexpected exception: a failure of the
+product, recorded by the caller).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ class Outcome(Enum):
     CLEAN = "clean"
     INSTABILITY = "instability"
     SILENT = "silent"
+    REFUSED = "refused"
     ERROR = "error"
 
 

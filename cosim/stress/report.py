@@ -11,7 +11,8 @@ from cosim.atomic_files import atomic_path, write_text_atomic
 from cosim.stress.classify import DENSITY_ERROR_BOUND, ENERGY_EXCESS_BOUND, Outcome
 from cosim.stress.matrix import CARRY_TIME, DEFAULT_CFL, DURATION
 
-OUTCOME_COLOURS = {"clean": "tab:green", "instability": "tab:orange", "silent": "tab:red", "error": "tab:purple"}
+OUTCOME_COLOURS = {"clean": "tab:green", "instability": "tab:orange", "silent": "tab:red", "refused": "tab:gray",
+                   "error": "tab:purple"}
 AXES = [("motion", "motion"), ("level", "level (rad/s, m or m/s)"), ("fill", "fill (of the height)"),
         ("across", "particles across"), ("layers", "particle layers of liquid"), ("cfl_factor", "CFL factor"), ("dim", "dim"), ("solver", "solver")]
 OUTCOMES = [o.value for o in Outcome]
@@ -53,7 +54,9 @@ def markdown(rows: list[dict], commands: list[str]) -> str:
         "message is in the table); **silent** (finished, but garbage: non-finite values, a leaked particle -- "
         "inside or through a wall, or out of the vessel where the motion cannot spill --, "
         f"|rho - rho0| / rho0 > {DENSITY_ERROR_BOUND:g}, or energy created by the numerics "
-        f"(E - E0 - W) / (M g L) > {ENERGY_EXCESS_BOUND:g}); **error** (an unexpected exception). "
+        f"(E - E0 - W) / (M g L) > {ENERGY_EXCESS_BOUND:g}); **refused** (the solver refused the configuration at "
+        "set-up with its one-line input error: a liquid fewer than 3 particle layers deep or 4 across, which the "
+        "particles cannot resolve; the message is in the table); **error** (an unexpected exception). "
         "Silent and error must be 0.",
         "",
         "## Summary",
