@@ -11,7 +11,8 @@ from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma
 @wp.struct
 class SPHParams:
     """Static SPH parameters (SI). ``mass`` is the SPH particle mass (kg, or kg/m of depth in 2-D); ``mass_out``
-    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``eta2`` = 0.01 h^2 (m^2)."""
+    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``eta2`` = 0.01 h^2 (m^2); the last three are DFSPH's stopping rule (relative
+    tolerances and the iteration cap of each solve)."""
 
     dim: int
     kernel: int
@@ -31,6 +32,9 @@ class SPHParams:
     eta2: float
     gravity: wp.vec3
     n_vessels: int
+    density_tolerance: float
+    divergence_tolerance: float
+    max_iterations: int
 
 
 def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
@@ -54,4 +58,7 @@ def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
     p.eta2 = 0.01 * h * h
     p.gravity = wp.vec3(*cfg.gravity)
     p.n_vessels = n_vessels
+    p.density_tolerance = cfg.density_tolerance
+    p.divergence_tolerance = cfg.divergence_tolerance
+    p.max_iterations = cfg.max_solver_iterations
     return p

@@ -81,7 +81,7 @@ def _run(name: str, p: Params, pose_at) -> CaseResult:
     reach = spec.inner_height + 0.5 * spec.inner_width + 0.1
     cfg = case_fluid_config(
         p.dim, dx, max(p.fill, FALL_HEIGHT), spec.section_depth,
-        (-reach - p.amplitude, -reach, -FALL_HEIGHT), (reach + p.amplitude, reach, reach),
+        (-reach - p.amplitude, -reach, -FALL_HEIGHT), (reach + p.amplitude, reach, reach), p.solver,
     )
     solver = FluidSolver(cfg, [spec], [pose_at(0.0)], fill_vessel(spec, p.fill, cfg, pose_at(0.0)), device=p.device)
     t_wall = float(solver.model.wall_thickness[0])
@@ -130,7 +130,7 @@ def _run(name: str, p: Params, pose_at) -> CaseResult:
         "t": series_t,
         "volume_in_vessel": series_volume,
     }
-    params = dict(fill=p.fill, spacing=dx, dim=p.dim, device=p.device, rate=p.rate, angle=p.angle,
+    params = dict(fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, rate=p.rate, angle=p.angle,
                   amplitude=p.amplitude, periods=p.periods)
     return CaseResult(name, params, metrics, raw, wall)
 
