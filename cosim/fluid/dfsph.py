@@ -4,8 +4,9 @@ Incompressibility is enforced by two iterative solves per substep instead of a s
 time step follows the flow speed (CFL on particle and wall speed) rather than an artificial speed of sound.
 A substep, after the neighbour search:
 
-  compute_density_factor   rho_i = sum_j m W_ij + sum_b rho0 V_b W_ib (summation density, wall particles
-                           included) and the DFSPH factor alpha_i = rho_i / (|sum_j m grad W_ij + sum_b rho0 V_b
+  compute_density_factor   rho_i = (sum_j m W_ij + sum_b rho0 V_b W_ib) / s (summation density, wall particles
+                           included; s = the sum over a resting lattice / rho0, 1.005 for Wendland C2 at h = 1.5 dx
+                           in 2-D, so the liquid as seeded is at rest instead of 0.5 % compressed) and the DFSPH factor alpha_i = rho_i / (|sum_j m grad W_ij + sum_b rho0 V_b
                            grad W_ib|^2 + sum_j |m grad W_ij|^2); starts the divergence solve (warm start).
   divergence solve         iterate [apply_stiffness, compute_solve_error, check_convergence] until the average
                            compressing density rate times dt is below ``divergence_tolerance`` rho0 (or the cap).
@@ -189,6 +190,7 @@ def compute_density_factor(
     if count > capacity:
         wp.atomic_add(diag_i, row[0], DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
+    density = density / prm.lattice_density
     denominator = wp.dot(grad_sum, grad_sum) + grad_sq
     scale = prm.mass * prm.sigma * prm.inv_h
     a = float(0.0)

@@ -5,14 +5,15 @@ from __future__ import annotations
 import warp as wp
 
 from cosim.fluid.config import FluidConfig
-from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma
+from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma, lattice_kernel_sum
 
 
 @wp.struct
 class SPHParams:
     """Static SPH parameters (SI). ``mass`` is the SPH particle mass (kg, or kg/m of depth in 2-D); ``mass_out``
-    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``eta2`` = 0.01 h^2 (m^2); the last three are DFSPH's stopping rule (relative
-    tolerances and the iteration cap of each solve)."""
+    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``eta2`` = 0.01 h^2 (m^2); then DFSPH's stopping rule (relative tolerances and
+    the iteration cap of each solve) and ``lattice_density``, the summation density of a resting lattice over rho0
+    (DFSPH divides its summation density by it, so the liquid as seeded is at rest density)."""
 
     dim: int
     kernel: int
@@ -35,6 +36,7 @@ class SPHParams:
     density_tolerance: float
     divergence_tolerance: float
     max_iterations: int
+    lattice_density: float
 
 
 def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
@@ -61,4 +63,5 @@ def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
     p.density_tolerance = cfg.density_tolerance
     p.divergence_tolerance = cfg.divergence_tolerance
     p.max_iterations = cfg.max_solver_iterations
+    p.lattice_density = lattice_kernel_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim)
     return p

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import warp as wp
 
 from cosim.fluid.config import KernelType
@@ -21,6 +22,22 @@ def kernel_sigma(kernel: KernelType, h: float, dim: int) -> float:
     if kernel is KernelType.CUBIC_SPLINE:
         return 10.0 / (7.0 * math.pi * h * h) if dim == 2 else 1.0 / (math.pi * h**3)
     return 7.0 / (4.0 * math.pi * h * h) if dim == 2 else 21.0 / (16.0 * math.pi * h**3)
+
+
+def lattice_kernel_sum(kernel: KernelType, smoothing_ratio: float, dim: int) -> float:
+    """sum_j W(x_i - x_j) dx^dim over a full square (cubic) lattice of spacing dx around x_i (itself included):
+    the summation density of a resting lattice in units of rho0 (1.005 for Wendland C2 at h = 1.5 dx in 2-D)."""
+    h = smoothing_ratio  # in units of dx
+    reach = math.ceil(2.0 * h)
+    axis = np.arange(-reach, reach + 1, dtype=float)
+    grid = np.stack(np.meshgrid(*([axis] * dim), indexing="ij"), axis=-1).reshape(-1, dim)
+    q = np.linalg.norm(grid, axis=1) / h
+    sigma = kernel_sigma(kernel, h, dim)
+    if kernel is KernelType.CUBIC_SPLINE:
+        w = np.where(q < 1.0, 1.0 - 1.5 * q**2 + 0.75 * q**3, np.where(q < 2.0, 0.25 * (2.0 - q) ** 3, 0.0))
+    else:
+        w = np.where(q < 2.0, (1.0 - 0.5 * q) ** 4 * (2.0 * q + 1.0), 0.0)
+    return float(sigma * w.sum())
 
 
 @wp.func
