@@ -25,7 +25,8 @@ One Jacobi iteration, for stiffness increments k_i (m^2/s^2, a pressure over den
 (the wall particles mirror the particle's own stiffness, as in SPlisHSPlasH's Akinci boundary). Only compression
 is corrected (e_i >= 0): a free surface's kernel deficiency is not a pressure. The stiffness each particle applied
 over both solves, kappa_i, is kept: it gives the reported pressure p_i = rho_i kappa_i (the pressure whose impulse
-acted over dt), the wall reaction, and the warm start of the next substep.
+acted over dt; reported as its average over the interval), the wall reaction, and the warm start of the next
+substep.
 
 The stopping test reads one int32 flag that ``check_convergence`` writes on the device, driven by
 ``wp.capture_while``: on the CPU it reads the flag from memory each iteration; on CUDA it becomes a conditional
@@ -211,7 +212,6 @@ def apply_stiffness(
     increment: wp.array(dtype=float),
     active: wp.array(dtype=wp.int32),
     dt: wp.array(dtype=float),
-    keep_going: wp.array(dtype=wp.int32),
     pair_count: wp.array(dtype=wp.int32),
     pair_index: wp.array2d(dtype=wp.int32),
     pair_grad: wp.array2d(dtype=wp.vec3),
@@ -220,9 +220,10 @@ def apply_stiffness(
     kappa: wp.array(dtype=float),
 ):
     """v_i -= dt [sum_j m (k_i/rho_i + k_j/rho_j) grad W_ij + sum_b rho0 V_b (k_i/rho_i) grad W_ib]; kappa_i += k_i.
-    Does nothing once the solve has converged (``keep_going`` 0: the last measured increments are not applied)."""
+    The first iteration of a solve applies its warm start; once a solve has converged, the increments its last
+    iteration measured are not applied (the loop ends before this stage)."""
     i = wp.tid()
-    if active[i] == 0 or keep_going[0] == 0:
+    if active[i] == 0:
         return
     ki = increment[i] / rho[i]
     dv = wp.vec3(0.0)
@@ -413,16 +414,20 @@ def compute_wall_reaction(
     b_order: wp.array(dtype=wp.int32),
     b_cell_start: wp.array(dtype=wp.int32),
     b_cell_end: wp.array(dtype=wp.int32),
+    substep_weight: wp.array(dtype=float),
     # Out
     wall_force: wp.array2d(dtype=wp.vec3),
     wall_torque: wp.array2d(dtype=wp.vec3),
+    # State in/out
     p: wp.array(dtype=float),
 ):
     """The force each particle exerted on each vessel this substep, the opposite of what its wall neighbours gave
     it: per wall particle the pressure m (kappa_i / rho_i) rho0 V_b grad W_ib over both solves (kappa_i enters
     linearly, so the sum over the iterations is exact) and the viscous term with the velocity the non-pressure
-    stage saw (``v``, before the density solve), and its moment about the vessel's centre of mass. Also the
-    reported pressure p_i = rho_i kappa_i (Pa)."""
+    stage saw (``v``, before the density solve), and its moment about the vessel's centre of mass. Also adds this
+    substep's share (``substep_weight`` = 1 / substeps of the interval) of the reported pressure p_i = rho_i kappa_i
+    (Pa): the pressure is the interval's average, as the wrenches are (one substep's stiffness is the multiplier of
+    that substep's residual, noisy from substep to substep)."""
     i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
@@ -431,7 +436,7 @@ def compute_wall_reaction(
         return
     kappa = kappa_density[i] + kappa_divergence[i]
     rhoi = rho[i]
-    p[i] = rhoi * kappa
+    p[i] = p[i] + substep_weight[0] * rhoi * kappa
     xi = x[i]
     vi = v[i]
     ki = kappa / rhoi

@@ -125,6 +125,10 @@ class FluidSolver:
         self.state.active.fill_(1)
         self.state.pid.assign(np.arange(n, dtype=np.int32))
         wp.launch(wcsph.equation_of_state, dim=n, inputs=[m.params, self.state.rho], outputs=[self.state.p], device=d)
+        if self.config.pressure_solver is PressureSolver.DFSPH:
+            # the seeded pressure (hydrostatic for a filled vessel) as the stiffness the liquid was already under:
+            # the first density solve warm-starts from it as from any previous substep's
+            self.state.kappa_density.assign((self.state.p.numpy() / self.state.rho.numpy()).astype(np.float32))
         self._drho = wp.zeros(n, dtype=float, device=d)
         self._acc = wp.zeros(n, dtype=wp.vec3, device=d)
         self._rho_grad = wp.zeros(n, dtype=wp.vec3, device=d)
@@ -152,6 +156,7 @@ class FluidSolver:
         self._b_active = wp.ones(nb, dtype=wp.int32, device=d)
         self._motions = wp.zeros(m.n_vessels, dtype=bd.VesselMotion, device=d)
         self._dt = wp.zeros(1, dtype=float, device=d)
+        self._substep_weight = wp.zeros(1, dtype=float, device=d)
         self._row = wp.zeros(1, dtype=wp.int32, device=d)
         self._rows_capacity = 0
         self._ensure_rows(64)
@@ -201,9 +206,10 @@ class FluidSolver:
         DFSPH), force and viscous criteria."""
         cfg = self.config
         h = cfg.smoothing_length
-        signal = self._last_max_speed + wall_speed
         if cfg.pressure_solver is PressureSolver.WCSPH:
-            signal += cfg.sound_speed
+            signal = cfg.sound_speed + self._last_max_speed + wall_speed
+        else:  # the expected speed bounds the step before the flow has reached it (a jet forms within an interval)
+            signal = max(cfg.max_expected_speed, self._last_max_speed) + wall_speed
         dt = cfg.cfl * h / max(signal, 1e-9)
         dt = min(dt, FORCE_CFL * math.sqrt(h / max(self._last_max_accel, 1e-9)))
         if cfg.kinematic_viscosity > 0.0:
@@ -229,6 +235,9 @@ class FluidSolver:
             even, odd = (self.state, self._spare) if self._parity == 0 else (self._spare, self.state)
             self._ops = (self._substep_commands(even, odd), self._substep_commands(odd, even))
         self._dt.fill_(dt)
+        if self.config.pressure_solver is PressureSolver.DFSPH:  # its pressure is averaged over the interval
+            self._substep_weight.fill_(1.0 / n_sub)
+            self.state.p.zero_()
         self._row.zero_()
         self._diag_f.zero_()
         self._diag_i.zero_()
@@ -338,7 +347,7 @@ class FluidSolver:
 
         def solve(mode: int, v: wp.array, kappa: wp.array):
             body = [
-                rec(dfsph.apply_stiffness, n, [st.rho, self._increment, st.active, self._dt, self._keep_going, *pairs], [v, kappa]),
+                rec(dfsph.apply_stiffness, n, [st.rho, self._increment, st.active, self._dt, *pairs], [v, kappa]),
                 rec(dfsph.compute_solve_error, n, [prm, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [self._increment, self._solve_stats]),
                 rec(dfsph.check_convergence, 1, [prm, mode, self._row], [self._solve_stats, self._keep_going, self._diag_f, self._diag_i]),
             ]
@@ -362,7 +371,10 @@ class FluidSolver:
             solve(dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density),
             rec(
                 dfsph.compute_wall_reaction, n,
-                [prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel, self._motions, st.x, st.v, st.rho, st.kappa_density, st.kappa_divergence, st.active, *walls_v],
+                [
+                    prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel, self._motions, st.x, st.v, st.rho, st.kappa_density,
+                    st.kappa_divergence, st.active, *walls_v, self._substep_weight,
+                ],
                 [self._wall_force, self._wall_torque, st.p],
             ),
             rec(dfsph.integrate, n, [*self._integrate_model_args(), self._v_star, st.rho], [st.x, st.v, st.active, self._diag_f, self._diag_i]),
@@ -412,7 +424,8 @@ class FluidSolver:
         return self._in_id_order(self.state.rho).astype(np.float64)
 
     def pressures(self) -> np.ndarray:
-        """(N,) Pa."""
+        """(N,) Pa. WCSPH: from the equation of state after the last substep; DFSPH: rho kappa averaged over the
+        last interval's substeps."""
         return self._in_id_order(self.state.p).astype(np.float64)
 
     def active_mask(self) -> np.ndarray:
