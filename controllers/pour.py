@@ -77,6 +77,7 @@ class PourController:
         self._first_t = math.nan
         self._initial_volume = math.nan
         self._outflow_rate = 0.0  # m^3/s, filtered
+        self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
         self._last_poured = 0.0
         self._sigma_prev = 0.0
         self._since = math.nan  # start of the current settle (SIM_DAMP) or max-tilt (CFS) interval, s
@@ -136,7 +137,9 @@ class PourController:
             if nxt is None:
                 break
             self._enter(nxt[0], nxt[1], m)
+        theta_before = self.pose.theta
         self.pose = self._act[self.phase](m)
+        self._tilt_rate = (self.pose.theta - theta_before) / self.dt
         landing = self._landing(m)
         return PourCommand(
             t=m.t,
@@ -173,9 +176,13 @@ class PourController:
         elif phase is Phase.APPROACH:
             self._reference = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
             self._approach.reset(self.pose.theta)
+        elif phase is Phase.CFS and self._transitions[-1].source is Phase.SIM_DAMP and m.tilt < self.pose.theta:
+            # The PID's command runs ahead of the arm (task-space filter lag); CFS starts from the measured tilt, so
+            # the stream does not begin with the command's lead as an overshoot of h_q.
+            self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
         elif phase is Phase.RETURN:
             self._return_from = self.pose
-            self._return.reset(self.pose.theta)
+            self._return.reset(self.pose.theta, self._tilt_rate)  # brakes the forward motion it inherits
 
     def _elapsed(self, m: LiquidMeasurement) -> float:
         return m.t - self._phase_start
@@ -197,7 +204,7 @@ class PourController:
         if target is not None:
             lever = crest_lever(self.config.vessel, self.pose.theta, self._area(m))
             ret = self.config.returning
-            after = after_flow_volume(self._outflow_rate, m.h_q, lever, ret.max_rate, ret.max_accel)
+            after = after_flow_volume(self._outflow_rate, m.h_q, lever, ret.max_rate, ret.max_accel, self._tilt_rate)
             if m.poured_volume + after >= target:
                 return Phase.RETURN, (
                     f"poured {1e6 * m.poured_volume:.1f} mL + {1e6 * after:.1f} mL predicted after-flow "
@@ -231,6 +238,11 @@ class PourController:
         stop = self._check_stop(m)
         if stop:
             return stop
+        if m.h_q > 0.0:
+            # seed Sec. 3.1: "at the beginning of t3, where the slosh finds free exit to flow out of the vessel,
+            # AFS will end and CFS will begin". From here the crest clamps the surface, theta1 no longer follows
+            # the pendulum plant Gp, and a PID on theta1 would keep tilting into the outflow.
+            return Phase.CFS, f"t3: the slosh found free exit over the crest (h_q = {1e3 * m.h_q:.2f} mm)"
         sim = self.config.sim
         if abs(m.slosh_angle) > sim.settle_tolerance:
             self._since = math.nan
@@ -309,14 +321,14 @@ class PourController:
         return PlanarPose(start.dx * f, start.dz * f, theta)
 
     def _landing(self, m: LiquidMeasurement) -> float | None:
-        """Predicted landing x (m, world): measured jet while liquid flows, else the weir estimate at h_q_ref;
+        """Predicted landing x (m, world): the measured jet (launched where v_q is measured) while liquid flows, else
+        the weir estimate at h_q_ref launched at the lip;
         None (hold vessel B) once the pour is over and nothing flows."""
         flowing = m.h_q > 0.0 and m.v_q > 0.0
         if not flowing and self.phase in (Phase.RETURN, Phase.DONE):
             return None
         cfg = self.config
         if flowing:
-            v_x, v_z = m.v_q, m.v_q_z
-        else:
-            v_x, v_z = weir_velocity(cfg.cfs.h_q_ref, cfg.catcher.discharge_coefficient, cfg.gravity), 0.0
-        return landing_x(m.lip_x, m.lip_z, m.catcher_rim_z, v_x, v_z, cfg.gravity)
+            return landing_x(m.lip_x + m.jet_dx, m.lip_z + m.jet_dz, m.catcher_rim_z, m.v_q, m.v_q_z, cfg.gravity)
+        v_weir = weir_velocity(cfg.cfs.h_q_ref, cfg.catcher.discharge_coefficient, cfg.gravity)
+        return landing_x(m.lip_x, m.lip_z, m.catcher_rim_z, v_weir, 0.0, cfg.gravity)

@@ -6,7 +6,9 @@ Timeline (Fig. 7), run by :class:`controllers.pour.PourController` about the cen
       runs toward the lip with its largest speed);
   t2  PID damping of theta1 (:mod:`controllers.pid`) toward the tilt at which the resting liquid would stand
       h_ref over the crest;
-  t3  hand-over to the constant-flow stage once |sigma| stays small.
+  t3  hand-over to the constant-flow stage when "the slosh finds free exit to flow out of the vessel" (liquid
+      over the crest, h_q > 0), or once |sigma| stays small, or after a timeout. On the SPH liquid the first is
+      what happens: the induced wave reaches the crest within about a slosh period of t2's start.
 
 Fill condition. The seed runs SIM when "h_e <= h_q at theta = 20 deg". Read literally (h_q = 5 mm) it would
 exclude the seed's own vessel. Implemented reading (reference README): SIM is needed when the liquid would reach

@@ -2,7 +2,8 @@
 
 Outputs, in a new run folder (``recordings/<UTC time>-<scene name>/``, never an earlier run's) or ``--out DIR``:
 ``pour.rrd`` (Rerun recording, unless logging is off), ``trajectory.csv`` and ``trajectory.json`` (the arms' checked
-jerk-limited joint trajectories), ``summary.json`` (volumes, phases, timings, versions, the scene). Everything is
+jerk-limited joint trajectories), ``series.csv`` (per-control-step signals, :mod:`cosim.io.pour_series`),
+``summary.json`` (volumes, phases, timings, versions, the scene). Everything is
 written into a hidden temporary folder next to the destination and renamed into place only when the run
 succeeded, so a failed or interrupted run leaves no half-written folder behind.
 """
@@ -31,6 +32,7 @@ from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour, build_pour
 from cosim.errors import InputError
 from cosim.frames import tilt_about_y
+from cosim.io.pour_series import write_series_csv
 from cosim.io.recording import PourRecorder
 from cosim.pour_scene import PourScene
 from cosim.robots.scene import RobotScene
@@ -200,6 +202,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
             recorder.log_state(pour.time, pour.steps, pour.scene.data, pour.fluid.positions(),
                                np.linalg.norm(pour.fluid.velocities(), axis=1), active=pour.fluid.active_mask(), force=True)
             recorder.close()
+        write_series_csv(pour.log.rows, work / "series.csv")
         trajectory = pour.recorder.trajectory()
         write_trajectory_files(trajectory, pour.recorder.limits, pour.recorder.sample_rate_hz, work / "trajectory.csv", work / "trajectory.json")
         summary.update(

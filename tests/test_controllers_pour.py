@@ -31,7 +31,8 @@ PARTIAL_POUR_RTOL = 0.03
 # CFS holds h_q at its reference: on the model plant within 5 % of 5 mm once the approach transient is over.
 H_Q_TOL = 0.25e-3  # m
 CFS_TRANSIENT = 3.0  # s after entering CFS: ten time constants of the CFS law (0.3 s)
-# SIM damping (t2): the slosh angle at the end of t2 is a small fraction of its amplitude when t2 starts.
+# After SIM, the slosh left when CFS takes over (seed t3) decays under CFS: its amplitude CFS_TRANSIENT s into
+# CFS is a small fraction of the induced slosh's amplitude during t1.
 SLOSH_DECAY = 0.2
 MODEL_MAX_TILT = 1.45  # rad: the model plant's box geometry needs tilts below 90 deg
 # The weir drains the last head over the crest asymptotically; holding max_tilt for 3 s leaves about 2 % of the
@@ -69,7 +70,7 @@ def test_sim_timeline_on_the_linear_plant() -> None:
     reasons = [tr.reason for tr in controller.transitions]
     assert reasons[0].startswith("h_e = 31.9 mm <= (B/2) tan(20 deg) = 34.8 mm")
     assert "crossed zero toward the lip" in reasons[2]
-    assert "slosh damped" in reasons[3]
+    assert "found free exit over the crest" in reasons[3]  # seed Sec. 3.1: t3 starts when the slosh flows out
     assert "target" in reasons[4]
     # t0 lasts a quarter period of the excitation and ends at phi = 0.9 x the static crest tilt
     t = trace.t
@@ -84,12 +85,11 @@ def test_sim_timeline_on_the_linear_plant() -> None:
     sigma = trace.series("theta1") - trace.series("tilt")
     k_damp = int(np.argmax(phases == Phase.SIM_DAMP))
     assert sigma[k_damp - 1] < 0 <= sigma[k_damp]
-    # t2: theta1 returns to the tilt (sigma -> 0)
-    damp = np.flatnonzero(phases == Phase.SIM_DAMP)
-    start_amp = np.max(np.abs(sigma[damp[: int(controller.model.period / config.dt)]]))
-    end_amp = np.max(np.abs(sigma[damp[-int(config.sim.settle_dwell / config.dt):]]))
-    assert end_amp < SLOSH_DECAY * start_amp
-    assert end_amp <= config.sim.settle_tolerance
+    # t2 runs the PID until the induced wave reaches the crest; from t3 the slosh decays under CFS
+    induced = np.max(np.abs(sigma[phases == Phase.SIM_HOLD]))
+    t_cfs = controller.transitions[3].t
+    late = (trace.t > t_cfs + CFS_TRANSIENT - 0.5) & (trace.t <= t_cfs + CFS_TRANSIENT)
+    assert np.max(np.abs(sigma[late])) < SLOSH_DECAY * induced
     assert t[-1] < 60.0
 
 

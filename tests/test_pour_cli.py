@@ -11,6 +11,7 @@ import pytest
 
 from cosim.cli.main import main
 from cosim.frames import tilt_about_y
+from cosim.io.pour_series import read_series_csv
 from cosim.io.rerun_read import entity_paths, read_scalar_series
 from cosim.io.trajectory_csv import read_trajectory_csv
 from cosim.io.trajectory_json import read_trajectory_json
@@ -50,12 +51,16 @@ def run(tmp_path_factory):
 
 
 def test_outputs_and_summary(run):
-    assert sorted(p.name for p in run.iterdir()) == ["pour.rrd", "summary.json", "trajectory.csv", "trajectory.json"]
+    assert sorted(p.name for p in run.iterdir()) == ["pour.rrd", "series.csv", "summary.json", "trajectory.csv", "trajectory.json"]
     summary = json.loads((run / "summary.json").read_text())
     for key in ("initial_volume", "poured_volume", "spilled_volume", "phases", "sim_time", "wall_time", "real_time_factor", "device", "versions"):
         assert key in summary
     assert summary["initial_volume"] > 0 and summary["sim_time"] == pytest.approx(0.8)
     assert [p["phase"] for p in summary["phases"]][0] == "idle"
+    assert "landing" in summary
+    series = read_series_csv(run / "series.csv")
+    assert len(series["t"]) == round(0.8 / 0.01) and series["phase"][0] == "idle"
+    assert series["volume_in_pourer"][0] == pytest.approx(summary["initial_volume"])
 
 
 def test_recording_verifies_and_its_theta_is_the_trajectorys(run):

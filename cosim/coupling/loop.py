@@ -27,7 +27,10 @@ from controllers.config import CatcherConfig, PourConfig
 from controllers.geometry import VesselGeometry
 from controllers.measurement import PourCommand
 from controllers.pour import PourController
+from controllers.catcher import fall_time
 from cosim.coupling.exchange import ROLES, vessel_poses, wrench_at_body_com
+from cosim.coupling.landing import landing_accuracy, stream_crossing_x
+from cosim.coupling.outflow import outflow_timing
 from cosim.coupling.measure import MeasurementGeometry, measure
 from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
 from cosim.coupling.settings import Coupling, CouplingSettings
@@ -149,7 +152,8 @@ class CoupledPour:
         poses = fluid.vessel_poses()
         last = fluid.last_report.last if fluid.last_report else None
         in_pourer = last.volume_in_vessel[0] if last else self.geometry.initial_volume
-        m = measure(self.time, self.geometry, poses[0], poses[1], fluid.positions(), fluid.velocities(), fluid.active_mask(), in_pourer)
+        x, v, active = fluid.positions(), fluid.velocities(), fluid.active_mask()
+        m = measure(self.time, self.geometry, poses[0], poses[1], x, v, active, in_pourer)
         cmd = self.controller.step(m)
         self.command = cmd
         targets = {ArmRole.POUR: cmd.pourer, ArmRole.CATCH: cmd.catcher}
@@ -164,11 +168,17 @@ class CoupledPour:
             self._seed[role] = q
             self.generators[role].set_target(q)
         in_catcher = last.volume_in_vessel[1] if last else 0.0
+        gravity = self.fluid.config.gravity_magnitude
+        flowing = m.h_q > 0.0 and m.v_q > 0.0
+        crossing = stream_crossing_x(x[active], v[active], m.catcher_rim_z, m.lip_z,
+                                     self.geometry.spacing, gravity)
         self.log.append(
             t=self.time, tilt=m.tilt, theta1=m.theta1, h_q=m.h_q, v_q=m.v_q, v_q_z=m.v_q_z,
             volume_in_pourer=in_pourer, volume_in_catcher=in_catcher, poured_volume=m.poured_volume,
-            spilled_volume=last.spilled_volume if last else 0.0, lip_x=m.lip_x, lip_z=m.lip_z,
-            landing_x=cmd.landing_x, phase=cmd.phase.value, target_theta=cmd.pourer.theta, target_dx=cmd.pourer.dx,
+            spilled_volume=last.spilled_volume if last else 0.0, lip_x=m.lip_x, lip_z=m.lip_z, jet_dx=m.jet_dx, jet_dz=m.jet_dz,
+            landing_x=cmd.landing_x, landing_measured_x=crossing,
+            landing_fall_time=fall_time(m.lip_z + m.jet_dz - m.catcher_rim_z, m.v_q_z, gravity) if flowing else math.nan,
+            catcher_rim_z=m.catcher_rim_z, phase=cmd.phase.value, target_theta=cmd.pourer.theta, target_dx=cmd.pourer.dx,
             target_dz=cmd.pourer.dz, smoothed_theta=smoothed[ArmRole.POUR].theta, catcher_dx=cmd.catcher.dx,
             smoothed_catcher_dx=smoothed[ArmRole.CATCH].dx, wrench_pourer=self.wrench[0].copy(),
             wrench_catcher=self.wrench[1].copy(),
@@ -187,6 +197,21 @@ class CoupledPour:
             if on_step is not None:
                 on_step(self)
         return self.summary()
+
+    def landing_accuracy(self) -> dict:
+        """Predicted against measured landing x of the stream in CFS (:func:`cosim.coupling.landing.landing_accuracy`)."""
+        rows = self.log.arrays()
+        if "t" not in rows:
+            return {"samples": 0}
+        return landing_accuracy(rows["t"], rows["landing_x"], rows["landing_fall_time"], rows["landing_measured_x"],
+                                rows["phase"] == "cfs")
+
+    def outflow_timing(self) -> dict:
+        """First and steady outflow (s after the pour's start), :func:`cosim.coupling.outflow.outflow_timing`."""
+        rows = self.log.arrays()
+        if "t" not in rows:
+            return outflow_timing([], [], [], 0.0)
+        return outflow_timing(rows["t"], rows["poured_volume"], rows["phase"] == "cfs", self.controller.config.start_time)
 
     def summary(self) -> dict:
         """Volumes (m^3), phases (name, start s, end s), times (s) of the run so far."""
@@ -207,6 +232,8 @@ class CoupledPour:
                 {"time": tr.t, "from": tr.source.value, "to": tr.target.value, "reason": tr.reason}
                 for tr in self.controller.transitions
             ],
+            "landing": self.landing_accuracy(),
+            "outflow": self.outflow_timing(),
             "pour_done": self.done_at is not None,
             "sim_time": self.time,
             "wall_time": self.wall_time,

@@ -1,12 +1,14 @@
 """Side-view pictures of a finished pour, from its run folder (a tool for docs and debugging; it only reads).
 
-    python -m cosim.io.snapshot RUN [--times 2.0 5.0 8.0] [--out RUN/snapshot.png]
+    python -m cosim.io.snapshot RUN [--times 2.0 5.0 8.0] [--stream] [--out RUN/snapshot.png]
 
 Each panel is the pour plane (world x-z): the liquid particles logged in ``pour.rrd`` at the nearest logged time
 (coloured by speed, viridis), and the vessels and arm links of the scene posed by forward kinematics of the joint
 trajectory in ``trajectory.csv`` at that time (every box geom as its outline in the plane, capsules and cylinders as
 their axis). Without ``--times``, four times spread over the controller's pouring phases are taken from
-``summary.json``.
+``summary.json``. ``--stream`` draws, where liquid flows over the lip, the free-fall parabola the catcher aims
+with (seed Eqs. 6-7, launched at the lip with the measured v_q, from where it is measured, ``series.csv``) over the SPH stream: the seed's
+Fig. 10 comparison, and the landing point predicted at the catcher's rim height.
 """
 
 from __future__ import annotations
@@ -18,12 +20,15 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from controllers.catcher import fall_time
 from cosim.atomic_files import atomic_path
+from cosim.io.pour_series import read_series_csv
 from cosim.io.rerun_read import read_component
 from cosim.io.rerun_paths import LIQUID
 from cosim.io.trajectory_csv import read_trajectory_csv
 from cosim.robots.scene import RobotScene
 
+GRAVITY = 9.81  # m/s^2, the scenes' gravity (the controller's model uses the same)
 BOX_CORNERS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]], dtype=float)
 
 
@@ -48,7 +53,21 @@ def _draw_scene(ax, model: mujoco.MjModel, data: mujoco.MjData) -> None:
             ax.plot(ends[:, 0], ends[:, 2], color=color, lw=max(1.0, 200 * size[0]), alpha=0.6, solid_capstyle="round")
 
 
-def render(run: Path, times: list[float] | None, out: Path) -> Path:
+def _draw_parabola(ax, series: dict[str, np.ndarray], t: float) -> None:
+    """The jet parabola predicted at the control step nearest ``t`` (if liquid flowed then), down to the rim."""
+    k = int(np.argmin(np.abs(series["t"] - t)))
+    h_q, v_x, v_z = series["h_q"][k], series["v_q"][k], series["v_q_z"][k]
+    if not (h_q > 0.0 and v_x > 0.0):
+        return
+    x0, z0 = series["lip_x"][k] + series["jet_dx"][k], series["lip_z"][k] + series["jet_dz"][k]
+    rim = series["catcher_rim_z"][k]
+    s = np.linspace(0.0, fall_time(z0 - rim, v_z, GRAVITY), 50)
+    ax.plot(x0 + v_x * s, z0 + v_z * s - 0.5 * GRAVITY * s**2, "r--", lw=1.2, zorder=4, label="Eqs. 6-7 parabola")
+    ax.plot([series["landing_x"][k]], [rim], "rx", ms=8, zorder=5, label="predicted landing")
+    ax.legend(loc="upper right", fontsize=7)
+
+
+def render(run: Path, times: list[float] | None, out: Path, stream: bool = False) -> Path:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -62,6 +81,7 @@ def render(run: Path, times: list[float] | None, out: Path) -> Path:
     model, data = scene.model, mujoco.MjData(scene.model)
     mujoco.mj_resetDataKeyframe(model, data, scene.home_key)
     columns = {name: k for k, name in enumerate(traj.joint_names)}
+    series = {k: np.asarray(v) for k, v in read_series_csv(run / "series.csv").items()} if stream else None
     fig, axes = plt.subplots(1, len(times), figsize=(4.2 * len(times), 4.6), dpi=110, squeeze=False)
     for ax, t in zip(axes[0], times):
         k = int(np.argmin(np.abs(traj.time - t)))
@@ -72,6 +92,8 @@ def render(run: Path, times: list[float] | None, out: Path) -> Path:
         i = int(np.argmin(np.abs(liquid.sim_time - t)))
         points = liquid.values[i]
         ax.scatter(points[:, 0], points[:, 2], s=4, c="tab:blue", zorder=3)
+        if series is not None:
+            _draw_parabola(ax, series, liquid.sim_time[i])
         ax.set_title(f"t = {liquid.sim_time[i]:.2f} s")
         ax.set_aspect("equal")
         ax.set_xlim(-0.45, 0.75)
@@ -90,9 +112,10 @@ def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("run", type=Path)
     p.add_argument("--times", type=float, nargs="*")
+    p.add_argument("--stream", action="store_true", help="draw the predicted jet parabola where liquid flows")
     p.add_argument("--out", type=Path)
     args = p.parse_args(argv)
-    print(render(args.run, args.times, args.out or args.run / "snapshot.png"))
+    print(render(args.run, args.times, args.out or args.run / "snapshot.png", args.stream))
     return 0
 
 
