@@ -46,7 +46,7 @@ class FluidSettings:
     pressure_solver: 'wcsph' (weakly compressible, time step set by an artificial sound speed) or 'dfsph'
       (divergence-free SPH, time step set by the flow speed).
     smoothing_ratio: h / dx. [1.0, 2.5]
-    cfl: Courant number of the acoustic time step. (0, 0.6]
+    cfl: Courant number of the time step (on the sound speed for WCSPH, on the flow speed for DFSPH). (0, 0.6]
     sound_speed_factor: c0 / expected maximum speed (>= 10 keeps density errors near 1 %). [10, 100]
     artificial_viscosity: Monaghan alpha. [0, 1]
     density_diffusion: delta-SPH delta. [0, 1]

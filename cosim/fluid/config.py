@@ -44,7 +44,8 @@ class FluidConfig:
     rest_density: kg/m^3, rho0. [500, 2000]
     gamma: Tait exponent. [1, 10]
     max_expected_speed: m/s, the largest liquid speed the scene is expected to reach (sets c0). (0, 50]
-    sound_speed_factor: c0 / max_expected_speed. [10, 100] (>= 10 keeps |rho - rho0|/rho0 ~ 1 %)
+    sound_speed_factor: c0 / max_expected_speed. [10, 100] (>= 10 keeps |rho - rho0|/rho0 ~ 1 %). DFSPH has no
+        equation of state: it uses c0 only as the velocity scale of the artificial viscosity, as WCSPH does.
     kinematic_viscosity: m^2/s, laminar viscosity (water 1.0e-6 at 20 C). [0, 0.01]
     artificial_viscosity: Monaghan alpha (dimensionless), also applied against walls. [0, 1]
     density_diffusion: delta of delta-SPH (Antuono et al. 2010, renormalised density gradient). [0, 1]

@@ -4,7 +4,9 @@ Incompressibility is enforced by two iterative solves per substep instead of a s
 time step follows the flow speed (CFL on particle and wall speed) rather than an artificial speed of sound.
 A substep, after the neighbour search:
 
-  compute_density_factor   rho_i = (sum_j m W_ij + sum_b rho0 V_b W_ib) / s (summation density, wall particles
+  compute_density_factor   the substep's pair list (liquid and wall neighbours with their mass-weighted kernel
+                           gradients, which every solve iteration loops over instead of the cell grid);
+                           rho_i = (sum_j m W_ij + sum_b rho0 V_b W_ib) / s (summation density, wall particles
                            included; s = the sum over a resting lattice / rho0, 1.005 for Wendland C2 at h = 1.5 dx
                            in 2-D, so the liquid as seeded is at rest instead of 0.5 % compressed) and the DFSPH factor alpha_i = rho_i / (|sum_j m grad W_ij + sum_b rho0 V_b
                            grad W_ib|^2 + sum_j |m grad W_ij|^2); starts the divergence solve (warm start).
@@ -31,7 +33,8 @@ substep.
 
 The stopping test reads one int32 flag that ``check_convergence`` writes on the device, driven by
 ``wp.capture_while``: on the CPU it reads the flag from memory each iteration; on CUDA it becomes a conditional
-graph node when captured (otherwise warp copies the flag to the host each iteration). The average error is
+graph node when captured (otherwise warp copies the flag to the host each iteration). Verified on the CPU only: no
+GPU was available when this was written, so neither the CUDA run nor its graph capture has been executed. The average error is
 summed as integers (quanta of ``ERROR_QUANTUM``) so it does not depend on the order of the atomic adds: the
 iteration count, and with it the trajectory, is deterministic on every device.
 
