@@ -8,14 +8,16 @@ A substep, after the neighbour search:
                            gradients, which every solve iteration loops over instead of the cell grid);
                            rho_i = (sum_j m W_ij + sum_b rho0 V_b W_ib) / s (summation density, wall particles
                            included; s = the sum over a resting lattice / rho0, 1.005 for Wendland C2 at h = 1.5 dx
-                           in 2-D, so the liquid as seeded is at rest instead of 0.5 % compressed) and the DFSPH factor alpha_i = rho_i / (|sum_j m grad W_ij + sum_b rho0 V_b
-                           grad W_ib|^2 + sum_j |m grad W_ij|^2); starts the divergence solve (warm start).
+                           in 2-D, so the liquid as seeded is at rest instead of 0.5 % compressed) and the DFSPH
+                           factor alpha_i = rho_i / (|sum_j m grad W_ij + sum_b rho0 V_b grad W_ib|^2
+                           + sum_j |m grad W_ij|^2) (denominator bounded below); starts the divergence solve.
   divergence solve         iterate [apply_stiffness, compute_solve_error, check_convergence] until the average
                            compressing density rate times dt is below ``divergence_tolerance`` rho0 and no
                            particle's above MAX_PARTICLE_RESIDUAL (or the iteration cap).
   compute_nonpressure      v* = v + dt (gravity + viscosity); starts the density solve (warm start).
   density solve            the same iteration on the predicted density rho_i + dt Drho_i/Dt until its average
-                           compression is below ``density_tolerance`` rho0.
+                           compression is below ``density_tolerance`` rho0 (and no particle's above
+                           MAX_PARTICLE_RESIDUAL).
   compute_wall_reaction    the liquid's force on each vessel from exactly the pair forces its wall particles
                            exerted in both solves (Newton's third law), per particle, reduced later in fixed order.
   integrate                x += dt v*, then the shared wall guard, deactivation and diagnostics.
@@ -33,9 +35,9 @@ substep.
 
 The stopping test reads one int32 flag that ``check_convergence`` writes on the device, driven by
 ``wp.capture_while``: on the CPU it reads the flag from memory each iteration; on CUDA it becomes a conditional
-graph node when captured (otherwise warp copies the flag to the host each iteration). Verified on the CPU only: no
-GPU was available when this was written, so neither the CUDA run nor its graph capture has been executed. The average error is
-summed as integers (quanta of ``ERROR_QUANTUM``) so it does not depend on the order of the atomic adds: the
+graph node when captured (otherwise warp copies the flag to the host each iteration). Verified on the CPU only:
+no GPU was available when this was written, so neither the CUDA run nor its graph capture has been executed.
+The average error is summed as integers (quanta of ``ERROR_QUANTUM``) so it does not depend on the order of the atomic adds: the
 iteration count, and with it the trajectory, is deterministic on every device.
 
 Diagnostics: ``max_density_error`` and ``max_compression`` are the summation density's compression
@@ -103,6 +105,7 @@ def pair_capacity(dim: int, smoothing_ratio: float) -> int:
     radius = 2.0 * smoothing_ratio  # in particle spacings
     lattice = math.pi * radius**2 if dim == 2 else 4.0 / 3.0 * math.pi * radius**3
     return math.ceil(PAIR_CAPACITY_FACTOR * lattice)
+
 
 # solve_stats (int64): error sum (quanta), active particle count, iterations of the current solve, largest error
 STAT_ERROR = wp.constant(0)
