@@ -78,6 +78,11 @@ def liquid_block(lo, hi, cfg: FluidConfig, pose: Pose | None = None) -> Particle
     return _place(local, surface - local[:, 2], cfg, pose)
 
 
+def fill_layers(spec: VesselSpec, fill_depth: float, dx: float) -> int:
+    """Particle layers :func:`fill_vessel` seeds for ``fill_depth`` (m) at spacing ``dx`` (m): never above the rim."""
+    return min(_layers(fill_depth, dx), int(math.floor(spec.inner_height / dx + 1e-9)))
+
+
 def fill_vessel(spec: VesselSpec, fill_depth: float, cfg: FluidConfig, pose: Pose | None = None) -> ParticleSet:
     """Liquid filling an upright vessel to ``fill_depth`` (m) on the lattice; the vessel is placed by ``pose``."""
     spec.fill_volume(fill_depth)  # range check against the rim
@@ -93,7 +98,7 @@ def fill_vessel(spec: VesselSpec, fill_depth: float, cfg: FluidConfig, pose: Pos
         local = block.positions
         keep = np.hypot(local[:, 0], local[:, 1]) <= r - 0.5 * dx
         local = local[keep]
-    n_z = min(_layers(fill_depth, dx), int(math.floor(spec.inner_height / dx + 1e-9)))  # never above the rim
+    n_z = fill_layers(spec, fill_depth, dx)
     local = local[local[:, 2] < n_z * dx]
     return _place(local, n_z * dx - local[:, 2], cfg, pose)
 
