@@ -8,9 +8,9 @@ from typing import Any
 
 import numpy as np
 
-from cosim.checks import check_device, check_int, check_positive
+from cosim.checks import check_choice, check_device, check_int, check_positive
 from cosim.errors import InputError
-from cosim.fluid.config import GRAVITY, FluidConfig
+from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
 
 
 @dataclass(frozen=True)
@@ -57,12 +57,14 @@ class FluidCaseParams:
 
     spacing: m, particle spacing (None: the case's default resolution). dim: 2 or 3. device: 'cpu' or 'cuda[:N]'.
     depth: m, tank depth perpendicular to the pour plane (3-D extent; 2-D out-of-plane scale).
+    solver: pressure solver, :class:`PressureSolver` or its name ('wcsph', 'dfsph').
     """
 
     spacing: float | None = None
     dim: int = 2
     device: str = "cpu"
     depth: float = 0.1
+    solver: PressureSolver = PressureSolver.WCSPH
 
     def validate_common(self) -> None:
         if self.spacing is not None:
@@ -70,6 +72,7 @@ class FluidCaseParams:
         check_int("dim", self.dim, 2, 3)
         check_device("device", self.device)
         check_positive("depth", self.depth, "m", 2.0)
+        object.__setattr__(self, "solver", check_choice("solver", self.solver, PressureSolver))
 
 
 def reference_speed(liquid_height: float) -> float:
@@ -79,10 +82,13 @@ def reference_speed(liquid_height: float) -> float:
     return 2.0 * math.sqrt(GRAVITY * liquid_height)
 
 
-def case_fluid_config(dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max) -> FluidConfig:
+def case_fluid_config(
+    dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max, solver: PressureSolver = PressureSolver.WCSPH
+) -> FluidConfig:
     """The fluid configuration every case uses: project defaults, c0 from :func:`reference_speed`."""
     return FluidConfig(
         dim=dim,
+        pressure_solver=solver,
         spacing=spacing,
         max_expected_speed=reference_speed(liquid_height),
         depth_2d=depth,

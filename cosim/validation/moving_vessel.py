@@ -64,7 +64,7 @@ class Params(FluidCaseParams):
 def _run(name: str, p: Params, pose_at: PoseScript) -> CaseResult:
     spec = p.spec()
     dx = p.resolved_spacing
-    cfg = case_fluid_config(p.dim, dx, max(p.fill, FALL_HEIGHT), spec.section_depth, *domain_around(spec, p.amplitude))
+    cfg = case_fluid_config(p.dim, dx, max(p.fill, FALL_HEIGHT), spec.section_depth, *domain_around(spec, p.amplitude), p.solver)
     run = run_scripted(spec, p.fill, cfg, pose_at, p.duration_for(name), device=p.device)
     solver, leaks, failure = run.solver, run.leaks, run.failure
     hist = solver.history()
@@ -86,7 +86,7 @@ def _run(name: str, p: Params, pose_at: PoseScript) -> CaseResult:
         "t": run.t,
         "volume_in_vessel": run.volume_in_vessel,
     }
-    params = dict(fill=p.fill, spacing=dx, dim=p.dim, device=p.device, rate=p.rate, angle=p.angle,
+    params = dict(fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, rate=p.rate, angle=p.angle,
                   amplitude=p.amplitude, periods=p.periods)
     return CaseResult(name, params, metrics, raw, run.wall_time)
 
