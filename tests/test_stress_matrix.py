@@ -25,7 +25,8 @@ def test_matrix_covers_the_required_ranges():
     assert max(c.cfl_factor for c in configs) == pytest.approx(2.0)
     assert {c.dim for c in configs} == {2, 3}
     assert {c.solver for c in configs} == {s.value for s in PressureSolver}
-    assert len({c.across for c in configs if c.dim == 2}) == 3 and len({c.across for c in configs if c.dim == 3}) == 2
+    assert len({c.across for c in configs if c.dim == 2}) == 4 and len({c.across for c in configs if c.dim == 3}) == 2
+    assert any(c.fill == 0.10 and c.layers >= 3 for c in configs)  # the lowest fill is simulated, not only refused
 
 
 def test_config_id_is_stable_and_fluid_config_follows_the_axes():

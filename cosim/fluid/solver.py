@@ -44,10 +44,6 @@ from cosim.vessel import VesselSpec
 WRENCH_CHUNKS = 64  # first-level chunks of the fixed-order wrench reduction
 FORCE_CFL = 0.25  # Monaghan's force criterion dt <= 0.25 sqrt(h / a_max)
 VISCOUS_CFL = 0.125  # viscous criterion dt <= 0.125 h^2 / nu
-# WCSPH's density error grows as the Mach number squared: c0 = 10 v_max is sized for Ma = 0.1 (about 1 %); a
-# particle at Ma > 0.2 (about 4 %, Monaghan 1994) means the motion outran the c0 it was given. The stability matrix
-# (docs/stability.md) found such runs creating energy with plausible densities and no other symptom.
-MAX_MACH = 0.2
 GUARD_MARGIN = 0.01  # the guard puts a particle this many dx outside the wall face it crossed
 
 
@@ -403,13 +399,6 @@ class FluidSolver:
                 lambda s: f"compression {rows_f[s, 4]:.3f} exceeds fluid.max_density_error = {cfg.max_density_error:g}",
             ),
         ]
-        if cfg.pressure_solver is PressureSolver.WCSPH:
-            limit = MAX_MACH * cfg.sound_speed
-            checks.append((
-                rows_f[:, 0] > limit,
-                lambda s: f"fastest particle {rows_f[s, 0]:.3g} m/s is faster than {MAX_MACH:g} c0 = {limit:.3g} m/s, where "
-                "the weakly compressible model no longer holds: raise fluid.max_expected_speed",
-            ))
         bad = [(int(np.argmax(mask)), describe) for mask, describe in checks if mask.any()]
         if bad:
             s, describe = min(bad, key=lambda b: b[0])
