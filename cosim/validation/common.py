@@ -12,6 +12,9 @@ from cosim.checks import check_device, check_int, check_positive
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig
 
+# FluidConfig fields a case's numerics may override (the rest is the case's geometry and physics).
+NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "solver")
+
 
 @dataclass(frozen=True)
 class Metric:
@@ -57,12 +60,15 @@ class FluidCaseParams:
 
     spacing: m, particle spacing (None: the case's default resolution). dim: 2 or 3. device: 'cpu' or 'cuda[:N]'.
     depth: m, tank depth perpendicular to the pour plane (3-D extent; 2-D out-of-plane scale).
+    numerics: overrides of the solver's numerical settings, (FluidConfig field, value) pairs, e.g.
+        (("kernel", "cubic_spline"), ("cfl", 0.4)); one of NUMERICS_FIELDS each (the benchmark's axes).
     """
 
     spacing: float | None = None
     dim: int = 2
     device: str = "cpu"
     depth: float = 0.1
+    numerics: tuple[tuple[str, Any], ...] = ()
 
     def validate_common(self) -> None:
         if self.spacing is not None:
@@ -70,6 +76,10 @@ class FluidCaseParams:
         check_int("dim", self.dim, 2, 3)
         check_device("device", self.device)
         check_positive("depth", self.depth, "m", 2.0)
+        for name, _ in self.numerics:
+            if name not in NUMERICS_FIELDS:
+                raise InputError(f"numerics: {name!r} cannot be overridden; choose from {', '.join(NUMERICS_FIELDS)}")
+        FluidConfig(**dict(self.numerics))  # the values' own range checks, before anything runs
 
 
 def reference_speed(liquid_height: float) -> float:
@@ -79,8 +89,11 @@ def reference_speed(liquid_height: float) -> float:
     return 2.0 * math.sqrt(GRAVITY * liquid_height)
 
 
-def case_fluid_config(dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max) -> FluidConfig:
-    """The fluid configuration every case uses: project defaults, c0 from :func:`reference_speed`."""
+def case_fluid_config(
+    dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max, numerics=()
+) -> FluidConfig:
+    """The fluid configuration every case uses: project defaults (or ``numerics``, see :class:`FluidCaseParams`),
+    c0 from :func:`reference_speed`."""
     return FluidConfig(
         dim=dim,
         spacing=spacing,
@@ -88,6 +101,7 @@ def case_fluid_config(dim: int, spacing: float, liquid_height: float, depth: flo
         depth_2d=depth,
         domain_min=tuple(domain_min),
         domain_max=tuple(domain_max),
+        **dict(numerics),
     )
 
 

@@ -82,6 +82,7 @@ def _run(name: str, p: Params, pose_at) -> CaseResult:
     cfg = case_fluid_config(
         p.dim, dx, max(p.fill, FALL_HEIGHT), spec.section_depth,
         (-reach - p.amplitude, -reach, -FALL_HEIGHT), (reach + p.amplitude, reach, reach),
+        numerics=p.numerics,
     )
     solver = FluidSolver(cfg, [spec], [pose_at(0.0)], fill_vessel(spec, p.fill, cfg, pose_at(0.0)), device=p.device)
     t_wall = float(solver.model.wall_thickness[0])
