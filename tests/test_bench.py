@@ -78,9 +78,10 @@ def test_real_smoke_rows_csv_and_markdown(tmp_path):
     assert len(table) == len(plan.rows) and tuple(table[0]) == CSV_COLUMNS
     hydro = [t for t in table if t["case"] == "hydrostatic"]
     assert hydro and all(0 <= float(t["pressure_error"]) < 0.1 and t["front_error"] == "" for t in hydro)
-    text = markdown(plan, rows, [], {}, "## header")
+    text = markdown(plan, outcome.results, rows, [], {}, "## header")
     assert "### hydrostatic" in text and "### dam-break" in text and "**default**" in text
     assert text.count("| cfl 0.4 |") == 2  # one CFL row per case
+    assert "load average" in text
 
 
 def test_update_document_keeps_the_text_around_the_generated_block(tmp_path):
@@ -96,7 +97,7 @@ def test_update_document_keeps_the_text_around_the_generated_block(tmp_path):
 
 def _pour_raw(poured, landing, q, initial=1.0):
     t = [0.0, 1.0, 2.0]
-    return {"status": "ok", "outcome": {"initial_volume": initial},
+    return {"status": "ok", "outcome": {"initial_volume": initial, "caught_volume": 0.8 * poured[-1]},
             "series": {"t": t, "poured_volume": poured, "landing_measured_x": landing, "trajectory_time": t,
                        "joint_names": ["a/j"], "joint_positions": [[x] for x in q]}}
 
@@ -108,6 +109,8 @@ def test_pour_comparison_against_hand_computed_values():
     assert err["poured_curve_error"] == pytest.approx(math.sqrt(0.09 / 3))
     assert err["landing_error_m"] == pytest.approx(0.31 - 0.25)
     assert err["joint_rms_rad"] == pytest.approx(math.sqrt(0.09 / 3))
+    assert err["final_caught_error"] == pytest.approx(0.0)
+    assert compare_pours(_pour_raw([0.0, 0.1, 0.2], [None] * 3, [0, 0, 0]), ref)["final_caught_error"] == pytest.approx(0.08)
     assert math.isnan(compare_pours(_pour_raw([0, 0, 0], [None] * 3, [0, 0, 0]), ref)["landing_error_m"])
 
 

@@ -6,7 +6,9 @@ simulated.
 - ``landing_error_m``: m, difference of the median measured landing x (where the stream crosses the catcher's rim
   plane, ``series.csv``'s ``landing_measured_x``); NaN when either run had no stream.
 - ``joint_rms_rad``: rad, RMS over time and all joints of both arms of the joint position difference of the
-  exported trajectories.
+  exported (commanded, jerk-limited) trajectories.
+- ``final_caught_error``: difference of the volume in the catcher at the end of each run, divided by the
+  reference's initial volume (the runs may differ in length: the early-stop pair).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ import math
 
 import numpy as np
 
-POUR_ERRORS = ("poured_curve_error", "landing_error_m", "joint_rms_rad")
+POUR_ERRORS = ("poured_curve_error", "landing_error_m", "joint_rms_rad", "final_caught_error")
 
 
 def _common_grid(t_run: np.ndarray, t_ref: np.ndarray) -> np.ndarray:
@@ -46,4 +48,5 @@ def compare_pours(run: dict, reference: dict) -> dict[str, float]:
         "poured_curve_error": float(np.sqrt(np.mean(poured**2)) / initial),
         "landing_error_m": abs(_median_landing(a) - _median_landing(b)),
         "joint_rms_rad": float(np.sqrt(np.mean(dq**2))),
+        "final_caught_error": abs(run["outcome"]["caught_volume"] - reference["outcome"]["caught_volume"]) / initial,
     }

@@ -10,6 +10,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -37,6 +38,7 @@ ERROR_TITLES = {
     "poured_curve_error": "poured-volume curve RMS diff / initial volume",
     "landing_error_m": "landing point diff (m)",
     "joint_rms_rad": "joint trajectory RMS diff (rad)",
+    "final_caught_error": "final caught volume diff / initial volume",
 }
 CSV_COLUMNS = ("case", "dim", "particles_across", "kernel", "cfl", "pressure_solver", "device", "length", "options",
                "status", "particles", "sim_s", "wall_s", "wall_per_sim_s", *ERROR_TITLES, "compared_with", "key")
@@ -140,10 +142,15 @@ def _describe(cfg: BenchConfig, default: BenchConfig) -> str:
     return ", ".join(diffs) or "**default**"
 
 
-def markdown(plan: BenchPlan, rows: list[Row], skips: list[dict], plots: dict[BenchCase, str], header: str) -> str:
+def markdown(plan: BenchPlan, results: dict[BenchConfig, dict], rows: list[Row], skips: list[dict], plots: dict[BenchCase, str],
+             header: str) -> str:
     """The generated part of docs/benchmarks.md: per case a table (fastest first) with the Pareto membership and
     the plot, then the skip options."""
+    loads = [raw["load_average"] for raw in results.values() if "load_average" in raw]
     out = [header]
+    if loads:
+        out.append(f"1-minute load average after each computed row: {min(loads):.1f} to {max(loads):.1f} "
+                   f"(on {os.cpu_count()} logical cores; above that, other jobs shared the CPU and the wall times are longer).\n")
     for case, errors in CASE_ERRORS.items():
         case_rows = sorted((r for r in rows if r.config.case is case), key=lambda r: (r.config.device, r.wall_per_sim_s))
         if not case_rows:

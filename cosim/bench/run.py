@@ -3,6 +3,7 @@ soon as each finishes, so an interrupted bench resumes without redoing finished 
 
 from __future__ import annotations
 
+import os
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -52,7 +53,7 @@ def run_plan(plan: BenchPlan, cache: ResultCache, fresh: bool = False, progress:
     bar = tqdm(todo, unit="config", disable=not progress, file=sys.stderr, mininterval=1.0)
     for cfg in bar:
         bar.set_description_str(cfg.label)
-        result = runner(cfg)
+        result = dict(runner(cfg), load_average=os.getloadavg()[0])  # others' jobs on the machine skew wall times
         cache.put(keys[cfg], result)
         results[cfg] = result
     bar.close()

@@ -74,7 +74,7 @@ def run(args) -> int:
                 plot_dir.mkdir(parents=True, exist_ok=True)
                 shutil.copyfile(args.out / name, plot_dir / name)
     command = "cosim bench" + (f" --plan {args.plan}" if args.plan != "full" else "") + (f" --docs {args.docs}" if args.docs else "")
-    text = markdown(plan, rows, skips, plots, _header(command))
+    text = markdown(plan, outcome.results, rows, skips, plots, _header(command))
     write_text_atomic(args.out / "bench.csv", rows_csv(rows))
     write_text_atomic(args.out / "bench.md", text)
     if args.docs is not None:
