@@ -1,8 +1,9 @@
 """Result cache of the benchmark: one JSON file per configuration, named by its key.
 
-The key (:meth:`cosim.bench.config.BenchConfig.key`) hashes the configuration and :func:`code_version`, so an
-edit to the simulation code or a different warp/MuJoCo/numpy version reruns everything, while an interrupted
-bench resumes where it stopped. Files are written atomically: a run killed mid-write leaves no entry, never a
+The key (:meth:`cosim.bench.config.BenchConfig.key`) hashes the configuration and :func:`code_version` of the
+sources its case runs through, so an edit to that code or a different warp/MuJoCo/numpy version reruns the
+affected rows (an edit to the controller reruns the pours, not the fluid validations), while an interrupted bench
+resumes where it stopped. Files are written atomically: a run killed mid-write leaves no entry, never a
 broken one.
 """
 
@@ -14,28 +15,48 @@ from importlib import metadata
 from pathlib import Path
 
 from cosim.atomic_files import write_text_atomic
+from cosim.bench.config import BenchCase
 
-# What a result depends on: the packages the simulation runs through and the MJCF models (cosim/models, a link to
-# the repository's models/ in a checkout); the benchmark and CLI code are not part of it.
-_ROOTS = ("cosim", "controllers")
-_NOT_SIMULATION = ("cosim/bench", "cosim/cli")
+# What a result depends on, per case (paths relative to the repository root; "cosim/models" is a link to the MJCF
+# models in a checkout): the fluid cases run the fluid core only; coupling-static adds the robots and the coupling;
+# the pour runs everything. The benchmark and CLI code are never part of it.
+_FLUID_SOURCES = ("cosim/fluid", "cosim/validation", "cosim/frames.py", "cosim/vessel.py", "cosim/checks.py", "cosim/errors.py")
+_COUPLED_SOURCES = _FLUID_SOURCES + ("cosim/coupling", "cosim/robots", "cosim/models")
+_ALL_SOURCES = ("cosim", "controllers", "cosim/models")
+SOURCES = {
+    BenchCase.HYDROSTATIC: _FLUID_SOURCES,
+    BenchCase.SLOSH: _FLUID_SOURCES,
+    BenchCase.DAM_BREAK: _FLUID_SOURCES,
+    BenchCase.COUPLING_STATIC: _COUPLED_SOURCES,
+    BenchCase.POUR: _ALL_SOURCES,
+}
+_NOT_SIMULATION = ("cosim/bench/", "cosim/cli/")
 _SUFFIXES = (".py", ".xml", ".csv", ".toml", ".stl", ".obj")
 _DEPENDENCIES = ("warp-lang", "mujoco", "numpy", "ruckig", "control")
 
 
-def code_version() -> str:
-    """Hash of the simulation sources (``cosim`` and ``controllers``, without the bench and the CLI) and of the
-    installed versions of the numerical dependencies."""
+def _files(base: Path, source: str) -> list[tuple[str, Path]]:
+    root = (base / source).resolve()
+    if root.is_file():
+        return [(source, root)]
+    out = []
+    for path in root.rglob("*"):
+        rel = f"{source}/{path.relative_to(root).as_posix()}"
+        if path.is_file() and path.suffix in _SUFFIXES and not rel.startswith(_NOT_SIMULATION) and "__pycache__" not in rel:
+            out.append((rel, path))
+    return out
+
+
+def code_version(case: BenchCase) -> str:
+    """Hash of the sources ``case`` runs through (:data:`SOURCES`) and of the installed versions of the numerical
+    dependencies."""
     import cosim
 
     base = Path(cosim.__file__).resolve().parent.parent
-    roots = [(name, base / name) for name in _ROOTS] + [("models", (base / "cosim" / "models").resolve())]
+    files = dict(f for source in SOURCES[case] for f in _files(base, source))
     h = hashlib.sha256()
-    for name, root in roots:
-        for path in sorted(root.rglob("*")):
-            rel = f"{name}/{path.relative_to(root).as_posix()}"
-            if path.is_file() and path.suffix in _SUFFIXES and not rel.startswith(_NOT_SIMULATION):
-                h.update(rel.encode() + b"\0" + path.read_bytes() + b"\0")
+    for rel in sorted(files):
+        h.update(rel.encode() + b"\0" + files[rel].read_bytes() + b"\0")
     for name in _DEPENDENCIES:
         try:
             h.update(f"{name}={metadata.version(name)}".encode())

@@ -20,11 +20,13 @@ WARM_UP = dict(particles_across=8, length=0.01)  # a hydrostatic tank held 10 ms
 
 @dataclass
 class BenchOutcome:
-    """results and keys per configuration; computed: how many rows ran (the rest came from the cache)."""
+    """results and keys per configuration; computed: how many rows ran (the rest came from the cache);
+    versions: the code version of each case."""
 
     results: dict[BenchConfig, dict]
     keys: dict[BenchConfig, str]
     computed: int
+    versions: dict[BenchCase, str]
 
 
 def _warm_up(todo: list[BenchConfig], runner: Callable[[BenchConfig], dict]) -> None:
@@ -36,8 +38,8 @@ def _warm_up(todo: list[BenchConfig], runner: Callable[[BenchConfig], dict]) -> 
 def run_plan(plan: BenchPlan, cache: ResultCache, fresh: bool = False, progress: bool = True,
              runner: Callable[[BenchConfig], dict] = run_config) -> BenchOutcome:
     """Results of every row of ``plan``; ``fresh`` ignores (and overwrites) cached ones."""
-    version = code_version()
-    keys = {c: c.key(version) for c in plan.rows}
+    versions = {case: code_version(case) for case in dict.fromkeys(c.case for c in plan.rows)}
+    keys = {c: c.key(versions[c.case]) for c in plan.rows}
     results: dict[BenchConfig, dict] = {}
     todo = []
     for cfg in plan.rows:
@@ -47,7 +49,7 @@ def run_plan(plan: BenchPlan, cache: ResultCache, fresh: bool = False, progress:
         else:
             todo.append(cfg)
     print(f"cosim bench: {len(plan.rows)} configurations, {len(plan.rows) - len(todo)} cached, {len(todo)} to run "
-          f"(code version {version})", file=sys.stderr)
+          f"(code versions {', '.join(f'{k.value} {v}' for k, v in versions.items())})", file=sys.stderr)
     if todo:
         _warm_up(todo, runner)
     bar = tqdm(todo, unit="config", disable=not progress, file=sys.stderr, mininterval=1.0)
@@ -57,4 +59,4 @@ def run_plan(plan: BenchPlan, cache: ResultCache, fresh: bool = False, progress:
         cache.put(keys[cfg], result)
         results[cfg] = result
     bar.close()
-    return BenchOutcome(results, keys, len(todo))
+    return BenchOutcome(results, keys, len(todo), versions)

@@ -40,7 +40,7 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
 
-def _header(command: str) -> str:
+def _header(command: str, versions: dict) -> str:
     from cosim.fluid.benchmark import _machine
     from cosim.fluid.runtime import cuda_available
     from cosim.pour_run import _versions
@@ -49,7 +49,8 @@ def _header(command: str) -> str:
     cuda = "a CUDA device is present: cuda rows included" if cuda_available() else "no CUDA device here: CPU rows only"
     return (f"## Wall time against error ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
             f"Machine: {_machine()}; {cuda}. Versions: {versions}.\n"
-            f"Command: `{command}`.\n")
+            f"Command: `{command}`. Code versions (cosim.bench.cache.code_version): "
+            f"{', '.join(f'{k.value} {v}' for k, v in versions.items())}.\n")
 
 
 def run(args) -> int:
@@ -74,7 +75,7 @@ def run(args) -> int:
                 plot_dir.mkdir(parents=True, exist_ok=True)
                 shutil.copyfile(args.out / name, plot_dir / name)
     command = "cosim bench" + (f" --plan {args.plan}" if args.plan != "full" else "") + (f" --docs {args.docs}" if args.docs else "")
-    text = markdown(plan, outcome.results, rows, skips, plots, _header(command))
+    text = markdown(plan, outcome.results, rows, skips, plots, _header(command, outcome.versions))
     write_text_atomic(args.out / "bench.csv", rows_csv(rows))
     write_text_atomic(args.out / "bench.md", text)
     if args.docs is not None:
