@@ -151,8 +151,8 @@ class CatcherConfig:
     home_x: float
     travel_min: float = -0.3
     travel_max: float = 0.3
-    max_speed: float = 0.2
-    max_accel: float = 0.5
+    max_speed: float = 0.4
+    max_accel: float = 1.0
     discharge_coefficient: float = 0.6
 
     def __post_init__(self) -> None:

@@ -34,13 +34,16 @@ class LiquidMeasurement:
       (particles within one particle spacing dx of the crest's world x, above it): z of the highest such particle
       centre + dx/2 - z of the crest. Otherwise: the height of the theta1 fit line above the crest along world z,
       clipped to <= 0 (:func:`controllers.geometry.height_above`). h_q > 0 means outflow.
-    v_q: m/s, mean world-x velocity of the liquid particles leaving over the lip: those within dx of the lip's
-      world x, above z_lip - dx, outside the inner box; 0 when there are none.
+    v_q: m/s, mean world-x velocity of the liquid particles leaving over the lip: those outside the inner box
+      with world x in [x_lip - dx, x_lip + 3 dx] and z in [z_lip - 3 dx, z_lip + dx + max(h_q, 0)] (the stream
+      within a few spacings of the lip); 0 when there are none.
     volume_in_pourer: m^3, liquid inside the pourer's inner box.
     poured_volume: m^3, liquid that has left the pourer since the start (initial minus in-pourer volume).
     lip_x, lip_z: m, world position of the pour lip (outer top edge of the +x wall).
     catcher_rim_z: m, world z of vessel B's rim, the height at which the jet enters it.
     v_q_z: m/s, mean world-z velocity (up positive) of the same particles as v_q; 0 reproduces the seed's Eq. 6.
+    jet_dx, jet_dz: m, mean world position of the same particles relative to the lip: where the measured launch
+      state (v_q, v_q_z) applies; 0 launches at the lip (the seed's Eqs. 6-7).
     """
 
     t: float
@@ -54,6 +57,8 @@ class LiquidMeasurement:
     lip_z: float
     catcher_rim_z: float
     v_q_z: float = 0.0
+    jet_dx: float = 0.0
+    jet_dz: float = 0.0
 
     def __post_init__(self) -> None:
         for f in fields(self):

@@ -173,6 +173,10 @@ class PourController:
         elif phase is Phase.APPROACH:
             self._reference = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
             self._approach.reset(self.pose.theta)
+        elif phase is Phase.CFS and self._transitions[-1].source is Phase.SIM_DAMP and m.tilt < self.pose.theta:
+            # The PID's command runs ahead of the arm (task-space filter lag); CFS starts from the measured tilt, so
+            # the stream does not begin with the command's lead as an overshoot of h_q.
+            self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
         elif phase is Phase.RETURN:
             self._return_from = self.pose
             self._return.reset(self.pose.theta)
@@ -314,14 +318,14 @@ class PourController:
         return PlanarPose(start.dx * f, start.dz * f, theta)
 
     def _landing(self, m: LiquidMeasurement) -> float | None:
-        """Predicted landing x (m, world): measured jet while liquid flows, else the weir estimate at h_q_ref;
+        """Predicted landing x (m, world): the measured jet (launched where v_q is measured) while liquid flows, else
+        the weir estimate at h_q_ref launched at the lip;
         None (hold vessel B) once the pour is over and nothing flows."""
         flowing = m.h_q > 0.0 and m.v_q > 0.0
         if not flowing and self.phase in (Phase.RETURN, Phase.DONE):
             return None
         cfg = self.config
         if flowing:
-            v_x, v_z = m.v_q, m.v_q_z
-        else:
-            v_x, v_z = weir_velocity(cfg.cfs.h_q_ref, cfg.catcher.discharge_coefficient, cfg.gravity), 0.0
-        return landing_x(m.lip_x, m.lip_z, m.catcher_rim_z, v_x, v_z, cfg.gravity)
+            return landing_x(m.lip_x + m.jet_dx, m.lip_z + m.jet_dz, m.catcher_rim_z, m.v_q, m.v_q_z, cfg.gravity)
+        v_weir = weir_velocity(cfg.cfs.h_q_ref, cfg.catcher.discharge_coefficient, cfg.gravity)
+        return landing_x(m.lip_x, m.lip_z, m.catcher_rim_z, v_weir, 0.0, cfg.gravity)

@@ -91,8 +91,8 @@ class CatcherSettings:
     """
 
     travel: float = 0.15
-    max_speed: float = 0.2
-    max_accel: float = 0.5
+    max_speed: float = 0.4
+    max_accel: float = 1.0
     discharge_coefficient: float = 0.6
 
     def __post_init__(self) -> None:

@@ -175,9 +175,9 @@ class CoupledPour:
         self.log.append(
             t=self.time, tilt=m.tilt, theta1=m.theta1, h_q=m.h_q, v_q=m.v_q, v_q_z=m.v_q_z,
             volume_in_pourer=in_pourer, volume_in_catcher=in_catcher, poured_volume=m.poured_volume,
-            spilled_volume=last.spilled_volume if last else 0.0, lip_x=m.lip_x, lip_z=m.lip_z,
+            spilled_volume=last.spilled_volume if last else 0.0, lip_x=m.lip_x, lip_z=m.lip_z, jet_dx=m.jet_dx, jet_dz=m.jet_dz,
             landing_x=cmd.landing_x, landing_measured_x=crossing,
-            landing_fall_time=fall_time(m.lip_z - m.catcher_rim_z, m.v_q_z, gravity) if flowing else math.nan,
+            landing_fall_time=fall_time(m.lip_z + m.jet_dz - m.catcher_rim_z, m.v_q_z, gravity) if flowing else math.nan,
             catcher_rim_z=m.catcher_rim_z, phase=cmd.phase.value, target_theta=cmd.pourer.theta, target_dx=cmd.pourer.dx,
             target_dz=cmd.pourer.dz, smoothed_theta=smoothed[ArmRole.POUR].theta, catcher_dx=cmd.catcher.dx,
             smoothed_catcher_dx=smoothed[ArmRole.CATCH].dx, wrench_pourer=self.wrench[0].copy(),

@@ -103,9 +103,13 @@ def measure(
         h_q = -height  # no surface to measure: far below the crest
 
     lip = pourer_pose.transform(geo.lip_local[None, :])[0]
-    leaving = (np.abs(x[:, 0] - lip[0]) <= dx) & (x[:, 2] > lip[2] - dx) & ~inner
-    v_q = float(v[leaving, 0].mean()) if leaving.any() else 0.0
-    v_q_z = float(v[leaving, 2].mean()) if leaving.any() else 0.0
+    top = lip[2] + dx + max(h_q, 0.0)
+    leaving = (x[:, 0] >= lip[0] - dx) & (x[:, 0] <= lip[0] + 3 * dx) & (x[:, 2] >= lip[2] - 3 * dx) & (x[:, 2] <= top) & ~inner
+    if leaving.any():
+        v_q, v_q_z = (float(c) for c in v[leaving][:, [0, 2]].mean(axis=0))
+        jet_dx, jet_dz = (float(c) for c in x[leaving][:, [0, 2]].mean(axis=0) - lip[[0, 2]])
+    else:
+        v_q = v_q_z = jet_dx = jet_dz = 0.0
     rim = catcher_pose.transform(np.array([[0.0, 0.0, geo.catcher_height]]))[0]
     return LiquidMeasurement(
         t=t,
@@ -119,4 +123,6 @@ def measure(
         lip_z=float(lip[2]),
         catcher_rim_z=float(rim[2]),
         v_q_z=v_q_z,
+        jet_dx=jet_dx,
+        jet_dz=jet_dz,
     )

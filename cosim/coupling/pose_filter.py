@@ -4,7 +4,9 @@ The controller's planar targets can change faster than a jerk-limited arm can fo
 theta = phi sin(alpha t) starts with a velocity step); fed straight to IK, the joint trajectory then cuts across
 the intended vessel path by centimetres. The targets (dx, dz, theta of the pourer; dx of the catcher) go through a
 ruckig generator in those coordinates first (the same :class:`TrajectoryGenerator`, one "joint" per coordinate),
-stepped at the control rate; the joint generators then follow IK of the smoothed path within their limits.
+stepped at the control rate; the joint generators then follow IK of the smoothed path within their limits. Each
+target is approached as a state at rest, so a moving target is followed with a small lag (a 0.35 rad/s ramp: 0.039 rad, a
+jerk-limited stop's distance) and a chattering one never sets the filter swinging.
 """
 
 from __future__ import annotations
@@ -68,7 +70,11 @@ class PoseFilter:
 
     def __call__(self, target: PlanarPose) -> PlanarPose:
         """The smoothed pose one control period after the previous call, heading for ``target``."""
-        self._generator.set_target(np.array([getattr(target, c) for c in self.coordinates]))
+        # Each target is one to come to rest at. Estimating a path velocity from the targets (what the joint
+        # generators do with the already smooth output of this filter) reads the controller's step-to-step
+        # corrections of either sign as velocity and drove a +-0.1 rad limit cycle of the tilt in the coupled pour.
+        zero = np.zeros(len(self.coordinates))
+        self._generator.set_target(np.array([getattr(target, c) for c in self.coordinates]), zero, zero)
         q, _, _ = self._generator.step()
         values = dict(zip(self.coordinates, map(float, q)))
         return PlanarPose(values.get("dx", 0.0), values.get("dz", 0.0), values.get("theta", 0.0))

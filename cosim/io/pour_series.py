@@ -3,7 +3,7 @@
 One row per control step (10 ms by default). Columns (SI units, rad): ``t`` s; ``phase``; ``tilt``, ``theta1``
 rad (measured pourer tilt and free-surface angle); ``h_q`` m, ``v_q``, ``v_q_z`` m/s (height over the crest and
 outflow velocity); ``volume_in_pourer``, ``volume_in_catcher``, ``poured_volume``, ``spilled_volume`` m^3
-(spilled: left the simulation domain); ``lip_x``, ``lip_z``, ``catcher_rim_z`` m; ``landing_x`` m (predicted),
+(spilled: left the simulation domain); ``lip_x``, ``lip_z``, ``catcher_rim_z`` m; ``jet_dx``, ``jet_dz`` m (where v_q is measured, from the lip); ``landing_x`` m (predicted),
 ``landing_measured_x`` m (stream crossing the rim plane, empty when none), ``landing_fall_time`` s;
 ``target_theta``, ``target_dx``, ``target_dz``, ``smoothed_theta``, ``catcher_dx``, ``smoothed_catcher_dx``
 (controller targets before and after the task-space filter, rad and m).
@@ -17,7 +17,7 @@ from pathlib import Path
 
 COLUMNS = (
     "t", "phase", "tilt", "theta1", "h_q", "v_q", "v_q_z", "volume_in_pourer", "volume_in_catcher", "poured_volume",
-    "spilled_volume", "lip_x", "lip_z", "catcher_rim_z", "landing_x", "landing_measured_x", "landing_fall_time",
+    "spilled_volume", "lip_x", "lip_z", "jet_dx", "jet_dz", "catcher_rim_z", "landing_x", "landing_measured_x", "landing_fall_time",
     "target_theta", "target_dx", "target_dz", "smoothed_theta", "catcher_dx", "smoothed_catcher_dx",
 )
 

@@ -7,7 +7,7 @@ Each panel is the pour plane (world x-z): the liquid particles logged in ``pour.
 trajectory in ``trajectory.csv`` at that time (every box geom as its outline in the plane, capsules and cylinders as
 their axis). Without ``--times``, four times spread over the controller's pouring phases are taken from
 ``summary.json``. ``--stream`` draws, where liquid flows over the lip, the free-fall parabola the catcher aims
-with (seed Eqs. 6-7, launched at the lip with the measured v_q, from ``series.csv``) over the SPH stream: the seed's
+with (seed Eqs. 6-7, launched at the lip with the measured v_q, from where it is measured, ``series.csv``) over the SPH stream: the seed's
 Fig. 10 comparison, and the landing point predicted at the catcher's rim height.
 """
 
@@ -59,7 +59,8 @@ def _draw_parabola(ax, series: dict[str, np.ndarray], t: float) -> None:
     h_q, v_x, v_z = series["h_q"][k], series["v_q"][k], series["v_q_z"][k]
     if not (h_q > 0.0 and v_x > 0.0):
         return
-    x0, z0, rim = series["lip_x"][k], series["lip_z"][k], series["catcher_rim_z"][k]
+    x0, z0 = series["lip_x"][k] + series["jet_dx"][k], series["lip_z"][k] + series["jet_dz"][k]
+    rim = series["catcher_rim_z"][k]
     s = np.linspace(0.0, fall_time(z0 - rim, v_z, GRAVITY), 50)
     ax.plot(x0 + v_x * s, z0 + v_z * s - 0.5 * GRAVITY * s**2, "r--", lw=1.2, zorder=4, label="Eqs. 6-7 parabola")
     ax.plot([series["landing_x"][k]], [rim], "rx", ms=8, zorder=5, label="predicted landing")

@@ -1,0 +1,42 @@
+"""The task-space pose filter: jerk-limited, and calm under a target that chatters (CFS increments of either sign)."""
+
+import numpy as np
+
+from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
+from cosim.robots.planar import PlanarPose
+
+PERIOD = 0.01  # s, the control period
+# A target chattering by +-CHATTER around a constant must leave the filtered tilt within a few chatter amplitudes of
+# it (a filter that reads the chatter as path velocity ran into a +-0.1 rad limit cycle in the coupled pour).
+CHATTER = 0.002  # rad
+CALM_BAND = 3 * CHATTER
+# A ramp at the CFS rate limit is followed with at most the lag of a jerk-limited stop from that rate
+# (v^2 / 2a + v a / 2j) plus one control period of travel.
+RAMP_RATE = 0.35  # rad/s
+
+
+def _filter() -> PoseFilter:
+    return PoseFilter("pourer_pose", ("dx", "dz", "theta"), PoseFilterLimits(), PERIOD)
+
+
+def test_chattering_target_does_not_start_a_limit_cycle() -> None:
+    f = _filter()
+    tilts = []
+    for k in range(600):
+        target = 1.2 if k < 100 else 1.2 + 0.35 + CHATTER * (-1) ** k  # a move, then chatter about 1.55 rad
+        tilts.append(f(PlanarPose(0.0, 0.0, target)).theta)
+    settled = np.array(tilts[300:])
+    assert np.max(np.abs(settled - 1.55)) <= CALM_BAND
+
+
+def test_a_ramp_is_followed_with_a_bounded_lag() -> None:
+    f = _filter()
+    limits = PoseFilterLimits()
+    a, j = limits.tilt_acceleration, limits.tilt_jerk
+    lag_bound = RAMP_RATE**2 / (2 * a) + RAMP_RATE * a / (2 * j) + RAMP_RATE * PERIOD
+    lags = []
+    for k in range(300):
+        target = RAMP_RATE * k * PERIOD
+        lags.append(target - f(PlanarPose(0.0, 0.0, target)).theta)
+    assert max(lags[100:]) <= lag_bound
+    assert min(lags) >= -1e-9  # each target is one to stop at: never ahead of the ramp
