@@ -146,3 +146,11 @@ def test_bad_config_is_one_input_error():
         BenchConfig(BenchCase.POUR, 4, 1.0)
     with pytest.raises(InputError, match="options"):
         BenchConfig(BenchCase.SLOSH, 20, 1.0, options=(("coupling.coupling", "one_way"),))
+
+
+def test_code_version_is_per_case_sources():
+    from cosim.bench.cache import SOURCES, code_version
+
+    assert not any(s.startswith("controllers") for s in SOURCES[BenchCase.HYDROSTATIC])  # a controller edit keeps them
+    assert code_version(BenchCase.HYDROSTATIC) == code_version(BenchCase.SLOSH)
+    assert code_version(BenchCase.HYDROSTATIC) != code_version(BenchCase.POUR) != code_version(BenchCase.COUPLING_STATIC)
