@@ -154,3 +154,15 @@ def test_code_version_is_per_case_sources():
     assert not any(s.startswith("controllers") for s in SOURCES[BenchCase.HYDROSTATIC])  # a controller edit keeps them
     assert code_version(BenchCase.HYDROSTATIC) == code_version(BenchCase.SLOSH)
     assert code_version(BenchCase.HYDROSTATIC) != code_version(BenchCase.POUR) != code_version(BenchCase.COUPLING_STATIC)
+
+
+def test_cli_smoke_writes_csv_markdown_plots_and_the_doc_block(tmp_path, capsys):
+    doc = tmp_path / "docs" / "benchmarks.md"
+    out = tmp_path / "out"
+    argv = ["bench", "--plan", "smoke", "--out", str(out), "--docs", str(doc), "--quiet"]
+    assert main(argv) == 0
+    assert "2 from the cache" not in capsys.readouterr().out
+    assert {"bench.csv", "bench.md", "bench_hydrostatic.png", "bench_dam_break.png"} <= {p.name for p in out.iterdir()}
+    assert (doc.parent / "bench_hydrostatic.png").exists() and GENERATED_BEGIN in doc.read_text()
+    assert main(argv) == 0
+    assert "(0 configurations computed" in capsys.readouterr().out

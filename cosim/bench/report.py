@@ -84,15 +84,17 @@ def build_rows(plan: BenchPlan, results: dict[BenchConfig, dict], keys: dict[Ben
 
 
 def skip_table(plan: BenchPlan, results: dict[BenchConfig, dict]) -> list[dict]:
-    """Per skip option: wall s per simulated s with and without it, the speed-up, and the errors of the skipping
-    run against the full one (:mod:`cosim.bench.pour_compare`)."""
+    """Per skip option: wall s per simulated s with and without it, the speed-up (the ratio of the runs' wall times:
+    the early stop saves simulated seconds, the others the cost of each), and the errors of the skipping run
+    against the full one (:mod:`cosim.bench.pour_compare`)."""
     out = []
     for s in plan.skips:
         a, b = results[s.skip], results[s.full]
         entry = {"name": s.name, "setting": s.setting, "skip": s.skip, "full": s.full}
         if a["status"] == "ok" and b["status"] == "ok":
             skip_cost, full_cost = a["wall_s"] / a["sim_s"], b["wall_s"] / b["sim_s"]
-            entry.update(skip_cost=skip_cost, full_cost=full_cost, speedup=full_cost / skip_cost,
+            entry.update(skip_cost=skip_cost, full_cost=full_cost, speedup=b["wall_s"] / a["wall_s"],
+                         sim_skip=a["sim_s"], sim_full=b["sim_s"],
                          wall_skip=a["wall_s"], wall_full=b["wall_s"], errors=compare_pours(a, b))
         else:
             entry["failed"] = "; ".join(r.get("message", "") for r in (a, b) if r["status"] != "ok")
@@ -139,6 +141,8 @@ def _describe(cfg: BenchConfig, default: BenchConfig) -> str:
         if a != b:
             diffs.append(f"{name} {getattr(a, 'value', a)}")
     diffs += [f"{k} = {v}" for k, v in cfg.options]
+    if cfg.length != default.length:
+        diffs.append(f"length {cfg.length:g}")
     return ", ".join(diffs) or "**default**"
 
 
@@ -185,16 +189,17 @@ def markdown(plan: BenchPlan, results: dict[BenchConfig, dict], rows: list[Row],
         out.append("\n### Skip options (pour)\n")
         out.append("Each pair differs only in the option; the error columns compare the run that skips with the one "
                    "that does the full work.\n")
-        out.append("| option | setting | at | wall s per simulated s (skip / full) | speed-up | "
+        out.append("| option | setting | at | simulated s (skip / full) | wall s per simulated s (skip / full) | speed-up (wall s full / skip) | "
                    + " | ".join(ERROR_TITLES[e] for e in POUR_ERRORS) + " |")
-        out.append("|---" * (5 + len(POUR_ERRORS)) + "|")
+        out.append("|---" * (6 + len(POUR_ERRORS)) + "|")
         for s in skips:
-            at = f"{s['skip'].particles_across} across, {s['skip'].length:g} s"
+            at = f"{s['skip'].particles_across} across, at most {s['skip'].length:g} s"
             if "failed" in s:
-                out.append(f"| {s['name']} | `{s['setting']}` | {at} | failed: {s['failed']} |" + " |" * (1 + len(POUR_ERRORS)))
+                out.append(f"| {s['name']} | `{s['setting']}` | {at} | failed: {s['failed']} |" + " |" * (2 + len(POUR_ERRORS)))
                 continue
             errs = " | ".join(_fmt(s["errors"][e]) for e in POUR_ERRORS)
-            out.append(f"| {s['name']} | `{s['setting']}` | {at} | {s['skip_cost']:.3g} / {s['full_cost']:.3g} | "
+            out.append(f"| {s['name']} | `{s['setting']}` | {at} | {s['sim_skip']:.3g} / {s['sim_full']:.3g} | "
+                       f"{s['skip_cost']:.3g} / {s['full_cost']:.3g} | "
                        f"{s['speedup']:.2f}x | {errs} |")
     return "\n".join(out) + "\n"
 

@@ -40,7 +40,7 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
 
-def _header(command: str, versions: dict) -> str:
+def _header(command: str, code_versions: dict) -> str:
     from cosim.fluid.benchmark import _machine
     from cosim.fluid.runtime import cuda_available
     from cosim.pour_run import _versions
@@ -50,7 +50,7 @@ def _header(command: str, versions: dict) -> str:
     return (f"## Wall time against error ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
             f"Machine: {_machine()}; {cuda}. Versions: {versions}.\n"
             f"Command: `{command}`. Code versions (cosim.bench.cache.code_version): "
-            f"{', '.join(f'{k.value} {v}' for k, v in versions.items())}.\n")
+            f"{', '.join(f'{k.value} {v}' for k, v in code_versions.items())}.\n")
 
 
 def run(args) -> int:
