@@ -215,8 +215,10 @@ def plot_case(rows: list[Row], case: BenchCase, default: BenchConfig, path: Path
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(1, len(errors), figsize=(5.2 * len(errors), 4.2), dpi=100, squeeze=False)
-    for ax, e in zip(axes[0], errors):
+    cols = min(2, len(errors))
+    rows_n = math.ceil(len(errors) / cols)
+    fig, axes = plt.subplots(rows_n, cols, figsize=(6.0 * cols, 4.4 * rows_n), dpi=100, squeeze=False)
+    for ax, e in zip(axes.ravel(), errors):
         for device, marker in (("cpu", "o"), ("cuda", "s")):
             pool = _scored(rows, case, e, device)
             if not pool:
