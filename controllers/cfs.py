@@ -33,7 +33,6 @@ import math
 import numpy as np
 
 from controllers.geometry import MAX_STATIC_TILT, VesselGeometry, rotate, surface_chord, vector_step
-from controllers.motion import stop_time
 from controllers.slosh import SloshModel
 
 AFTER_FLOW_SAMPLES = 257  # quadrature points for the after-flow integral (trapezoid; smooth integrand)
@@ -89,21 +88,33 @@ def cfs_pivot(geom: VesselGeometry, model: SloshModel, theta: float, margin: flo
 
 
 def after_flow_volume(
-    outflow_rate: float, h_q: float, lever: tuple[float, float], max_rate: float, max_accel: float
+    outflow_rate: float,
+    h_q: float,
+    lever: tuple[float, float],
+    max_rate: float,
+    max_accel: float,
+    tilt_rate: float = 0.0,
 ) -> float:
     """Volume (m^3) that still leaves after the return starts, to stop a partial pour early by that much.
 
-    The return tilts back from rest with ``max_accel`` (rad/s^2) up to ``max_rate`` (rad/s); the crest rises over
-    the surface in proportion to the turned angle until, after the vector-step angle for -h_q about ``lever``
-    (a, m), it clears the head ``h_q`` (m). Over a sharp crest the outflow goes as h^(3/2), so the volume is
-    outflow_rate (m^3/s) times the integral of (1 - rise / h_q)^(3/2) over that time.
+    The return starts from the current tilt rate ``tilt_rate`` (rad/s, + forward; CFS is usually still tilting
+    forward), turns back with ``max_accel`` (rad/s^2) up to ``max_rate`` (rad/s); the crest rises over the surface
+    in proportion to the angle turned back (and sinks further while the vessel still moves forward) until, after
+    the vector-step angle for -h_q about ``lever`` (a, m), it clears the head ``h_q`` (m). Over a sharp crest the
+    outflow goes as h^(3/2), so the volume is outflow_rate (m^3/s) times the integral of (1 - back / angle)^(3/2)
+    over that time, back(t) the angle turned back.
     """
     if h_q <= 0.0 or outflow_rate <= 0.0:
         return 0.0
     angle = -vector_step(lever, -h_q)
-    duration = stop_time(angle, max_rate, max_accel)
+    w0 = max(tilt_rate, 0.0)
+    t_turn = (w0 + max_rate) / max_accel  # until the backward rate reaches max_rate
+    back_at_turn = -w0 * t_turn + 0.5 * max_accel * t_turn**2
+    if back_at_turn >= angle:  # clears the head while still accelerating back: -w0 t + a t^2 / 2 = angle
+        duration = (w0 + math.sqrt(w0 * w0 + 2.0 * max_accel * angle)) / max_accel
+    else:
+        duration = t_turn + (angle - back_at_turn) / max_rate
     t = np.linspace(0.0, duration, AFTER_FLOW_SAMPLES)
-    t_acc = max_rate / max_accel
-    turned = np.where(t < t_acc, 0.5 * max_accel * t**2, 0.5 * max_rate * t_acc + max_rate * (t - t_acc))
-    head = np.clip(1.0 - turned / angle, 0.0, 1.0)
+    back = np.where(t < t_turn, -w0 * t + 0.5 * max_accel * t**2, back_at_turn + max_rate * (t - t_turn))
+    head = np.clip(1.0 - back / angle, 0.0, None)
     return float(outflow_rate * np.trapezoid(head**1.5, t))

@@ -77,6 +77,7 @@ class PourController:
         self._first_t = math.nan
         self._initial_volume = math.nan
         self._outflow_rate = 0.0  # m^3/s, filtered
+        self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
         self._last_poured = 0.0
         self._sigma_prev = 0.0
         self._since = math.nan  # start of the current settle (SIM_DAMP) or max-tilt (CFS) interval, s
@@ -136,7 +137,9 @@ class PourController:
             if nxt is None:
                 break
             self._enter(nxt[0], nxt[1], m)
+        theta_before = self.pose.theta
         self.pose = self._act[self.phase](m)
+        self._tilt_rate = (self.pose.theta - theta_before) / self.dt
         landing = self._landing(m)
         return PourCommand(
             t=m.t,
@@ -179,7 +182,7 @@ class PourController:
             self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
         elif phase is Phase.RETURN:
             self._return_from = self.pose
-            self._return.reset(self.pose.theta)
+            self._return.reset(self.pose.theta, self._tilt_rate)  # brakes the forward motion it inherits
 
     def _elapsed(self, m: LiquidMeasurement) -> float:
         return m.t - self._phase_start
@@ -201,7 +204,7 @@ class PourController:
         if target is not None:
             lever = crest_lever(self.config.vessel, self.pose.theta, self._area(m))
             ret = self.config.returning
-            after = after_flow_volume(self._outflow_rate, m.h_q, lever, ret.max_rate, ret.max_accel)
+            after = after_flow_volume(self._outflow_rate, m.h_q, lever, ret.max_rate, ret.max_accel, self._tilt_rate)
             if m.poured_volume + after >= target:
                 return Phase.RETURN, (
                     f"poured {1e6 * m.poured_volume:.1f} mL + {1e6 * after:.1f} mL predicted after-flow "

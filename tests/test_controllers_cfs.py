@@ -5,6 +5,7 @@ import math
 import control as ct
 import numpy as np
 import pytest
+from scipy.integrate import quad
 
 from controllers.cfs import after_flow_volume, cfs_pivot, crest_lever, level_drop
 from controllers.geometry import VesselGeometry, rotate, vector_step
@@ -79,3 +80,17 @@ def test_after_flow_in_the_acceleration_phase() -> None:
     expected = q * t_stop * 3 * math.pi / 16
     assert after_flow_volume(q, h_q, lever, max_rate=10.0, max_accel=accel) == pytest.approx(expected, rel=QUADRATURE_RTOL)
     assert after_flow_volume(q, -0.001, lever, 10.0, accel) == 0.0
+
+
+def test_after_flow_of_a_return_that_first_brakes_a_forward_tilt() -> None:
+    """Started while tilting forward at w0: back(t) = -w0 t + a t^2 / 2 (rate limit not reached), so the volume is
+    Q times the integral of (1 - back / angle)^(3/2) up to back = angle (by adaptive quadrature here)."""
+    q, h_q, accel, w0 = 6e-5, 0.005, 1.5, 0.3
+    lever = crest_lever(SEED_VESSEL, 0.4, SEED_VESSEL.inner_width * 0.15)
+    angle = -vector_step(lever, -h_q)
+    t_end = (w0 + math.sqrt(w0 * w0 + 2 * accel * angle)) / accel
+    expected, _ = quad(lambda t: (1.0 + (w0 * t - 0.5 * accel * t * t) / angle) ** 1.5, 0.0, t_end)
+    got = after_flow_volume(q, h_q, lever, max_rate=10.0, max_accel=accel, tilt_rate=w0)
+    assert got == pytest.approx(q * expected, rel=QUADRATURE_RTOL)
+    assert got > after_flow_volume(q, h_q, lever, 10.0, accel)  # braking first lets more out
+
