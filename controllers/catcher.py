@@ -37,21 +37,31 @@ class CatcherFollower:
     """Vessel B's planar offset dx (m, world x, relative to its home) following the predicted landing point.
 
     ``home_x``: world x of vessel B's centre (vessel-frame origin) at home. The target dx = landing - home_x,
-    clipped to [travel_min, travel_max]; the motion is rate- and acceleration-limited (max_speed m/s,
-    max_accel m/s^2), so a jump in the prediction never becomes a step of the vessel.
+    low-passed with the time constant ``filter_time`` (s; 0 = none: the SPH jet's prediction jitters from step to
+    step, and chasing it shakes the liquid already caught), clipped to [travel_min, travel_max]; the motion is
+    rate- and acceleration-limited (max_speed m/s, max_accel m/s^2), so a jump in the prediction never becomes a
+    step of the vessel.
     """
 
     def __init__(
-        self, home_x: float, travel: tuple[float, float], max_speed: float, max_accel: float, dt: float
+        self,
+        home_x: float,
+        travel: tuple[float, float],
+        max_speed: float,
+        max_accel: float,
+        dt: float,
+        filter_time: float = 0.0,
     ) -> None:
         self.home_x = home_x
         self.travel = travel
         self.tracker = RateLimitedTracker(max_speed, max_accel, dt)
+        self.gain = 1.0 if filter_time <= 0.0 else min(dt / filter_time, 1.0)
         self.target_dx = 0.0
 
     def step(self, landing: float | None) -> float:
         """Advance one control step; ``landing`` (world x, m) updates the target, None keeps the last one."""
         if landing is not None:
             lo, hi = self.travel
-            self.target_dx = min(max(landing - self.home_x, lo), hi)
+            wanted = min(max(landing - self.home_x, lo), hi)
+            self.target_dx += self.gain * (wanted - self.target_dx)
         return self.tracker.step(self.target_dx)

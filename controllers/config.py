@@ -128,8 +128,8 @@ class ReturnConfig:
     max_rate: rad/s. (0, 3]   max_accel: rad/s^2. (0, 20]
     """
 
-    max_rate: float = 0.5
-    max_accel: float = 1.5
+    max_rate: float = 1.0
+    max_accel: float = 2.5
 
     def __post_init__(self) -> None:
         check_range("returning.max_rate", self.max_rate, 0.0, 3.0, "rad/s", lo_open=True)
@@ -146,6 +146,7 @@ class CatcherConfig:
     max_speed: m/s. (0, 2]   max_accel: m/s^2. (0, 20]
     discharge_coefficient: C_d of the weir estimate v_q = (2/3) C_d sqrt(2 g h_q) used to place vessel B before
       the outflow starts (seed Sec. 2.2: about 0.6). (0, 1]
+    filter_time: s, time constant of the low-pass on vessel B's target (the predicted landing point). [0, 5]
     """
 
     home_x: float
@@ -154,8 +155,10 @@ class CatcherConfig:
     max_speed: float = 0.4
     max_accel: float = 1.0
     discharge_coefficient: float = 0.6
+    filter_time: float = 0.2
 
     def __post_init__(self) -> None:
+        check_range("catcher.filter_time", self.filter_time, 0.0, 5.0, "s")
         check_range("catcher.home_x", self.home_x, -10.0, 10.0, "m")
         check_range("catcher.travel_min", self.travel_min, -2.0, 2.0, "m")
         check_range("catcher.travel_max", self.travel_max, self.travel_min, 2.0, "m", lo_open=True)

@@ -66,7 +66,9 @@ class PourController:
         self._approach = RateLimitedTracker(config.approach.max_rate, config.approach.max_accel, self.dt)
         self._return = RateLimitedTracker(config.returning.max_rate, config.returning.max_accel, self.dt)
         c = config.catcher
-        self._catcher = CatcherFollower(c.home_x, (c.travel_min, c.travel_max), c.max_speed, c.max_accel, self.dt)
+        self._catcher = CatcherFollower(
+            c.home_x, (c.travel_min, c.travel_max), c.max_speed, c.max_accel, self.dt, c.filter_time
+        )
 
         self.pose = PlanarPose()
         self.phase = Phase.IDLE

@@ -53,6 +53,7 @@ def _controller_config(scene: PourScene, spacing: float):
         catcher = replace(
             catcher, travel_min=-c.catcher.travel, travel_max=c.catcher.travel, max_speed=c.catcher.max_speed,
             max_accel=c.catcher.max_accel, discharge_coefficient=c.catcher.discharge_coefficient,
+            filter_time=c.catcher.filter_time,
         )
         target = scene.liquid.pour_fraction * volume if scene.liquid.pour_fraction < 1.0 else None
         return PourConfig(

@@ -88,12 +88,14 @@ class CatcherSettings:
     """travel: m, how far vessel B may move each way along x from home (the robot scene verifies +-0.15 m). (0, 0.15]
     max_speed: m/s. (0, 2]   max_accel: m/s^2. (0, 20]
     discharge_coefficient: C_d of the weir estimate used to place vessel B before the outflow starts. (0, 1]
+    filter_time: s, low-pass time constant on vessel B's target, the predicted landing point. [0, 5]
     """
 
     travel: float = 0.15
     max_speed: float = 0.4
     max_accel: float = 1.0
     discharge_coefficient: float = 0.6
+    filter_time: float = 0.2
 
     def __post_init__(self) -> None:
         check_positive("controller.catcher.travel", self.travel, "m", 0.15)

@@ -65,3 +65,19 @@ def test_follower_clips_travel_and_never_steps() -> None:
     assert np.max(np.abs(np.diff([0.0] + xs))) <= 0.2 * DT + 1e-12
     held = f.step(None)  # no prediction: keep going to the last target
     assert held == pytest.approx(-0.10, abs=1e-9)
+
+
+def test_target_filter_keeps_vessel_b_calm_under_a_jittering_prediction() -> None:
+    """A prediction jittering by +-20 mm about 0.35 m: the filtered catcher arrives under its mean and swings far
+    less than one chasing every step (which also ends off the mean: the tracker's braking is not symmetric)."""
+    def swing(filter_time: float) -> tuple[float, float]:
+        f = CatcherFollower(home_x=0.30, travel=(-0.1, 0.1), max_speed=0.4, max_accel=1.0, dt=DT, filter_time=filter_time)
+        xs = [f.step(0.35 + 0.02 * (-1) ** k) for k in range(int(3.0 / DT))]
+        late = np.array(xs[int(2.0 / DT):])
+        return float(np.mean(late)), float(np.ptp(late))
+
+    raw_mean, raw_swing = swing(0.0)
+    mean, calm_swing = swing(0.2)
+    assert mean == pytest.approx(0.05, abs=0.002)
+    assert abs(raw_mean - 0.05) > abs(mean - 0.05)
+    assert calm_swing < 0.25 * raw_swing
