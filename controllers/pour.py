@@ -16,6 +16,7 @@ back to home along a straight line in (dx, dz, theta). Every pivot change keeps 
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Callable
 
 from controllers.catcher import CatcherFollower, landing_x, weir_velocity
@@ -32,6 +33,11 @@ from controllers.slosh_induction import excitation_duration, excitation_tilt, si
 # Time constant (s) of the first-order filter on the measured outflow rate d(poured)/dt: a fifth of the seed
 # vessel's slosh period, enough to smooth SPH particle-count steps while keeping the stop prediction current.
 OUTFLOW_FILTER_TIME = 0.1
+# CFS has stalled when, over the last cfs.max_tilt_hold s, less than this fraction of the initial volume left and
+# the tilt rose by less than STALL_TILT: near 90 deg the crest's lever degenerates and the last wedge of liquid
+# only drips (default scene: 139 mL left, about 5 mL/s, for 26 s at 89 deg).
+STALL_FRACTION = 0.005
+STALL_TILT = 0.01  # rad
 # Tilt (rad) within which a rate-limited tilt counts as arrived (approach target, upright): 0.006 deg.
 ARRIVAL_TOLERANCE = 1e-4
 
@@ -83,6 +89,7 @@ class PourController:
         self._last_poured = 0.0
         self._sigma_prev = 0.0
         self._since = math.nan  # start of the current settle (SIM_DAMP) or max-tilt (CFS) interval, s
+        self._cfs_history: deque[tuple[float, float, float]] = deque()  # (t, poured, tilt) over the last hold
         self._reference = 0.0  # rad, tilt reference of SIM_DAMP / target of APPROACH
         self._return_from = PlanarPose()
 
@@ -169,6 +176,7 @@ class PourController:
         self._transitions.append(PhaseTransition(m.t, self.phase, phase, reason))
         self.phase, self.reason, self._phase_start = phase, reason, m.t
         self._since = math.nan
+        self._cfs_history.clear()
         if phase is Phase.SIM_HOLD:
             self._sigma_prev = m.slosh_angle
         elif phase is Phase.SIM_DAMP:
@@ -280,6 +288,24 @@ class PourController:
             self._since = m.t
         if not math.isnan(self._since) and m.t - self._since >= cfs.max_tilt_hold:
             return Phase.RETURN, f"held max_tilt {math.degrees(cfs.max_tilt):.1f} deg for {cfs.max_tilt_hold:g} s"
+        return self._check_stall(m)
+
+    def _check_stall(self, m: LiquidMeasurement) -> Transition:
+        """CFS stalled: over the last max_tilt_hold s almost nothing left and the tilt hardly rose."""
+        hold, history = self.config.cfs.max_tilt_hold, self._cfs_history
+        history.append((m.t, m.poured_volume, self.pose.theta))
+        while len(history) > 1 and m.t - history[1][0] >= hold:
+            history.popleft()
+        t0, poured0, tilt0 = history[0]
+        if m.t - t0 < hold:
+            return None
+        poured, rose = m.poured_volume - poured0, self.pose.theta - tilt0
+        if poured < STALL_FRACTION * self._initial_volume and rose < STALL_TILT:
+            return Phase.RETURN, (
+                f"outflow stalled: {1e6 * poured:.1f} mL in {hold:g} s at {math.degrees(self.pose.theta):.1f} deg, "
+                f"{1e6 * m.volume_in_pourer:.1f} mL left"
+            )
+        return None
         return None
 
     def _check_return(self, m: LiquidMeasurement) -> Transition:

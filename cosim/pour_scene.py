@@ -19,7 +19,7 @@ from cosim.config_mapping import from_mapping, to_toml
 from cosim.coupling.pose_filter import PoseFilterLimits
 from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig, KernelType
+from cosim.fluid.config import FluidConfig, KernelType, PressureSolver
 from cosim.io.recording import RecordingConfig
 from cosim.trajectory.limits import JointLimitOverride
 
@@ -43,8 +43,10 @@ class FluidSettings:
     """dim: 2 (liquid in the pour plane, times the pourer's depth) or 3. [2, 3]
     particles_across: particles across the pourer's inner width; sets the spacing dx = B / n. [8, 400]
     kernel: 'wendland_c2' or 'cubic_spline' (the seed's).
+    pressure_solver: 'wcsph' (weakly compressible, time step set by an artificial sound speed) or 'dfsph'
+      (divergence-free SPH, time step set by the flow speed).
     smoothing_ratio: h / dx. [1.0, 2.5]
-    cfl: Courant number of the acoustic time step. (0, 0.6]
+    cfl: Courant number of the time step (on the sound speed for WCSPH, on the flow speed for DFSPH). (0, 0.6]
     sound_speed_factor: c0 / expected maximum speed (>= 10 keeps density errors near 1 %). [10, 100]
     artificial_viscosity: Monaghan alpha. [0, 1]
     density_diffusion: delta-SPH delta. [0, 1]
@@ -55,6 +57,7 @@ class FluidSettings:
     dim: int = 2
     particles_across: int = 32
     kernel: KernelType = KernelType.WENDLAND_C2
+    pressure_solver: PressureSolver = PressureSolver.WCSPH
     smoothing_ratio: float = 1.5
     cfl: float = 0.25
     sound_speed_factor: float = 10.0
@@ -73,6 +76,7 @@ class FluidSettings:
             dim=self.dim,
             spacing=pourer_width / self.particles_across,
             kernel=self.kernel,
+            pressure_solver=self.pressure_solver,
             smoothing_ratio=self.smoothing_ratio,
             cfl=self.cfl,
             sound_speed_factor=self.sound_speed_factor,

@@ -239,3 +239,21 @@ def test_controllers_import_no_warp_mujoco_or_cosim() -> None:
     root = Path(__file__).resolve().parents[1]
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=root)
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_cfs_that_no_longer_pours_returns_as_stalled() -> None:
+    """Near 90 deg the crest's lever degenerates and the last liquid only drips: a CFS whose tilt and poured volume
+    stop changing for max_tilt_hold s ends with the reason, not at the coupling's time limit."""
+    config = _config(sim=SimConfig(mode=SimMode.NEVER), cfs=CfsConfig(max_tilt=2.4))
+    controller = PourController(config)
+    poured = 0.95 * config.initial_volume
+    for k in range(3000):  # 30 s
+        m = _measurement(t=0.2 + k * config.dt, h_q=0.002 if k < 10 else -0.19, tilt=controller.pose.theta,
+                         volume_in_pourer=config.initial_volume - poured, poured_volume=poured)
+        if controller.step(m).phase is Phase.RETURN:
+            break
+    transition = controller.transitions[-1]
+    assert transition.target is Phase.RETURN and transition.reason.startswith("outflow stalled")
+    # not before a whole hold of CFS has been seen
+    cfs_entry = next(tr.t for tr in controller.transitions if tr.target is Phase.CFS)
+    assert transition.t - cfs_entry >= config.cfs.max_tilt_hold

@@ -104,6 +104,16 @@ def test_instability_is_raised_naming_the_step_and_the_cause():
     assert str(err.value).startswith(f"SPH step {err.value.step} ") and "compression" in str(err.value)
 
 
+def test_wcsph_faster_than_its_sound_speed_allows_is_an_instability():
+    # a blob falling freely with c0 sized for 0.5 m/s: past 0.2 c0 = 1 m/s (after about 0.1 s) the model is invalid
+    cfg = FluidConfig(dim=2, spacing=0.01, max_expected_speed=0.5, domain_min=(-0.3, -0.1, 0.0), domain_max=(0.3, 0.1, 0.5))
+    solver = FluidSolver(cfg, [], [], liquid_block((-0.03, -0.05, 0.3), (0.03, 0.05, 0.36), cfg))
+    with pytest.raises(FluidInstabilityError, match=r"faster than 0.2 c0 = 1 m/s.*raise fluid.max_expected_speed"):
+        while solver.time < 0.2:
+            solver.advance(0.01)
+    assert 0.1 <= solver.time <= 0.12
+
+
 @pytest.mark.parametrize(
     "kwargs, field",
     [
@@ -111,6 +121,9 @@ def test_instability_is_raised_naming_the_step_and_the_cause():
         ({"dim": 4}, "fluid.dim"),
         ({"sound_speed_factor": 5.0}, "fluid.sound_speed_factor"),
         ({"kernel": "quintic"}, "fluid.kernel"),
+        ({"pressure_solver": "pcisph"}, "fluid.pressure_solver"),
+        ({"density_tolerance": 0.0}, "fluid.density_tolerance"),
+        ({"max_solver_iterations": 1}, "fluid.max_solver_iterations"),
         ({"cfl": float("nan")}, "fluid.cfl"),
         ({"domain_min": (0.0, 0.0, 0.0), "domain_max": (0.01, 1.0, 1.0)}, "fluid.domain_max[0]"),
     ],

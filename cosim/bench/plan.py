@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from cosim.bench.config import BenchCase, BenchConfig
-from cosim.fluid.config import FluidConfig, KernelType, PressureSolver
+from cosim.fluid.config import KernelType, PressureSolver
 from cosim.fluid.runtime import cuda_available
 from cosim.pour_scene import FluidSettings
 
@@ -88,7 +88,7 @@ class BenchPlan:
 def default_numerics(device: str = "cpu") -> dict:
     """The default scene's numerical settings (pour_scene.FluidSettings, the solver's default pressure solver)."""
     scene = FluidSettings()
-    return {"dim": scene.dim, "kernel": scene.kernel, "cfl": scene.cfl, "pressure_solver": FluidConfig().solver,
+    return {"dim": scene.dim, "kernel": scene.kernel, "cfl": scene.cfl, "pressure_solver": scene.pressure_solver,
             "device": device}
 
 

@@ -23,7 +23,6 @@ import numpy as np
 from cosim.bench.config import BenchCase, BenchConfig
 from cosim.config_mapping import from_mapping
 from cosim.errors import SimulationError
-from cosim.fluid.config import FluidConfig
 from cosim.io.pour_series import read_series_csv
 from cosim.io.trajectory_csv import read_trajectory_csv
 from cosim.pour_scene import PourScene
@@ -33,12 +32,11 @@ from cosim.validation.common import CaseResult
 # Rate (Hz) at which a pour's joint trajectories are kept for the comparison (the 500 Hz export, decimated: the
 # jerk-limited trajectories carry nothing above a few Hz).
 TRAJECTORY_KEEP_HZ = 100.0
-DEFAULT_SOLVER = FluidConfig().solver
 
 
 def numerics(cfg: BenchConfig) -> tuple[tuple[str, Any], ...]:
     """The configuration's numerical settings as FluidConfig overrides (``FluidCaseParams.numerics``)."""
-    return (("kernel", cfg.kernel), ("cfl", cfg.cfl), ("solver", cfg.pressure_solver))
+    return (("kernel", cfg.kernel), ("cfl", cfg.cfl))
 
 
 def case_width(cfg: BenchConfig) -> float:
@@ -53,7 +51,7 @@ def case_width(cfg: BenchConfig) -> float:
 
 def _validation_params(cfg: BenchConfig):
     spacing = case_width(cfg) / cfg.particles_across
-    common = dict(spacing=spacing, dim=cfg.dim, device=cfg.device, numerics=numerics(cfg))
+    common = dict(spacing=spacing, dim=cfg.dim, device=cfg.device, solver=cfg.pressure_solver, numerics=numerics(cfg))
     length = {
         BenchCase.HYDROSTATIC: "duration", BenchCase.SLOSH: "periods", BenchCase.DAM_BREAK: "t_max",
         BenchCase.COUPLING_STATIC: "duration",
@@ -85,12 +83,11 @@ def pour_scene(cfg: BenchConfig) -> PourScene:
     unless an option turns it on; built through the scene-file mapping, so options are checked like a TOML file."""
     table: dict[str, Any] = {
         "device": cfg.device,
-        "fluid": {"dim": cfg.dim, "particles_across": cfg.particles_across, "kernel": cfg.kernel.value, "cfl": cfg.cfl},
+        "fluid": {"dim": cfg.dim, "particles_across": cfg.particles_across, "kernel": cfg.kernel.value, "cfl": cfg.cfl,
+                  "pressure_solver": cfg.pressure_solver.value},
         "coupling": {"max_duration": cfg.length},
         "logging": {"enabled": False},
     }
-    if cfg.pressure_solver is not DEFAULT_SOLVER:  # a scene without the key runs the default solver
-        table["fluid"]["pressure_solver"] = cfg.pressure_solver.value
     for key, value in cfg.options:
         *path, leaf = key.split(".")
         node = table

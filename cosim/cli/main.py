@@ -22,6 +22,7 @@ SUBCOMMAND_MODULES: list[str] = [
     "cosim.cli.scene",
     "cosim.cli.validate",
     "cosim.cli.bench",
+    "cosim.cli.stress",
     "cosim.cli.replay",
     "cosim.cli.view",
 ]

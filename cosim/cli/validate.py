@@ -17,6 +17,7 @@ from pathlib import Path
 
 from cosim.atomic_files import atomic_path
 from cosim.errors import InputError
+from cosim.fluid.config import PressureSolver
 from cosim.validation import CASES, DEFAULT_CASES, slosh
 from cosim.validation.common import CaseResult
 DEFAULT_OUT = Path("recordings") / "validate"
@@ -34,6 +35,8 @@ def register(subparsers) -> None:
     p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
     p.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2-D (pour plane) or 3-D (default 2)")
     p.add_argument("--device", default="cpu", help="cpu or cuda[:N] (default cpu)")
+    p.add_argument("--solver", choices=[s.value for s in PressureSolver], default=PressureSolver.WCSPH.value,
+                   help="pressure solver: wcsph (weakly compressible) or dfsph (divergence-free) (default wcsph)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
@@ -41,7 +44,7 @@ def register(subparsers) -> None:
 
 
 def _case_params(name: str, args) -> list:
-    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing}
+    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing, "solver": args.solver}
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
     if name in ("tilt", "shake", "coupling-static"):

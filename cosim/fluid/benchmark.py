@@ -2,10 +2,13 @@
 ``example_sph`` at the same particle count (a benchmark, not a test).
 
     python -m cosim.fluid.benchmark [--device cpu|cuda] [--counts2d 1000 4000 16000] [--counts3d 4000 16000 62500]
-                                    [--repeats 3] [--out docs/benchmarks.md]
+                                    [--solvers wcsph dfsph] [--repeats 3] [--out docs/benchmarks.md]
 
 Ours: a resting box of liquid in a tank (the hydrostatic case), every stage of a substep (walls, neighbour sort,
-reorder, wall extrapolation, forces, density rate, integration, wrench reduction). ``example_sph``: warp's own
+reorder, then the pressure solver's stages, integration, wrench reduction), for each pressure solver. Besides
+particle-steps/s (cost per substep) it reports simulated seconds per wall-clock second over the same interval,
+the comparison that matters between solvers whose time steps differ (WCSPH: acoustic CFL; DFSPH: flow CFL and the
+force criterion, with its iterations per substep). ``example_sph``: warp's own
 3-D toy (Mueller 2003 kernels on ``wp.HashGrid``, a handful of neighbours per particle), re-sized to the same
 count by reallocating its particle arrays with its own initialisation kernel. Both are timed after a warm-up
 step (kernel compilation excluded); the median of ``repeats`` timed batches is reported. Appends a dated section
@@ -25,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import warp as wp
 
-from cosim.fluid.config import FluidConfig
+from cosim.fluid.config import FluidConfig, PressureSolver
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import liquid_block
 from cosim.fluid.solver import FluidSolver
@@ -35,8 +38,10 @@ from cosim.vessel import VesselSpec
 TANK_ASPECT = 1.0  # the liquid block is as tall as it is wide
 
 
-def _ours(n: int, dim: int, device: str, steps: int, repeats: int) -> tuple[float, int]:
-    """(median particle-steps/s, actual particle count) of our solver on a resting liquid block of ~n particles."""
+def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver) -> tuple[float, float, int, float]:
+    """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s) of our
+    solver on a resting liquid block of ~n particles, timed over intervals of ``steps`` WCSPH substeps after a
+    settling interval of the same length (kernel compilation and DFSPH's cold start excluded)."""
     width = 0.2
     depth = width if dim == 3 else 0.1
     cells = n ** (1.0 / dim)
@@ -44,21 +49,24 @@ def _ours(n: int, dim: int, device: str, steps: int, repeats: int) -> tuple[floa
     tank = VesselSpec(name="tank", inner_width=width, inner_depth=depth, inner_height=1.5 * width)
     m = 0.1 * width
     cfg = FluidConfig(
-        dim=dim, spacing=dx, max_expected_speed=2 * math.sqrt(9.81 * width),
+        dim=dim, spacing=dx, max_expected_speed=2 * math.sqrt(9.81 * width), pressure_solver=solver,
         domain_min=(-0.5 * width - m, -0.5 * depth - m, -m), domain_max=(0.5 * width + m, 0.5 * depth + m, 1.5 * width + m),
     )
     block = liquid_block((-0.5 * width, -0.5 * depth, 0.0), (0.5 * width, 0.5 * depth, width * TANK_ASPECT), cfg)
-    solver = FluidSolver(cfg, [tank], [Pose()], block, device=device)
-    dt = cfg.cfl * cfg.smoothing_length / cfg.sound_speed
-    solver.advance(dt)  # warm-up: compiles and records
-    rates = []
+    fluid = FluidSolver(cfg, [tank], [Pose()], block, device=device)
+    interval = steps * cfg.cfl * cfg.smoothing_length / cfg.sound_speed * 0.999
+    fluid.advance(interval)  # warm-up: compiles, records, settles
+    rates, speeds, dts = [], [], []
     for _ in range(repeats):
-        wp.synchronize_device(solver.device)
+        wp.synchronize_device(fluid.device)
         start = time.perf_counter()
-        solver.advance(steps * dt * 0.999)
-        wp.synchronize_device(solver.device)
-        rates.append(solver.n_particles * solver.last_report.substeps / (time.perf_counter() - start))
-    return statistics.median(rates), solver.n_particles
+        fluid.advance(interval)
+        wp.synchronize_device(fluid.device)
+        wall = time.perf_counter() - start
+        rates.append(fluid.n_particles * fluid.last_report.substeps / wall)
+        speeds.append(interval / wall)
+        dts.append(fluid.last_report.dt)
+    return statistics.median(rates), statistics.median(speeds), fluid.n_particles, statistics.mean(dts)
 
 
 def _example_sph(n: int, device: str, steps: int, repeats: int) -> float:
@@ -112,33 +120,37 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--device", default="cpu")
     p.add_argument("--counts2d", type=int, nargs="*", default=[1000, 4000, 16000])
     p.add_argument("--counts3d", type=int, nargs="*", default=[4000, 16000, 62500])
-    p.add_argument("--steps", type=int, default=20, help="steps per timed batch")
+    p.add_argument("--steps", type=int, default=20, help="WCSPH substeps per timed interval (the same simulated interval for every solver)")
     p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--solvers", nargs="*", choices=[s.value for s in PressureSolver], default=[s.value for s in PressureSolver])
     p.add_argument("--out", type=Path, default=None, help="append the table to this Markdown file")
     args = p.parse_args(argv)
     device = resolve_device(args.device)
     rows = []
     for dim, counts in ((2, args.counts2d), (3, args.counts3d)):
         for n in counts:
-            ours, actual = _ours(n, dim, str(device), args.steps, args.repeats)
-            theirs = _example_sph(actual, str(device), args.steps, args.repeats) if dim == 3 else float("nan")
-            rows.append((dim, actual, ours, theirs))
-            print(f"{dim}-D {actual:>8d} particles: cosim {ours / 1e6:8.3f} M particle-steps/s"
-                  + (f"   example_sph {theirs / 1e6:8.3f} M   ratio {ours / theirs:5.2f}" if dim == 3 else ""), flush=True)
-    table = ["| dim | particles | cosim WCSPH (M particle-steps/s) | warp example_sph (M particle-steps/s) | cosim / example |",
-             "|---|---|---|---|---|"]
-    for dim, n, ours, theirs in rows:
+            theirs = float("nan")
+            for k, name in enumerate(args.solvers):
+                ours, sim_rate, actual, dt = _ours(n, dim, str(device), args.steps, args.repeats, PressureSolver(name))
+                if dim == 3 and k == 0:
+                    theirs = _example_sph(actual, str(device), args.steps, args.repeats)
+                rows.append((dim, actual, name, ours, sim_rate, dt, theirs))
+                print(f"{dim}-D {actual:>8d} particles {name}: {ours / 1e6:8.3f} M particle-steps/s, dt {dt * 1e6:8.1f} us, "
+                      f"{sim_rate:8.4f} simulated s per wall s" + (f"   example_sph {theirs / 1e6:8.3f} M" if dim == 3 else ""), flush=True)
+    table = ["| dim | particles | solver | M particle-steps/s | substep dt (us) | simulated s / wall s | warp example_sph (M particle-steps/s) |",
+             "|---|---|---|---|---|---|---|"]
+    for dim, n, name, ours, sim_rate, dt, theirs in rows:
         ex = f"{theirs / 1e6:.3f}" if not math.isnan(theirs) else "- (3-D only)"
-        ratio = f"{ours / theirs:.2f}" if not math.isnan(theirs) else "-"
-        table.append(f"| {dim}-D | {n} | {ours / 1e6:.3f} | {ex} | {ratio} |")
+        table.append(f"| {dim}-D | {n} | {name} | {ours / 1e6:.3f} | {dt * 1e6:.1f} | {sim_rate:.4f} | {ex} |")
     header = (
         f"\n## Fluid step throughput, {device} ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
         f"Machine: {_machine()}. Versions: Python {platform.python_version()}, warp {wp.__version__}, numpy {np.__version__}.\n"
         f"Command: `python -m cosim.fluid.benchmark --device {args.device} --counts2d {' '.join(map(str, args.counts2d))} "
-        f"--counts3d {' '.join(map(str, args.counts3d))} --steps {args.steps} --repeats {args.repeats}`. Median of "
-        f"{args.repeats} batches of {args.steps} steps after a warm-up step; one step of cosim is the full substep "
-        "(walls, neighbour sort and reorder, wall pressure extrapolation, forces, density rate, integration, wrench "
-        "reduction); example_sph is warp's bundled toy (Mueller 2003 kernels, few neighbours) re-sized to the same count.\n\n"
+        f"--counts3d {' '.join(map(str, args.counts3d))} --solvers {' '.join(args.solvers)} --steps {args.steps} --repeats {args.repeats}`. "
+        f"Median of {args.repeats} intervals of {args.steps} WCSPH substeps' simulated time after a settling interval; one step "
+        "is the full substep (walls, neighbour sort and reorder, the pressure solver's stages, integration, wrench "
+        "reduction; DFSPH's includes its iterations); simulated s / wall s compares the solvers at equal simulated time; "
+        "example_sph is warp's bundled toy (Mueller 2003 kernels, few neighbours) re-sized to the same count.\n\n"
     )
     text = header + "\n".join(table) + "\n"
     print(text)

@@ -29,6 +29,7 @@ class PressureSolver(Enum):
     """How pressure is obtained."""
 
     WCSPH = "wcsph"  # weakly compressible: Tait equation of state, continuity density + delta-SPH
+    DFSPH = "dfsph"  # divergence-free SPH (Bender & Koschier 2015/2017): iterative incompressibility, CFL on flow speed
 
 
 @dataclass(frozen=True)
@@ -39,15 +40,24 @@ class FluidConfig:
     spacing: m, initial particle spacing dx. (0, 0.05]
     smoothing_ratio: h / dx. [1.0, 2.5]
     kernel: :class:`KernelType`.
-    solver: :class:`PressureSolver`.
+    pressure_solver: :class:`PressureSolver`.
     rest_density: kg/m^3, rho0. [500, 2000]
     gamma: Tait exponent. [1, 10]
     max_expected_speed: m/s, the largest liquid speed the scene is expected to reach (sets c0). (0, 50]
-    sound_speed_factor: c0 / max_expected_speed. [10, 100] (>= 10 keeps |rho - rho0|/rho0 ~ 1 %)
+    sound_speed_factor: c0 / max_expected_speed. [10, 100] (>= 10 keeps |rho - rho0|/rho0 ~ 1 %). DFSPH has no
+        equation of state: it uses c0 only as the velocity scale of the artificial viscosity, as WCSPH does.
     kinematic_viscosity: m^2/s, laminar viscosity (water 1.0e-6 at 20 C). [0, 0.01]
     artificial_viscosity: Monaghan alpha (dimensionless), also applied against walls. [0, 1]
     density_diffusion: delta of delta-SPH (Antuono et al. 2010, renormalised density gradient). [0, 1]
-    cfl: Courant number of the acoustic CFL step; 0.25 x of it for the force criterion. (0, 0.6]
+    cfl: Courant number: dt <= cfl h / (c0 + v_max + v_wall) (WCSPH) or cfl h / (v_max + v_wall) (DFSPH, no sound
+        speed). (0, 0.6]
+    density_tolerance: DFSPH: the density solve stops when the average compression (rho* - rho0) / rho0 is below
+        this (0.01 %, SPlisHSPlasH's default for DFSPH; 0.1 % leaves a pressure noise of tens of % between
+        substeps that kicks particles over rims). (0, 0.05]
+    divergence_tolerance: DFSPH: the divergence solve stops when the average density rate times dt, over rho0, is
+        below this (the paper's 0.1 % per step). (0, 0.05]
+    max_solver_iterations: DFSPH: iteration cap of each of the two solves (a solve that hits it is not an error;
+        the remaining error shows in the diagnostics). [2, 1000]
     depth_2d: m, liquid thickness perpendicular to the pour plane in 2-D (the pouring vessel's depth): masses,
         volumes and wrenches reported to the outside are per unit depth times this. (0, 2]
     boundary_spacing_ratio: wall sample spacing / dx. [0.3, 1.0]
@@ -66,7 +76,7 @@ class FluidConfig:
     spacing: float = 0.191 / 40
     smoothing_ratio: float = 1.5
     kernel: KernelType = KernelType.WENDLAND_C2
-    solver: PressureSolver = PressureSolver.WCSPH
+    pressure_solver: PressureSolver = PressureSolver.WCSPH
     rest_density: float = 1000.0
     gamma: float = 7.0
     max_expected_speed: float = 2.0
@@ -75,6 +85,9 @@ class FluidConfig:
     artificial_viscosity: float = 0.01
     density_diffusion: float = 0.1
     cfl: float = 0.25
+    density_tolerance: float = 0.0001
+    divergence_tolerance: float = 0.001
+    max_solver_iterations: int = 100
     depth_2d: float = 0.1
     boundary_spacing_ratio: float = 0.75
     domain_min: tuple[float, float, float] = (-1.0, -0.5, 0.0)
@@ -90,7 +103,7 @@ class FluidConfig:
         s(self, "spacing", check_positive("fluid.spacing", self.spacing, "m", 0.05))
         s(self, "smoothing_ratio", check_range("fluid.smoothing_ratio", self.smoothing_ratio, 1.0, 2.5))
         s(self, "kernel", check_choice("fluid.kernel", self.kernel, KernelType))
-        s(self, "solver", check_choice("fluid.solver", self.solver, PressureSolver))
+        s(self, "pressure_solver", check_choice("fluid.pressure_solver", self.pressure_solver, PressureSolver))
         s(self, "rest_density", check_range("fluid.rest_density", self.rest_density, 500.0, 2000.0, "kg/m^3"))
         s(self, "gamma", check_range("fluid.gamma", self.gamma, 1.0, 10.0))
         s(self, "max_expected_speed", check_positive("fluid.max_expected_speed", self.max_expected_speed, "m/s", 50.0))
@@ -99,6 +112,9 @@ class FluidConfig:
         s(self, "artificial_viscosity", check_range("fluid.artificial_viscosity", self.artificial_viscosity, 0.0, 1.0))
         s(self, "density_diffusion", check_range("fluid.density_diffusion", self.density_diffusion, 0.0, 1.0))
         s(self, "cfl", check_range("fluid.cfl", self.cfl, 0.0, 0.6, lo_open=True))
+        s(self, "density_tolerance", check_range("fluid.density_tolerance", self.density_tolerance, 0.0, 0.05, lo_open=True))
+        s(self, "divergence_tolerance", check_range("fluid.divergence_tolerance", self.divergence_tolerance, 0.0, 0.05, lo_open=True))
+        s(self, "max_solver_iterations", check_int("fluid.max_solver_iterations", self.max_solver_iterations, 2, 1000))
         s(self, "depth_2d", check_positive("fluid.depth_2d", self.depth_2d, "m", 2.0))
         s(self, "boundary_spacing_ratio", check_range("fluid.boundary_spacing_ratio", self.boundary_spacing_ratio, 0.3, 1.0))
         lo = check_vector("fluid.domain_min", self.domain_min, 3)

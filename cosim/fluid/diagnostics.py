@@ -14,17 +14,22 @@ import warp as wp
 # float row
 DIAG_MAX_SPEED = wp.constant(0)  # m/s
 DIAG_MAX_ACCEL = wp.constant(1)  # m/s^2 (total, gravity included)
-DIAG_MAX_DENSITY_ERROR = wp.constant(2)  # max |rho - rho0| / rho0
+DIAG_MAX_DENSITY_ERROR = wp.constant(2)  # max |rho - rho0| / rho0 (DFSPH: compression only, see dfsph.py)
 DIAG_KINETIC_ENERGY = wp.constant(3)  # J (3-D equivalent)
 DIAG_MAX_COMPRESSION = wp.constant(4)  # max (rho - rho0) / rho0 (the part an instability shows in)
-N_DIAG_FLOAT = 5
+DIAG_DIVERGENCE_ERROR = wp.constant(5)  # DFSPH: average compressing density rate x dt / rho0 left by its solve
+DIAG_DENSITY_SOLVE_ERROR = wp.constant(6)  # DFSPH: average predicted compression / rho0 left by its solve
+N_DIAG_FLOAT = 7
 # int row
 DIAG_NONFINITE = wp.constant(0)  # particles with a non-finite position, velocity or density
 DIAG_BREACHES = wp.constant(1)  # wall contacts deeper than max_wall_penetration (instability)
 DIAG_CORRECTIONS = wp.constant(2)  # shallow wall contacts corrected by the guard
 DIAG_ACTIVE = wp.constant(3)  # active particles after the substep
-DIAG_INSIDE0 = wp.constant(4)  # particles inside vessel k at DIAG_INSIDE0 + k
-N_DIAG_INT_BASE = 4
+DIAG_DIVERGENCE_ITERATIONS = wp.constant(4)  # DFSPH: iterations of the divergence solve
+DIAG_DENSITY_ITERATIONS = wp.constant(5)  # DFSPH: iterations of the density solve
+DIAG_PAIR_OVERFLOW = wp.constant(6)  # DFSPH: particles with more neighbours than its pair list holds (instability)
+DIAG_INSIDE0 = wp.constant(7)  # particles inside vessel k at DIAG_INSIDE0 + k
+N_DIAG_INT_BASE = 7
 
 
 @dataclass(frozen=True)
@@ -35,7 +40,7 @@ class StepDiagnostics:
     time: float  # s, at the end of the substep
     dt: float  # s
     max_speed: float  # m/s
-    max_acceleration: float  # m/s^2
+    max_acceleration: float  # m/s^2 (DFSPH: of the non-pressure forces; its pressure is implicit)
     max_density_error: float  # max |rho - rho0| / rho0
     max_compression: float  # max (rho - rho0) / rho0
     kinetic_energy: float  # J
@@ -43,6 +48,7 @@ class StepDiagnostics:
     wall_breaches: int
     wall_corrections: int
     active: int
+    solver_iterations: tuple[int, int]  # DFSPH (divergence, density) solve iterations; (0, 0) for WCSPH
     volume_in_vessel: tuple[float, ...]  # m^3 per vessel
     spilled_volume: float  # m^3 deactivated (fell below the floor or left the domain)
 
@@ -68,6 +74,7 @@ def rows_to_records(
                 wall_breaches=int(i[1]),
                 wall_corrections=int(i[2]),
                 active=int(i[3]),
+                solver_iterations=(int(i[4]), int(i[5])),
                 volume_in_vessel=tuple(float(c) * particle_volume for c in i[N_DIAG_INT_BASE:]),
                 spilled_volume=(n_total - int(i[3])) * particle_volume,
             )

@@ -94,7 +94,9 @@ class FluidState:
     """Per-particle arrays (N,), world frame, in cell order after each reorder.
 
     x: m; v: m/s; rho: kg/m^3; p: Pa; active: 1 while simulated, 0 once spilled or broken; pid: the particle's
-    original index (to return results in the order the particles were given).
+    original index (to return results in the order the particles were given); kappa_density, kappa_divergence:
+    DFSPH only, m^2/s^2, the stiffness (p / rho) each of its two solves applied in the last substep (the warm start
+    of the next; zero under WCSPH).
     """
 
     x: wp.array
@@ -103,6 +105,8 @@ class FluidState:
     p: wp.array
     active: wp.array
     pid: wp.array
+    kappa_density: wp.array
+    kappa_divergence: wp.array
 
     @staticmethod
     def allocate(n: int, device) -> "FluidState":
@@ -113,7 +117,9 @@ class FluidState:
             p=wp.zeros(n, dtype=float, device=device),
             active=wp.zeros(n, dtype=wp.int32, device=device),
             pid=wp.zeros(n, dtype=wp.int32, device=device),
+            kappa_density=wp.zeros(n, dtype=float, device=device),
+            kappa_divergence=wp.zeros(n, dtype=float, device=device),
         )
 
     def arrays(self) -> list[wp.array]:
-        return [self.x, self.v, self.rho, self.p, self.active, self.pid]
+        return [self.x, self.v, self.rho, self.p, self.active, self.pid, self.kappa_density, self.kappa_divergence]

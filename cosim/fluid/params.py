@@ -5,13 +5,17 @@ from __future__ import annotations
 import warp as wp
 
 from cosim.fluid.config import FluidConfig
-from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma
+from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma, lattice_gradient_square_sum, lattice_kernel_sum
 
 
 @wp.struct
 class SPHParams:
     """Static SPH parameters (SI). ``mass`` is the SPH particle mass (kg, or kg/m of depth in 2-D); ``mass_out``
-    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``eta2`` = 0.01 h^2 (m^2)."""
+    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``eta2`` = 0.01 h^2 (m^2); then DFSPH's stopping rule (relative tolerances and
+    the iteration cap of each solve) and ``lattice_density``, the summation density of a resting lattice over rho0
+    (DFSPH divides its summation density by it, so the liquid as seeded is at rest density) and
+    ``lattice_factor_denominator``, sum_j |m grad W|^2 of a particle inside that lattice (kg^2/m^(2 dim + 2)), the
+    scale below which DFSPH does not let a factor's denominator fall."""
 
     dim: int
     kernel: int
@@ -31,6 +35,11 @@ class SPHParams:
     eta2: float
     gravity: wp.vec3
     n_vessels: int
+    density_tolerance: float
+    divergence_tolerance: float
+    max_iterations: int
+    lattice_density: float
+    lattice_factor_denominator: float
 
 
 def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
@@ -54,4 +63,9 @@ def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
     p.eta2 = 0.01 * h * h
     p.gravity = wp.vec3(*cfg.gravity)
     p.n_vessels = n_vessels
+    p.density_tolerance = cfg.density_tolerance
+    p.divergence_tolerance = cfg.divergence_tolerance
+    p.max_iterations = cfg.max_solver_iterations
+    p.lattice_density = lattice_kernel_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim)
+    p.lattice_factor_denominator = lattice_gradient_square_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim) * (cfg.particle_mass / cfg.spacing ** (cfg.dim + 1)) ** 2
     return p

@@ -78,9 +78,46 @@ def liquid_block(lo, hi, cfg: FluidConfig, pose: Pose | None = None) -> Particle
     return _place(local, surface - local[:, 2], cfg, pose)
 
 
+# Least liquid the particles resolve: kernel support 2h = 3 dx at the default h = 1.5 dx, so below these counts every
+# particle is within a wall's reach of both sides.
+MIN_FILL_LAYERS = 3
+MIN_PARTICLES_ACROSS = 4
+
+
+def fill_layers(spec: VesselSpec, fill_depth: float, dx: float) -> int:
+    """Particle layers :func:`fill_vessel` seeds for ``fill_depth`` (m) at spacing ``dx`` (m): never above the rim."""
+    return min(_layers(fill_depth, dx), int(math.floor(spec.inner_height / dx + 1e-9)))
+
+
+def check_resolution(spec: VesselSpec, fill_depth: float, cfg: FluidConfig) -> None:
+    """Refuse a liquid the particles cannot resolve (InputError naming the remedy): fewer than MIN_FILL_LAYERS
+    layers deep, or fewer than MIN_PARTICLES_ACROSS across the vessel's inner width (and, in 3-D, its depth).
+
+    With the kernel support of 2h = 3 dx, such a liquid has no particle outside the walls' reach; the stability
+    matrix (docs/stability.md) showed them creating energy from wall motion without any other symptom.
+    """
+    dx = cfg.spacing
+    layers = fill_layers(spec, fill_depth, dx)
+    if layers < MIN_FILL_LAYERS:
+        raise InputError(
+            f"fill_depth: {fill_depth:.4g} m is {layers} particle layers at spacing {dx:.4g} m; at least "
+            f"{MIN_FILL_LAYERS} are needed (a deeper fill, or a spacing <= {fill_depth / MIN_FILL_LAYERS:.4g} m)"
+        )
+    across = [("inner width", spec.inner_width)] + ([("depth", spec.section_depth)] if cfg.dim == 3 else [])
+    for name, size in across:
+        n = int(math.floor(size / dx + 1e-9))
+        if n < MIN_PARTICLES_ACROSS:
+            raise InputError(
+                f"spacing: {dx:.4g} m puts {n} particles across the vessel's {name} ({size:.4g} m); at least "
+                f"{MIN_PARTICLES_ACROSS} are needed (spacing <= {size / MIN_PARTICLES_ACROSS:.4g} m)"
+            )
+
+
 def fill_vessel(spec: VesselSpec, fill_depth: float, cfg: FluidConfig, pose: Pose | None = None) -> ParticleSet:
-    """Liquid filling an upright vessel to ``fill_depth`` (m) on the lattice; the vessel is placed by ``pose``."""
+    """Liquid filling an upright vessel to ``fill_depth`` (m) on the lattice; the vessel is placed by ``pose``.
+    Raises InputError for a liquid the particles cannot resolve (:func:`check_resolution`)."""
     spec.fill_volume(fill_depth)  # range check against the rim
+    check_resolution(spec, fill_depth, cfg)
     dx = cfg.spacing
     if spec.is_box or cfg.dim == 2:
         b = 0.5 * spec.inner_width
@@ -93,7 +130,7 @@ def fill_vessel(spec: VesselSpec, fill_depth: float, cfg: FluidConfig, pose: Pos
         local = block.positions
         keep = np.hypot(local[:, 0], local[:, 1]) <= r - 0.5 * dx
         local = local[keep]
-    n_z = min(_layers(fill_depth, dx), int(math.floor(spec.inner_height / dx + 1e-9)))  # never above the rim
+    n_z = fill_layers(spec, fill_depth, dx)
     local = local[local[:, 2] < n_z * dx]
     return _place(local, n_z * dx - local[:, 2], cfg, pose)
 

@@ -4,12 +4,18 @@ Time is advanced in intervals (the coupling's MuJoCo step, or any duration): bef
 each vessel's pose at the END of the interval (:meth:`FluidSolver.set_vessel_poses`); the vessel then moves from
 its current pose to that one at constant linear and angular velocity while the liquid takes as many equal
 substeps as the CFL, force and viscous criteria need (computed from the previous interval's maxima and the wall
-speed). Each substep runs the named stages
+speed). Each substep runs the named stages of the configured pressure solver, WCSPH (``cosim.fluid.wcsph``)
 
     move_vessels; place_wall_particles; find_neighbors; extrapolate_wall_state; compute_forces;
     compute_density_rate; integrate (+ wall guard); reduce_wrenches
 
-entirely on the device (no host copies inside; only the interval's plan and its diagnostics cross). After the
+or DFSPH (``cosim.fluid.dfsph``)
+
+    move_vessels; place_wall_particles; find_neighbors; compute_density_factor; divergence solve;
+    compute_nonpressure; density solve; compute_wall_reaction; integrate (+ wall guard); reduce_wrenches
+
+entirely on the device (no host copies inside; only the interval's plan and its diagnostics cross; DFSPH's
+convergence loops read a device flag through ``wp.capture_while``, see ``cosim.fluid.dfsph``). After the
 interval the per-substep diagnostics are checked and an instability raises :class:`FluidInstabilityError`
 naming the step and what broke. Results come back as numpy arrays in the particles' original order.
 """
@@ -25,8 +31,9 @@ import warp as wp
 
 from cosim.errors import InputError, SimulationError
 from cosim.fluid import boundary as bd
-from cosim.fluid import wcsph
-from cosim.fluid.config import FluidConfig
+from cosim.fluid import dfsph, wcsph
+from cosim.fluid.config import FluidConfig, PressureSolver
+from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, sum_wall_wrench_chunks
 from cosim.fluid.diagnostics import N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, rows_to_records
 from cosim.fluid.model import FluidModel, FluidState, build_model
 from cosim.fluid.runtime import resolve_device
@@ -37,6 +44,10 @@ from cosim.vessel import VesselSpec
 WRENCH_CHUNKS = 64  # first-level chunks of the fixed-order wrench reduction
 FORCE_CFL = 0.25  # Monaghan's force criterion dt <= 0.25 sqrt(h / a_max)
 VISCOUS_CFL = 0.125  # viscous criterion dt <= 0.125 h^2 / nu
+# WCSPH's density error grows as the Mach number squared: c0 = 10 v_max is sized for Ma = 0.1 (about 1 %); a
+# particle at Ma > 0.2 (about 4 %, Monaghan 1994) means the motion outran the c0 it was given. The stability matrix
+# (docs/stability.md) found such runs creating energy with plausible densities and no other symptom.
+MAX_MACH = 0.2
 GUARD_MARGIN = 0.01  # the guard puts a particle this many dx outside the wall face it crossed
 
 
@@ -118,9 +129,22 @@ class FluidSolver:
         self.state.active.fill_(1)
         self.state.pid.assign(np.arange(n, dtype=np.int32))
         wp.launch(wcsph.equation_of_state, dim=n, inputs=[m.params, self.state.rho], outputs=[self.state.p], device=d)
+        if self.config.pressure_solver is PressureSolver.DFSPH:
+            # the seeded pressure (hydrostatic for a filled vessel) as the stiffness the liquid was already under:
+            # the first density solve warm-starts from it as from any previous substep's
+            self.state.kappa_density.assign((self.state.p.numpy() / self.state.rho.numpy()).astype(np.float32))
         self._drho = wp.zeros(n, dtype=float, device=d)
         self._acc = wp.zeros(n, dtype=wp.vec3, device=d)
         self._rho_grad = wp.zeros(n, dtype=wp.vec3, device=d)
+        self._v_star = wp.zeros(n, dtype=wp.vec3, device=d)
+        self._alpha = wp.zeros(n, dtype=float, device=d)
+        self._increment = wp.zeros(n, dtype=float, device=d)
+        self._solve_stats = wp.zeros(dfsph.N_STATS, dtype=wp.int64, device=d)
+        capacity = dfsph.pair_capacity(self.config.dim, self.config.smoothing_ratio) if self.config.pressure_solver is PressureSolver.DFSPH else 0
+        self._pair_count = wp.zeros(n, dtype=wp.int32, device=d)
+        self._pair_index = wp.zeros((n, capacity), dtype=wp.int32, device=d)
+        self._pair_grad = wp.zeros((n, capacity), dtype=wp.vec3, device=d)
+        self._keep_going = wp.zeros(1, dtype=wp.int32, device=d)
         self._wall_force = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
         self._wall_torque = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
         self._partial_force = wp.zeros((v_count, WRENCH_CHUNKS), dtype=wp.vec3, device=d)
@@ -136,6 +160,7 @@ class FluidSolver:
         self._b_active = wp.ones(nb, dtype=wp.int32, device=d)
         self._motions = wp.zeros(m.n_vessels, dtype=bd.VesselMotion, device=d)
         self._dt = wp.zeros(1, dtype=float, device=d)
+        self._substep_weight = wp.zeros(1, dtype=float, device=d)
         self._row = wp.zeros(1, dtype=wp.int32, device=d)
         self._rows_capacity = 0
         self._ensure_rows(64)
@@ -181,10 +206,15 @@ class FluidSolver:
         self._targets = [self._planar(p) for p in poses]
 
     def plan_time_step(self, duration: float, wall_speed: float) -> tuple[int, float]:
-        """(substeps, dt) for an interval: acoustic CFL with the wall speed, force and viscous criteria."""
+        """(substeps, dt) for an interval: CFL with the wall speed (acoustic for WCSPH, on the flow speed alone for
+        DFSPH), force and viscous criteria."""
         cfg = self.config
         h = cfg.smoothing_length
-        dt = cfg.cfl * h / (cfg.sound_speed + self._last_max_speed + wall_speed)
+        if cfg.pressure_solver is PressureSolver.WCSPH:
+            signal = cfg.sound_speed + self._last_max_speed + wall_speed
+        else:  # the expected speed bounds the step before the flow has reached it (a jet forms within an interval)
+            signal = max(cfg.max_expected_speed, self._last_max_speed) + wall_speed
+        dt = cfg.cfl * h / max(signal, 1e-9)
         dt = min(dt, FORCE_CFL * math.sqrt(h / max(self._last_max_accel, 1e-9)))
         if cfg.kinematic_viscosity > 0.0:
             dt = min(dt, VISCOUS_CFL * h * h / cfg.kinematic_viscosity)
@@ -209,6 +239,9 @@ class FluidSolver:
             even, odd = (self.state, self._spare) if self._parity == 0 else (self._spare, self.state)
             self._ops = (self._substep_commands(even, odd), self._substep_commands(odd, even))
         self._dt.fill_(dt)
+        if self.config.pressure_solver is PressureSolver.DFSPH:  # its pressure is averaged over the interval
+            self._substep_weight.fill_(1.0 / n_sub)
+            self.state.p.zero_()
         self._row.zero_()
         self._diag_f.zero_()
         self._diag_i.zero_()
@@ -239,32 +272,53 @@ class FluidSolver:
         packing), for the particle state ``src``, which is reordered into ``dst`` and advanced there.
 
         Stages: move_vessels; place_wall_particles; find_neighbors (wall particles by indirection, liquid
-        reordered into cell order); extrapolate_wall_state; compute_forces; compute_density_rate; integrate (+ wall
-        guard, deactivation, diagnostics); reduce_wrenches (fixed order); next_substep."""
-        m, d, prm, cfg = self.model, self.device, self.model.params, self.config
-        n, nb, nv = self.n_particles, m.n_boundary, m.n_vessels
-
-        def rec(kernel, dim, inputs, outputs=()):
-            return wp.launch(kernel, dim=dim, inputs=inputs, outputs=list(outputs), device=d, record_cmd=True).launch
-
+        reordered into cell order); the pressure solver's stages; reduce_wrenches (fixed order); next_substep."""
+        m, n, nb, nv = self.model, self.n_particles, self.model.n_boundary, self.model.n_vessels
         ops = []
         if nv:
-            ops.append(rec(bd.advance_vessel_poses, nv, [self._row, self._dt], [self._motions]))
-            ops.append(rec(bd.place_wall_particles, nb, [m.b_local, m.b_vessel, self._motions], [self._bx, self._bv]))
+            ops.append(self._rec(bd.advance_vessel_poses, nv, [self._row, self._dt], [self._motions]))
+            ops.append(self._rec(bd.place_wall_particles, nb, [m.b_local, m.b_vessel, self._motions], [self._bx, self._bv]))
         ops += m.b_grid.build_commands(self._bx, self._b_active, nb)
         ops += m.grid.build_commands(src.x, src.active, n)
-        ops.append(rec(wcsph.gather_particles, n, [m.grid.order, *src.arrays()], dst.arrays()))
+        ops.append(self._rec(gather_particles, n, [m.grid.order, *src.arrays()], dst.arrays()))
+        if self.config.pressure_solver is PressureSolver.DFSPH:
+            ops += self._dfsph_commands(dst)
+        else:
+            ops += self._wcsph_commands(dst)
+        if nv:
+            chunk = math.ceil(n / WRENCH_CHUNKS)
+            ops.append(self._rec(sum_wall_wrench_chunks, (nv, WRENCH_CHUNKS), [n, chunk, self._wall_force, self._wall_torque], [self._partial_force, self._partial_torque]))
+            ops.append(self._rec(accumulate_wall_wrench, nv, [WRENCH_CHUNKS, self._partial_force, self._partial_torque], [self._force_sum, self._torque_sum]))
+        ops.append(self._rec(next_substep, 1, [self._row]))
+        return ops
+
+    def _rec(self, kernel, dim, inputs, outputs=()):
+        """A launch recorded with its arguments bound (call ``.launch()`` to run it)."""
+        return wp.launch(kernel, dim=dim, inputs=inputs, outputs=list(outputs), device=self.device, record_cmd=True).launch
+
+    def _integrate_model_args(self) -> list:
+        cfg = self.config
+        return [
+            self.model.params, self.model.vessels, wp.vec3(*cfg.domain_min), wp.vec3(*cfg.domain_max), GUARD_MARGIN * cfg.spacing,
+            cfg.max_wall_penetration * cfg.spacing, self._motions, self._dt, self._row,
+        ]
+
+    def _wcsph_commands(self, st: FluidState) -> list:
+        """extrapolate_wall_state; compute_forces; compute_density_rate; integrate (``cosim.fluid.wcsph``)."""
+        m, prm, n, nb = self.model, self.model.params, self.n_particles, self.model.n_boundary
+        rec = self._rec
+        ops = []
         if nb:
             ops.append(rec(
                 bd.extrapolate_wall_state, nb,
-                [prm, m.grid.spec, m.b_vessel, self._motions, self._bx, self._bv, dst.x, dst.v, dst.rho, dst.p, m.grid.cell_start, m.grid.cell_end],
+                [prm, m.grid.spec, m.b_vessel, self._motions, self._bx, self._bv, st.x, st.v, st.rho, st.p, m.grid.cell_start, m.grid.cell_end],
                 [self._b_p, self._b_rho, self._b_v_noslip],
             ))
         ops.append(rec(
             wcsph.compute_forces, n,
             [
                 prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel,
-                self._motions, dst.x, dst.v, dst.rho, dst.p, dst.active, m.grid.cell_start, m.grid.cell_end,
+                self._motions, st.x, st.v, st.rho, st.p, st.active, m.grid.cell_start, m.grid.cell_end,
                 self._bx, self._bv, self._b_p, self._b_rho, self._b_v_noslip,
                 m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, self._row,
             ],
@@ -273,25 +327,63 @@ class FluidSolver:
         ops.append(rec(
             wcsph.compute_density_rate, n,
             [
-                prm, m.grid.spec, m.b_volume, dst.x, dst.v, self._acc, dst.rho, self._rho_grad, dst.active, self._dt,
+                prm, m.grid.spec, m.b_volume, st.x, st.v, self._acc, st.rho, self._rho_grad, st.active, self._dt,
                 m.grid.cell_start, m.grid.cell_end, self._bx, self._bv, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end,
             ],
             [self._drho],
         ))
         ops.append(rec(
-            wcsph.integrate, n,
-            [
-                prm, m.vessels, wp.vec3(*cfg.domain_min), wp.vec3(*cfg.domain_max), GUARD_MARGIN * cfg.spacing,
-                cfg.max_wall_penetration * cfg.spacing, self._motions, self._dt, self._row, self._drho, self._acc,
-            ],
-            [dst.x, dst.v, dst.rho, dst.p, dst.active, self._diag_f, self._diag_i],
+            wcsph.integrate, n, [*self._integrate_model_args(), self._drho, self._acc],
+            [st.x, st.v, st.rho, st.p, st.active, self._diag_f, self._diag_i],
         ))
-        if nv:
-            chunk = math.ceil(n / WRENCH_CHUNKS)
-            ops.append(rec(wcsph.sum_wall_wrench_chunks, (nv, WRENCH_CHUNKS), [n, chunk, self._wall_force, self._wall_torque], [self._partial_force, self._partial_torque]))
-            ops.append(rec(wcsph.accumulate_wall_wrench, nv, [WRENCH_CHUNKS, self._partial_force, self._partial_torque], [self._force_sum, self._torque_sum]))
-        ops.append(rec(wcsph.next_substep, 1, [self._row]))
         return ops
+
+    def _dfsph_commands(self, st: FluidState) -> list:
+        """compute_density_factor; divergence solve; compute_nonpressure; density solve; compute_wall_reaction;
+        integrate (``cosim.fluid.dfsph``). Each solve is a ``wp.capture_while`` loop on a device flag."""
+        m, prm, n = self.model, self.model.params, self.n_particles
+        rec = self._rec
+        grid = [m.grid.cell_start, m.grid.cell_end]
+        walls = [self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end]
+        walls_v = [self._bx, self._bv, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end]
+
+        pairs = [self._pair_count, self._pair_index, self._pair_grad]
+
+        def solve(mode: int, v: wp.array, kappa: wp.array):
+            body = [
+                rec(dfsph.apply_stiffness, n, [st.rho, self._increment, st.active, self._dt, *pairs], [v, kappa]),
+                rec(dfsph.compute_solve_error, n, [prm, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [self._increment, self._solve_stats]),
+                rec(dfsph.check_convergence, 1, [prm, mode, self._row], [self._solve_stats, self._keep_going, self._diag_f, self._diag_i]),
+            ]
+
+            def iterate() -> None:
+                for op in body:
+                    op()
+
+            return lambda: wp.capture_while(self._keep_going, iterate)
+
+        return [
+            rec(
+                dfsph.compute_density_factor, n, [prm, m.grid.spec, m.b_volume, self._pair_index.shape[1], st.x, st.active, *grid, *walls, self._row, st.kappa_divergence],
+                [st.rho, self._alpha, self._increment, *pairs, self._solve_stats, self._keep_going, self._diag_f, self._diag_i],
+            ),
+            solve(dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence),
+            rec(
+                dfsph.compute_nonpressure, n, [prm, m.grid.spec, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, *grid, *walls_v, self._row, st.kappa_density],
+                [self._v_star, self._increment, self._solve_stats, self._keep_going, self._diag_f],
+            ),
+            solve(dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density),
+            rec(
+                dfsph.compute_wall_reaction, n,
+                [
+                    prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel, self._motions, st.x, st.v, st.rho, st.kappa_density,
+                    st.kappa_divergence, st.active, *walls_v, self._substep_weight,
+                ],
+                [self._wall_force, self._wall_torque, st.p],
+            ),
+            rec(dfsph.integrate, n, [*self._integrate_model_args(), self._v_star, st.rho], [st.x, st.v, st.active, self._diag_f, self._diag_i]),
+            self._solve_stats.zero_,
+        ]
 
     def _substep(self) -> None:
         """One substep: run the recorded operations of the current parity, then swap the particle buffers."""
@@ -305,11 +397,19 @@ class FluidSolver:
         checks = [
             (rows_i[:, 0] > 0, lambda s: f"{rows_i[s, 0]} particles with a non-finite position, velocity or density"),
             (rows_i[:, 1] > 0, lambda s: f"{rows_i[s, 1]} particles inside a vessel wall (deeper than {cfg.max_wall_penetration:g} dx)"),
+            (rows_i[:, 6] > 0, lambda s: f"{rows_i[s, 6]} particles with more neighbours than the DFSPH pair list holds (over-compressed)"),
             (
                 rows_f[:, 4] > cfg.max_density_error,
                 lambda s: f"compression {rows_f[s, 4]:.3f} exceeds fluid.max_density_error = {cfg.max_density_error:g}",
             ),
         ]
+        if cfg.pressure_solver is PressureSolver.WCSPH:
+            limit = MAX_MACH * cfg.sound_speed
+            checks.append((
+                rows_f[:, 0] > limit,
+                lambda s: f"fastest particle {rows_f[s, 0]:.3g} m/s is faster than {MAX_MACH:g} c0 = {limit:.3g} m/s, where "
+                "the weakly compressible model no longer holds: raise fluid.max_expected_speed",
+            ))
         bad = [(int(np.argmax(mask)), describe) for mask, describe in checks if mask.any()]
         if bad:
             s, describe = min(bad, key=lambda b: b[0])
@@ -335,7 +435,8 @@ class FluidSolver:
         return self._in_id_order(self.state.rho).astype(np.float64)
 
     def pressures(self) -> np.ndarray:
-        """(N,) Pa."""
+        """(N,) Pa. WCSPH: from the equation of state after the last substep; DFSPH: rho kappa averaged over the
+        last interval's substeps."""
         return self._in_id_order(self.state.p).astype(np.float64)
 
     def active_mask(self) -> np.ndarray:
@@ -367,7 +468,8 @@ class FluidSolver:
     def history(self) -> dict[str, np.ndarray]:
         """Every substep so far: 'dt' (s), 'time' (s, end of substep), 'max_speed', 'max_acceleration',
         'max_density_error', 'kinetic_energy', 'nonfinite', 'wall_breaches', 'wall_corrections', 'active',
-        'volume_in_vessel' (steps, V) m^3."""
+        'volume_in_vessel' (steps, V) m^3; DFSPH's 'divergence_iterations', 'density_iterations' and the errors
+        its solves left, 'divergence_error', 'density_solve_error' (relative; zero under WCSPH)."""
         if not self._history:
             return {}
         dt = np.concatenate([h[0] for h in self._history])
@@ -385,5 +487,9 @@ class FluidSolver:
             "wall_breaches": i[:, 1],
             "wall_corrections": i[:, 2],
             "active": i[:, 3],
+            "divergence_iterations": i[:, 4],
+            "density_iterations": i[:, 5],
+            "divergence_error": f[:, 5],
+            "density_solve_error": f[:, 6],
             "volume_in_vessel": i[:, N_DIAG_INT_BASE:] * self.config.particle_volume,
         }

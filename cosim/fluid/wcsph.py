@@ -19,34 +19,16 @@ from __future__ import annotations
 
 import warp as wp
 
-from cosim.fluid.boundary import VesselGeometry, VesselMotion, guard_vessel, inside_vessel
-from cosim.fluid.diagnostics import (
-    DIAG_ACTIVE,
-    DIAG_BREACHES,
-    DIAG_CORRECTIONS,
-    DIAG_INSIDE0,
-    DIAG_KINETIC_ENERGY,
-    DIAG_MAX_ACCEL,
-    DIAG_MAX_COMPRESSION,
-    DIAG_MAX_DENSITY_ERROR,
-    DIAG_MAX_SPEED,
-    DIAG_NONFINITE,
-)
+from cosim.fluid.boundary import VesselGeometry, VesselMotion
+from cosim.fluid.diagnostics import DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
-from cosim.fluid.sph_kernels import kernel_dw
+from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair
 
 # The renormalisation matrix L^-1 (identity for a full kernel support) is used only where det L exceeds this:
 # near-empty supports (spray, a lone particle) give no meaningful density gradient.
 RENORMALISATION_MIN_DET = wp.constant(0.05)
 MIN_DENSITY_RATIO = wp.constant(0.8)
-
-
-@wp.func
-def kernel_gradient(prm: SPHParams, r: wp.vec3, r2: float) -> wp.vec3:
-    """grad_i W(x_i - x_j) for r = x_i - x_j, |r|^2 = r2 > 0 (1/m^(dim+1))."""
-    rl = wp.sqrt(r2)
-    return r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
 
 
 @wp.func
@@ -127,11 +109,7 @@ def compute_forces(
                     moment += vol * wp.outer(-r, gw)
                     gsum += (vol * (rhoj - rhoi)) * gw
                     a -= prm.mass * (pi_term + p[j] / (rhoj * rhoj)) * gw
-                    vr = wp.dot(vij, r)
-                    if vr < 0.0:
-                        mu = prm.h * vr / (r2 + prm.eta2)
-                        a += (prm.mass * prm.alpha * prm.sound_speed * mu / (0.5 * (rhoi + rhoj))) * gw
-                    a += (prm.mass * prm.nu * (1.0 / rhoi + 1.0 / rhoj) * wp.dot(r, gw) / (r2 + prm.eta2)) * vij
+                    a += viscous_pair(prm, prm.mass, r, r2, gw, vij, vij, rhoi, rhoj)
                 for kk in range(b_cell_start[cell], b_cell_end[cell]):
                     b = b_order[kk]
                     xb = bx[b]
@@ -143,11 +121,7 @@ def compute_forces(
                     mw = prm.rest_density * b_volume[b]
                     rhob = b_rho[b]
                     ab = -(mw * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
-                    vr = wp.dot(vi - bv[b], r)
-                    if vr < 0.0:
-                        mu = prm.h * vr / (r2 + prm.eta2)
-                        ab += (mw * prm.alpha * prm.sound_speed * mu / (0.5 * (rhoi + rhob))) * gw
-                    ab += (mw * prm.nu * (1.0 / rhoi + 1.0 / rhob) * wp.dot(r, gw) / (r2 + prm.eta2)) * (vi - b_v_noslip[b])
+                    ab += viscous_pair(prm, mw, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
                     a += ab
                     kv = b_vessel[b]
                     m = motions[kv]
@@ -272,50 +246,13 @@ def integrate(
     # stops the rare runaway expansion of a fragment whose support emptied (its density would otherwise fall
     # without bound, even below zero).
     rhoi = wp.max(rho[i] + h * drho[i], MIN_DENSITY_RATIO * prm.rest_density)
-    if prm.dim == 2:
-        vi[1] = 0.0
-        xi[1] = 0.0
-    for k in range(prm.n_vessels):
-        m = motions[k]
-        geo = vessels[k]
-        q_old = wp.transpose(m.r_now) @ (x_old - m.p_now)
-        q_new = wp.transpose(m.r_next) @ (xi - m.p_next)
-        q, normal, depth, hits = guard_vessel(q_old, q_new, geo, prm.dim, guard_margin)
-        if hits > 0:
-            xi = m.p_next + m.r_next @ q
-            n_world = m.r_next @ normal
-            v_wall = m.lin_vel + wp.cross(m.ang_vel, xi - m.p_next)
-            vn = wp.dot(vi - v_wall, n_world)
-            if vn < 0.0:
-                vi = vi - vn * n_world
-            wp.atomic_add(diag_i, s, DIAG_CORRECTIONS, 1)
-            if depth > max_penetration:
-                wp.atomic_add(diag_i, s, DIAG_BREACHES, 1)
-        if inside_vessel(q, geo, prm.dim) != 0:
-            wp.atomic_add(diag_i, s, DIAG_INSIDE0 + k, 1)
-    if not (wp.isfinite(xi) and wp.isfinite(vi) and wp.isfinite(rhoi)):
-        wp.atomic_add(diag_i, s, DIAG_NONFINITE, 1)
-        active[i] = 0
+    kept = finish_particle(prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, s, i, x_old, xi, vi, rhoi, x, v, active, diag_f, diag_i)
+    if kept == 0:
         return
-    outside = False
-    for a in range(3):
-        if xi[a] < domain_min[a] or xi[a] > domain_max[a]:
-            outside = True
-    if outside:
-        active[i] = 0
-        x[i] = xi
-        v[i] = wp.vec3(0.0)
-        return
-    x[i] = xi
-    v[i] = vi
     rho[i] = rhoi
     p[i] = tait_pressure(prm, rhoi)
-    speed = wp.length(vi)
-    wp.atomic_add(diag_i, s, DIAG_ACTIVE, 1)
-    wp.atomic_max(diag_f, s, DIAG_MAX_SPEED, speed)
     wp.atomic_max(diag_f, s, DIAG_MAX_DENSITY_ERROR, wp.abs(rhoi - prm.rest_density) / prm.rest_density)
     wp.atomic_max(diag_f, s, DIAG_MAX_COMPRESSION, (rhoi - prm.rest_density) / prm.rest_density)
-    wp.atomic_add(diag_f, s, DIAG_KINETIC_ENERGY, 0.5 * prm.mass_out * speed * speed)
 
 
 @wp.kernel
@@ -323,74 +260,3 @@ def equation_of_state(prm: SPHParams, rho: wp.array(dtype=float), p: wp.array(dt
     """p from rho for every particle (used once at start-up; integrate() keeps p current afterwards)."""
     i = wp.tid()
     p[i] = tait_pressure(prm, rho[i])
-
-
-@wp.kernel
-def gather_particles(
-    order: wp.array(dtype=wp.int32),
-    x: wp.array(dtype=wp.vec3),
-    v: wp.array(dtype=wp.vec3),
-    rho: wp.array(dtype=float),
-    p: wp.array(dtype=float),
-    active: wp.array(dtype=wp.int32),
-    pid: wp.array(dtype=wp.int32),
-    x_out: wp.array(dtype=wp.vec3),
-    v_out: wp.array(dtype=wp.vec3),
-    rho_out: wp.array(dtype=float),
-    p_out: wp.array(dtype=float),
-    active_out: wp.array(dtype=wp.int32),
-    pid_out: wp.array(dtype=wp.int32),
-):
-    """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
-    i = wp.tid()
-    src = order[i]
-    x_out[i] = x[src]
-    v_out[i] = v[src]
-    rho_out[i] = rho[src]
-    p_out[i] = p[src]
-    active_out[i] = active[src]
-    pid_out[i] = pid[src]
-
-
-@wp.kernel
-def sum_wall_wrench_chunks(
-    n: int,
-    chunk: int,
-    wall_force: wp.array2d(dtype=wp.vec3),
-    wall_torque: wp.array2d(dtype=wp.vec3),
-    partial_force: wp.array2d(dtype=wp.vec3),
-    partial_torque: wp.array2d(dtype=wp.vec3),
-):
-    """First level of the fixed-order reduction: chunk c of vessel k summed sequentially."""
-    k, c = wp.tid()
-    f = wp.vec3(0.0)
-    t = wp.vec3(0.0)
-    for i in range(c * chunk, wp.min((c + 1) * chunk, n)):
-        f += wall_force[k, i]
-        t += wall_torque[k, i]
-    partial_force[k, c] = f
-    partial_torque[k, c] = t
-
-
-@wp.kernel
-def accumulate_wall_wrench(
-    n_chunks: int,
-    partial_force: wp.array2d(dtype=wp.vec3),
-    partial_torque: wp.array2d(dtype=wp.vec3),
-    force_sum: wp.array(dtype=wp.vec3),
-    torque_sum: wp.array(dtype=wp.vec3),
-):
-    """Second level: the chunks of vessel k in order, added to the interval's running sum."""
-    k = wp.tid()
-    f = wp.vec3(0.0)
-    t = wp.vec3(0.0)
-    for c in range(n_chunks):
-        f += partial_force[k, c]
-        t += partial_torque[k, c]
-    force_sum[k] = force_sum[k] + f
-    torque_sum[k] = torque_sum[k] + t
-
-
-@wp.kernel
-def next_substep(row: wp.array(dtype=wp.int32)):
-    row[0] = row[0] + 1

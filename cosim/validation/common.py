@@ -8,12 +8,12 @@ from typing import Any
 
 import numpy as np
 
-from cosim.checks import check_device, check_int, check_positive
+from cosim.checks import check_choice, check_device, check_int, check_positive
 from cosim.errors import InputError
-from cosim.fluid.config import GRAVITY, FluidConfig
+from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
 
-# FluidConfig fields a case's numerics may override (the rest is the case's geometry and physics).
-NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "solver")
+# FluidConfig fields a case's numerics may override (the rest is the case's geometry, physics and solver).
+NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor")
 
 
 @dataclass(frozen=True)
@@ -60,6 +60,7 @@ class FluidCaseParams:
 
     spacing: m, particle spacing (None: the case's default resolution). dim: 2 or 3. device: 'cpu' or 'cuda[:N]'.
     depth: m, tank depth perpendicular to the pour plane (3-D extent; 2-D out-of-plane scale).
+    solver: pressure solver, :class:`PressureSolver` or its name ('wcsph', 'dfsph').
     numerics: overrides of the solver's numerical settings, (FluidConfig field, value) pairs, e.g.
         (("kernel", "cubic_spline"), ("cfl", 0.4)); one of NUMERICS_FIELDS each (the benchmark's axes).
     """
@@ -68,6 +69,7 @@ class FluidCaseParams:
     dim: int = 2
     device: str = "cpu"
     depth: float = 0.1
+    solver: PressureSolver = PressureSolver.WCSPH
     numerics: tuple[tuple[str, Any], ...] = ()
 
     def validate_common(self) -> None:
@@ -76,6 +78,7 @@ class FluidCaseParams:
         check_int("dim", self.dim, 2, 3)
         check_device("device", self.device)
         check_positive("depth", self.depth, "m", 2.0)
+        object.__setattr__(self, "solver", check_choice("solver", self.solver, PressureSolver))
         for name, _ in self.numerics:
             if name not in NUMERICS_FIELDS:
                 raise InputError(f"numerics: {name!r} cannot be overridden; choose from {', '.join(NUMERICS_FIELDS)}")
@@ -90,12 +93,14 @@ def reference_speed(liquid_height: float) -> float:
 
 
 def case_fluid_config(
-    dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max, numerics=()
+    dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max, solver: PressureSolver = PressureSolver.WCSPH,
+    numerics=(),
 ) -> FluidConfig:
     """The fluid configuration every case uses: project defaults (or ``numerics``, see :class:`FluidCaseParams`),
     c0 from :func:`reference_speed`."""
     return FluidConfig(
         dim=dim,
+        pressure_solver=solver,
         spacing=spacing,
         max_expected_speed=reference_speed(liquid_height),
         depth_2d=depth,

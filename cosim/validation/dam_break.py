@@ -87,6 +87,7 @@ def run(p: Params) -> CaseResult:
     cfg = case_fluid_config(
         p.dim, dx, p.height, p.depth,
         (wall - margin, -0.5 * p.depth - margin, -margin), (-wall + margin, 0.5 * p.depth + margin, tank.inner_height + margin),
+        p.solver,
         numerics=p.numerics,
     )
     column = liquid_block((wall, -0.5 * p.depth, 0.0), (wall + a, 0.5 * p.depth, p.height), cfg)
@@ -124,7 +125,7 @@ def run(p: Params) -> CaseResult:
         "particles": solver.n_particles,
         "steps": solver.step_count,
     }
-    params = dict(width=a, fill=p.height, spacing=dx, dim=p.dim, device=p.device, t_max=p.t_max, depth=p.depth)
+    params = dict(width=a, fill=p.height, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, t_max=p.t_max, depth=p.depth)
     return CaseResult("dam-break", params, metrics, raw, wall_time)
 
 

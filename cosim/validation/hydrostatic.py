@@ -69,7 +69,7 @@ def run(p: Params) -> CaseResult:
     margin = 0.05 * p.width + 10 * dx
     half = 0.5 * p.width + margin
     cfg = case_fluid_config(
-        p.dim, dx, p.fill, p.depth, (-half, -0.5 * p.depth - margin, -margin), (half, 0.5 * p.depth + margin, tank.inner_height + margin),
+        p.dim, dx, p.fill, p.depth, (-half, -0.5 * p.depth - margin, -margin), (half, 0.5 * p.depth + margin, tank.inner_height + margin), p.solver,
         numerics=p.numerics,
     )
     solver = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, p.fill, cfg), device=p.device)
@@ -116,7 +116,7 @@ def run(p: Params) -> CaseResult:
         "steps": solver.step_count,
         "active": int(active.sum()),
     }
-    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, duration=p.duration, depth=p.depth)
+    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, duration=p.duration, depth=p.depth)
     return CaseResult("hydrostatic", params, metrics, raw, wall)
 
 

@@ -4,31 +4,27 @@
 (default 90 deg) and held; the liquid pours out and falls out of the domain. ``shake``: the vessel moves
 x(t) = amplitude sin(2 pi f t) at the first sloshing frequency f (seed Eq. 17), default 1 cm for 4 periods.
 
-Checked independently of the solver's own guard, from positions and poses at every 2 ms sample (numpy): no
-particle inside the wall solid (the wall region the liquid sees), and no particle that went from the vessel's
-inside to its outside below the rim (through a wall) between two samples. Non-finite values or a breached wall
-would stop the run with the solver's instability error, which the case reports as a failure.
+Checked independently of the solver's own guard (``cosim.validation.scripted``), from positions and poses at
+every 2 ms sample (numpy): no particle inside the wall solid (the wall region the liquid sees), and no particle
+that went from the vessel's inside to its outside below the rim (through a wall) between two samples. Non-finite
+values or a breached wall would stop the run with the solver's instability error, which the case reports as a
+failure.
 """
 
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
 
 from cosim.checks import check_positive, check_range
-from cosim.fluid.seeding import fill_vessel
-from cosim.fluid.solver import FluidInstabilityError, FluidSolver
-from cosim.frames import Pose, rotation_y
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
+from cosim.validation.scripted import FALL_HEIGHT, PoseScript, domain_around, run_scripted, shake_sideways, tilt_about_lip
 from cosim.validation.slosh import eq17_frequency
 from cosim.vessel import VesselSpec, seed_pouring_vessel
 
-SAMPLE_INTERVAL = 0.002  # s
 HOLD_AFTER_TILT = 0.5  # s the tilted vessel is held before the run ends
-FALL_HEIGHT = 0.3  # m of domain below the vessel for the poured liquid (then it leaves the domain)
 
 
 @dataclass(frozen=True)
@@ -65,59 +61,19 @@ class Params(FluidCaseParams):
         return self.spacing if self.spacing is not None else self.spec().inner_width / self.particles_across
 
 
-def _classify(local: np.ndarray, b: float, d: float, h: float, t: float, dim: int) -> tuple[np.ndarray, np.ndarray]:
-    """(inside the wall solid, in the inner volume) for vessel-frame points; walls as the liquid sees them."""
-    ax, ay, z = np.abs(local[:, 0]), np.abs(local[:, 1]), local[:, 2]
-    y_in = np.ones(len(local), bool) if dim == 2 else ay < d
-    y_outer = np.ones(len(local), bool) if dim == 2 else ay < d + t
-    inner = (ax < b) & y_in & (z > 0.0) & (z < h)
-    envelope = (ax < b + t) & y_outer & (z > -t) & (z < h)
-    return envelope & ~inner & ~((ax < b) & y_in & (z >= h)), inner
-
-
-def _run(name: str, p: Params, pose_at) -> CaseResult:
+def _run(name: str, p: Params, pose_at: PoseScript) -> CaseResult:
     spec = p.spec()
     dx = p.resolved_spacing
-    reach = spec.inner_height + 0.5 * spec.inner_width + 0.1
-    cfg = case_fluid_config(
-        p.dim, dx, max(p.fill, FALL_HEIGHT), spec.section_depth,
-        (-reach - p.amplitude, -reach, -FALL_HEIGHT), (reach + p.amplitude, reach, reach),
-        numerics=p.numerics,
-    )
-    solver = FluidSolver(cfg, [spec], [pose_at(0.0)], fill_vessel(spec, p.fill, cfg, pose_at(0.0)), device=p.device)
-    t_wall = float(solver.model.wall_thickness[0])
-    b, d, h = 0.5 * spec.inner_width, 0.5 * spec.section_depth, spec.inner_height
-    duration = p.duration_for(name)
-    prev_inner = _classify(pose_at(0.0).inverse_transform(solver.positions()), b, d, h, t_wall, p.dim)[1]
-    worst_inside = worst_through = 0
-    failure = ""
-    series_t, series_volume = [], []
-    start = time.perf_counter()
-    try:
-        while solver.time < duration - 1e-9:
-            pose = pose_at(solver.time + SAMPLE_INTERVAL)
-            solver.set_vessel_poses([pose])
-            solver.advance(SAMPLE_INTERVAL)
-            sim_pose = solver.vessel_poses()[0]
-            active = solver.active_mask()
-            local = sim_pose.inverse_transform(solver.positions())
-            in_wall, inner = _classify(local, b, d, h, t_wall, p.dim)
-            below_rim = local[:, 2] < h - dx
-            through = prev_inner & ~inner & ~in_wall & below_rim & active
-            worst_inside = max(worst_inside, int((in_wall & active).sum()))
-            worst_through = max(worst_through, int(through.sum()))
-            prev_inner = inner & active
-            series_t.append(solver.time)
-            series_volume.append(solver.last_report.last.volume_in_vessel[0])
-    except FluidInstabilityError as exc:
-        failure = str(exc)
-    wall = time.perf_counter() - start
+    cfg = case_fluid_config(p.dim, dx, max(p.fill, FALL_HEIGHT), spec.section_depth, *domain_around(spec, p.amplitude), p.solver,
+                            numerics=p.numerics)
+    run = run_scripted(spec, p.fill, cfg, pose_at, p.duration_for(name), device=p.device)
+    solver, leaks, failure = run.solver, run.leaks, run.failure
     hist = solver.history()
     volume0 = solver.n_particles * cfg.particle_volume
     metrics = [
         Metric("run completed", 0.0 if failure else 1.0, 1.0, 0.0 if not failure else 1.0, 0.0, "", absolute=True),
-        Metric("particles inside a wall", float(worst_inside), 0.0, float(worst_inside), 0.0, "", absolute=True),
-        Metric("particles through a wall", float(worst_through), 0.0, float(worst_through), 0.0, "", absolute=True),
+        Metric("particles inside a wall", float(leaks.worst_inside), 0.0, float(leaks.worst_inside), 0.0, "", absolute=True),
+        Metric("particles through a wall", float(leaks.worst_through), 0.0, float(leaks.worst_through), 0.0, "", absolute=True),
     ]
     raw = {
         "failure": failure,
@@ -128,35 +84,21 @@ def _run(name: str, p: Params, pose_at) -> CaseResult:
         "guard_corrections": int(hist["wall_corrections"].sum()) if hist else 0,
         "volume_left_in_vessel": float(hist["volume_in_vessel"][-1, 0]) if hist else float("nan"),
         "initial_volume": volume0,
-        "t": series_t,
-        "volume_in_vessel": series_volume,
+        "t": run.t,
+        "volume_in_vessel": run.volume_in_vessel,
     }
-    params = dict(fill=p.fill, spacing=dx, dim=p.dim, device=p.device, rate=p.rate, angle=p.angle,
+    params = dict(fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, rate=p.rate, angle=p.angle,
                   amplitude=p.amplitude, periods=p.periods)
-    return CaseResult(name, params, metrics, raw, wall)
-
-
-def _tilt_pose(p: Params):
-    spec = p.spec()
-    lip = spec.lip_local
-    rate = math.radians(p.rate)
-    final = math.radians(p.angle)
-
-    def pose_at(t: float) -> Pose:
-        rot = rotation_y(min(rate * t, final))
-        return Pose(lip - rot @ lip, rot)
-
-    return pose_at
+    return CaseResult(name, params, metrics, raw, run.wall_time)
 
 
 def run_tilt(p: Params) -> CaseResult:
-    return _run("tilt", p, _tilt_pose(p))
+    return _run("tilt", p, tilt_about_lip(p.spec(), math.radians(p.rate), math.radians(p.angle)))
 
 
 def run_shake(p: Params) -> CaseResult:
-    spec = p.spec()
-    omega = 2 * math.pi * eq17_frequency(spec.inner_width, p.fill)
-    return _run("shake", p, lambda t: Pose((p.amplitude * math.sin(omega * t), 0.0, 0.0)))
+    omega = 2 * math.pi * eq17_frequency(p.spec().inner_width, p.fill)
+    return _run("shake", p, shake_sideways(p.amplitude, omega))
 
 
 def plot(result: CaseResult, path) -> None:

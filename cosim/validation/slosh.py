@@ -75,7 +75,7 @@ def run(p: Params) -> CaseResult:
     margin = 0.05 * p.width + 10 * dx
     half = 0.5 * p.width + margin
     cfg = case_fluid_config(
-        p.dim, dx, p.fill, p.depth, (-half, -0.5 * p.depth - margin, -margin), (half + PULSE_AMPLITUDE, 0.5 * p.depth + margin, tank.inner_height + margin),
+        p.dim, dx, p.fill, p.depth, (-half, -0.5 * p.depth - margin, -margin), (half + PULSE_AMPLITUDE, 0.5 * p.depth + margin, tank.inner_height + margin), p.solver,
         numerics=p.numerics,
     )
     solver = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, p.fill, cfg), device=p.device)
@@ -111,7 +111,7 @@ def run(p: Params) -> CaseResult:
         "particles": solver.n_particles,
         "steps": solver.step_count,
     }
-    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, periods=p.periods, depth=p.depth)
+    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, periods=p.periods, depth=p.depth)
     return CaseResult("slosh", params, metrics, raw, wall)
 
 

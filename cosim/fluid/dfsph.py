@@ -1,0 +1,518 @@
+"""Divergence-free SPH stages (warp kernels): Bender & Koschier (2015, SCA; 2017, IEEE TVCG).
+
+Incompressibility is enforced by two iterative solves per substep instead of a stiff equation of state, so the
+time step follows the flow speed (CFL on particle and wall speed) rather than an artificial speed of sound.
+A substep, after the neighbour search:
+
+  compute_density_factor   the substep's pair list (liquid and wall neighbours with their mass-weighted kernel
+                           gradients, which every solve iteration loops over instead of the cell grid);
+                           rho_i = (sum_j m W_ij + sum_b rho0 V_b W_ib) / s (summation density, wall particles
+                           included; s = the sum over a resting lattice / rho0, 1.005 for Wendland C2 at h = 1.5 dx
+                           in 2-D, so the liquid as seeded is at rest instead of 0.5 % compressed) and the DFSPH
+                           factor alpha_i = rho_i / (|sum_j m grad W_ij + sum_b rho0 V_b grad W_ib|^2
+                           + sum_j |m grad W_ij|^2) (denominator bounded below); starts the divergence solve.
+  divergence solve         iterate [apply_stiffness, compute_solve_error, check_convergence] until the average
+                           compressing density rate times dt is below ``divergence_tolerance`` rho0 and no
+                           particle's above MAX_PARTICLE_RESIDUAL (or the iteration cap).
+  compute_nonpressure      v* = v + dt (gravity + viscosity); starts the density solve (warm start).
+  density solve            the same iteration on the predicted density rho_i + dt Drho_i/Dt until its average
+                           compression is below ``density_tolerance`` rho0 (and no particle's above
+                           MAX_PARTICLE_RESIDUAL).
+  compute_wall_reaction    the liquid's force on each vessel from exactly the pair forces its wall particles
+                           exerted in both solves (Newton's third law), per particle, reduced later in fixed order.
+  integrate                x += dt v*, then the shared wall guard, deactivation and diagnostics.
+
+One Jacobi iteration, for stiffness increments k_i (m^2/s^2, a pressure over density p / rho):
+  k_i = max(e_i, 0) alpha_i / dt^2, with e_i = dt Drho_i/Dt (divergence) or rho_i - rho0 + dt Drho_i/Dt (density),
+  Drho_i/Dt = sum_j m (v_i - v_j) . grad W_ij + sum_b rho0 V_b (v_i - v_b) . grad W_ib   (wall velocity v_b: the
+  moving vessel enters the divergence term),
+  v_i -= dt [sum_j m (k_i / rho_i + k_j / rho_j) grad W_ij + sum_b rho0 V_b (k_i / rho_i) grad W_ib]
+(the wall particles mirror the particle's own stiffness, as in SPlisHSPlasH's Akinci boundary). Only compression
+is corrected (e_i >= 0): a free surface's kernel deficiency is not a pressure. The stiffness each particle applied
+over both solves, kappa_i, is kept: it gives the reported pressure p_i = rho_i kappa_i (the pressure whose impulse
+acted over dt; reported as its average over the interval), the wall reaction, and the warm start of the next
+substep.
+
+The stopping test reads one int32 flag that ``check_convergence`` writes on the device, driven by
+``wp.capture_while``: on the CPU it reads the flag from memory each iteration; on CUDA it becomes a conditional
+graph node when captured (otherwise warp copies the flag to the host each iteration). Verified on the CPU only:
+no GPU was available when this was written, so neither the CUDA run nor its graph capture has been executed.
+The average error is summed as integers (quanta of ``ERROR_QUANTUM``) so it does not depend on the order of the atomic adds: the
+iteration count, and with it the trajectory, is deterministic on every device.
+
+Diagnostics: ``max_density_error`` and ``max_compression`` are the summation density's compression
+max(rho - rho0, 0) / rho0 at the substep's start (the state the previous substep left), ``max_acceleration`` is
+that of the non-pressure forces; the solves' final errors and iteration counts have their own fields.
+"""
+
+from __future__ import annotations
+
+import math
+
+import warp as wp
+
+from cosim.fluid.boundary import VesselGeometry, VesselMotion
+from cosim.fluid.diagnostics import (
+    DIAG_DENSITY_ITERATIONS,
+    DIAG_DENSITY_SOLVE_ERROR,
+    DIAG_DIVERGENCE_ERROR,
+    DIAG_DIVERGENCE_ITERATIONS,
+    DIAG_MAX_ACCEL,
+    DIAG_MAX_COMPRESSION,
+    DIAG_MAX_DENSITY_ERROR,
+    DIAG_PAIR_OVERFLOW,
+)
+from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
+from cosim.fluid.params import SPHParams
+from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair
+from cosim.fluid.sph_kernels import kernel_w
+
+# Warm starts (Bender & Koschier 2017, Sec. 4.3): each solve starts from a fraction of the stiffness it applied in
+# the previous substep. Only compression is corrected, so a warm start can never be taken back within a substep:
+# a large fraction ratchets the pressure up (density 0.8: a shaken tank splashes over its rim; 0.95 and 1.0: it
+# blows up), a small one leaves the whole hydrostatic load to the Jacobi iterations. Measured: density 0.5 leaves the
+# least motion in a resting column (max speed after 1 s at 12 particles across 0.069 m/s; 0.25 / 0.75: 0.046 /
+# 0.108 with no divergence warm start); the divergence warm start trades that motion against the shallow slosh
+# frequency (A = 54 mm, seed Eq. 17): 0.5 gives -2.3 % and 0.069 m/s, 0.25 -6.4 % and 0.059 m/s, 0 -10.2 % and
+# 0.032 m/s. 0.5 for both, as SPlisHSPlasH.
+WARM_START_DENSITY = wp.constant(0.5)
+WARM_START_DIVERGENCE = wp.constant(0.5)
+# Relative errors are summed as integers of this size (deterministic order-free sum; 1e-9 of rho0 resolves a
+# 1e-5 tolerance to 1e-4 and keeps a million particles of error <= 1 within int64).
+ERROR_QUANTUM = wp.constant(1.0e-9)
+MAX_PARTICLE_ERROR = wp.constant(1.0)
+# Besides the average (Bender & Koschier's criterion), no particle may keep more than this relative error: an
+# impact compresses a few particles among many, which the average alone lets through (measured: a jet landing in the
+# catcher at 4 m/s, the solve stopped after one iteration and the landing particles blew up). 1 % is the density
+# error the weakly compressible solver is held to.
+MAX_PARTICLE_RESIDUAL = wp.constant(0.01)
+# The factor's denominator is kept above this fraction of that of a particle inside a resting lattice: with few
+# neighbours (spray, a particle landing on another: the kernel gradient vanishes as r -> 0) it tends to zero, the
+# linearised factor to infinity, and a tiny compression would give a kick that blows the pair apart (measured: the
+# pour's jet landing in the catcher). Such particles get a softer, under-relaxed push instead.
+MIN_FACTOR_DENOMINATOR = wp.constant(0.25)
+
+SOLVE_DIVERGENCE = 0
+SOLVE_DENSITY = 1
+
+# Pair-list room per particle, in units of the lattice neighbours a full kernel support holds (liquid and wall
+# together fill one support; the rest is margin for compression and disorder)
+PAIR_CAPACITY_FACTOR = 2.5
+
+
+def pair_capacity(dim: int, smoothing_ratio: float) -> int:
+    """Pair-list entries per particle: PAIR_CAPACITY_FACTOR x the lattice points in a support of radius 2h."""
+    radius = 2.0 * smoothing_ratio  # in particle spacings
+    lattice = math.pi * radius**2 if dim == 2 else 4.0 / 3.0 * math.pi * radius**3
+    return math.ceil(PAIR_CAPACITY_FACTOR * lattice)
+
+
+# solve_stats (int64): error sum (quanta), active particle count, iterations of the current solve, largest error
+STAT_ERROR = wp.constant(0)
+STAT_COUNT = wp.constant(1)
+STAT_ITERATIONS = wp.constant(2)
+STAT_MAX_ERROR = wp.constant(3)
+N_STATS = 4
+
+
+@wp.func
+def wall_pair(b: int) -> int:
+    """Pair-list code of wall particle b (fluid neighbours are stored as their index j >= 0)."""
+    return -1 - b
+
+
+@wp.kernel
+def compute_density_factor(
+    # Model
+    prm: SPHParams,
+    g: GridSpec,
+    b_volume: wp.array(dtype=float),
+    capacity: int,
+    # State in
+    x: wp.array(dtype=wp.vec3),
+    active: wp.array(dtype=wp.int32),
+    cell_start: wp.array(dtype=wp.int32),
+    cell_end: wp.array(dtype=wp.int32),
+    bx: wp.array(dtype=wp.vec3),
+    b_order: wp.array(dtype=wp.int32),
+    b_cell_start: wp.array(dtype=wp.int32),
+    b_cell_end: wp.array(dtype=wp.int32),
+    row: wp.array(dtype=wp.int32),
+    # State in/out
+    kappa_divergence: wp.array(dtype=float),
+    # Out
+    rho: wp.array(dtype=float),
+    alpha: wp.array(dtype=float),
+    increment: wp.array(dtype=float),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_grad: wp.array2d(dtype=wp.vec3),
+    solve_stats: wp.array(dtype=wp.int64),
+    keep_going: wp.array(dtype=wp.int32),
+    diag_f: wp.array2d(dtype=float),
+    diag_i: wp.array2d(dtype=wp.int32),
+):
+    """Summation density, DFSPH factor and the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall
+    code :func:`wall_pair`; ``pair_grad[i, k]``: its mass times grad_i W, kg/m^(dim+1)), which the solve
+    iterations loop over instead of the cell grid; the divergence solve's warm start (increment = a fraction of the
+    last substep's stiffness, applied by the first iteration) and its counters. More than ``capacity`` neighbours
+    (impossible below ~2x compression) count as an overflow, an instability."""
+    i = wp.tid()
+    if i == 0:
+        solve_stats[STAT_ITERATIONS] = wp.int64(0)
+        keep_going[0] = 1
+    warm = WARM_START_DIVERGENCE * kappa_divergence[i]
+    kappa_divergence[i] = 0.0
+    pair_count[i] = 0
+    if active[i] == 0:
+        rho[i] = prm.rest_density
+        alpha[i] = 0.0
+        increment[i] = 0.0
+        return
+    wp.atomic_add(solve_stats, STAT_COUNT, wp.int64(1))
+    xi = x[i]
+    support2 = prm.support * prm.support
+    density = prm.mass * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
+    grad_sum = wp.vec3(0.0)
+    grad_sq = float(0.0)
+    count = int(0)
+    c = grid_cell(g, xi)
+    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
+        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
+            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
+                cell = grid_index(g, cx, cy, cz)
+                for j in range(cell_start[cell], cell_end[cell]):
+                    r = xi - x[j]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    density += prm.mass * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                    gm = prm.mass * kernel_gradient(prm, r, r2)
+                    grad_sum += gm
+                    grad_sq += wp.dot(gm, gm)
+                    if count < capacity:
+                        pair_index[i, count] = j
+                        pair_grad[i, count] = gm
+                    count += 1
+                for kk in range(b_cell_start[cell], b_cell_end[cell]):
+                    b = b_order[kk]
+                    r = xi - bx[b]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    mw = prm.rest_density * b_volume[b]
+                    density += mw * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                    gm = mw * kernel_gradient(prm, r, r2)
+                    grad_sum += gm
+                    if count < capacity:
+                        pair_index[i, count] = wall_pair(b)
+                        pair_grad[i, count] = gm
+                    count += 1
+    if count > capacity:
+        wp.atomic_add(diag_i, row[0], DIAG_PAIR_OVERFLOW, 1)
+    pair_count[i] = wp.min(count, capacity)
+    density = density / prm.lattice_density
+    denominator = wp.max(wp.dot(grad_sum, grad_sum) + grad_sq, MIN_FACTOR_DENOMINATOR * prm.lattice_factor_denominator)
+    rho[i] = density
+    alpha[i] = density / denominator
+    increment[i] = warm
+    compression = wp.max(density - prm.rest_density, 0.0) / prm.rest_density
+    wp.atomic_max(diag_f, row[0], DIAG_MAX_DENSITY_ERROR, compression)
+    wp.atomic_max(diag_f, row[0], DIAG_MAX_COMPRESSION, compression)
+
+
+@wp.kernel
+def apply_stiffness(
+    # State in
+    rho: wp.array(dtype=float),
+    increment: wp.array(dtype=float),
+    active: wp.array(dtype=wp.int32),
+    dt: wp.array(dtype=float),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_grad: wp.array2d(dtype=wp.vec3),
+    # State in/out
+    v: wp.array(dtype=wp.vec3),
+    kappa: wp.array(dtype=float),
+):
+    """v_i -= dt [sum_j m (k_i/rho_i + k_j/rho_j) grad W_ij + sum_b rho0 V_b (k_i/rho_i) grad W_ib]; kappa_i += k_i.
+    The first iteration of a solve applies its warm start; once a solve has converged, the increments its last
+    iteration measured are not applied (the loop ends before this stage)."""
+    i = wp.tid()
+    if active[i] == 0:
+        return
+    ki = increment[i] / rho[i]
+    dv = wp.vec3(0.0)
+    for k in range(pair_count[i]):
+        j = pair_index[i, k]
+        kj = float(0.0)
+        if j >= 0:
+            kj = increment[j] / rho[j]
+        dv += (ki + kj) * pair_grad[i, k]
+    v[i] = v[i] - dt[0] * dv
+    kappa[i] = kappa[i] + increment[i]
+
+
+@wp.kernel
+def compute_solve_error(
+    # Model
+    prm: SPHParams,
+    mode: int,
+    # State in
+    v: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    alpha: wp.array(dtype=float),
+    active: wp.array(dtype=wp.int32),
+    dt: wp.array(dtype=float),
+    bv: wp.array(dtype=wp.vec3),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_grad: wp.array2d(dtype=wp.vec3),
+    # Out
+    increment: wp.array(dtype=float),
+    solve_stats: wp.array(dtype=wp.int64),
+):
+    """Each particle's remaining error e_i (``mode`` SOLVE_DIVERGENCE: dt Drho/Dt; SOLVE_DENSITY: rho_i - rho0 +
+    dt Drho/Dt; only compression: e_i >= 0), its next stiffness increment e_i alpha_i / dt^2 and the error sum."""
+    i = wp.tid()
+    if active[i] == 0:
+        increment[i] = 0.0
+        return
+    h = dt[0]
+    vi = v[i]
+    rate = float(0.0)
+    for k in range(pair_count[i]):
+        j = pair_index[i, k]
+        vj = wp.vec3(0.0)
+        if j >= 0:
+            vj = v[j]
+        else:
+            vj = bv[-1 - j]
+        rate += wp.dot(vi - vj, pair_grad[i, k])
+    e = h * rate
+    if mode == SOLVE_DENSITY:
+        e += rho[i] - prm.rest_density
+    e = wp.max(e, 0.0)
+    increment[i] = e * alpha[i] / (h * h)
+    rel = wp.min(e / prm.rest_density, MAX_PARTICLE_ERROR)
+    wp.atomic_add(solve_stats, STAT_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
+    wp.atomic_max(solve_stats, STAT_MAX_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
+
+
+@wp.kernel
+def check_convergence(
+    # Model
+    prm: SPHParams,
+    mode: int,
+    # State in
+    row: wp.array(dtype=wp.int32),
+    # State in/out
+    solve_stats: wp.array(dtype=wp.int64),
+    keep_going: wp.array(dtype=wp.int32),
+    diag_f: wp.array2d(dtype=float),
+    diag_i: wp.array2d(dtype=wp.int32),
+):
+    """One thread: average error of the iteration just measured, the stop decision, the solve's diagnostics."""
+    count = wp.max(solve_stats[STAT_COUNT], wp.int64(1))
+    error = float(solve_stats[STAT_ERROR]) * ERROR_QUANTUM / float(count)
+    worst = float(solve_stats[STAT_MAX_ERROR]) * ERROR_QUANTUM
+    solve_stats[STAT_ERROR] = wp.int64(0)
+    solve_stats[STAT_MAX_ERROR] = wp.int64(0)
+    iterations = solve_stats[STAT_ITERATIONS] + wp.int64(1)
+    solve_stats[STAT_ITERATIONS] = iterations
+    tolerance = prm.divergence_tolerance
+    err_col = DIAG_DIVERGENCE_ERROR
+    it_col = DIAG_DIVERGENCE_ITERATIONS
+    if mode == SOLVE_DENSITY:
+        tolerance = prm.density_tolerance
+        err_col = DIAG_DENSITY_SOLVE_ERROR
+        it_col = DIAG_DENSITY_ITERATIONS
+    unconverged = error > tolerance or worst > MAX_PARTICLE_RESIDUAL
+    keep_going[0] = wp.where(unconverged and iterations < wp.int64(prm.max_iterations), 1, 0)
+    s = row[0]
+    diag_f[s, err_col] = error
+    diag_i[s, it_col] = int(iterations)
+
+
+@wp.func
+def wall_pair_viscosity(prm: SPHParams, volume: float, r: wp.vec3, r2: float, v_rel: wp.vec3, rho_i: float) -> wp.vec3:
+    """Viscous acceleration of a particle from one wall particle (of rest density, ``volume``, relative velocity
+    ``v_rel`` against the wall's own): the same call in compute_nonpressure and compute_wall_reaction, so the
+    vessel receives exactly the opposite force."""
+    return viscous_pair(prm, prm.rest_density * volume, r, r2, kernel_gradient(prm, r, r2), v_rel, v_rel, rho_i, prm.rest_density)
+
+
+@wp.kernel
+def compute_nonpressure(
+    # Model
+    prm: SPHParams,
+    g: GridSpec,
+    b_volume: wp.array(dtype=float),
+    # State in
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    active: wp.array(dtype=wp.int32),
+    dt: wp.array(dtype=float),
+    cell_start: wp.array(dtype=wp.int32),
+    cell_end: wp.array(dtype=wp.int32),
+    bx: wp.array(dtype=wp.vec3),
+    bv: wp.array(dtype=wp.vec3),
+    b_order: wp.array(dtype=wp.int32),
+    b_cell_start: wp.array(dtype=wp.int32),
+    b_cell_end: wp.array(dtype=wp.int32),
+    row: wp.array(dtype=wp.int32),
+    # State in/out
+    kappa_density: wp.array(dtype=float),
+    # Out
+    v_star: wp.array(dtype=wp.vec3),
+    increment: wp.array(dtype=float),
+    solve_stats: wp.array(dtype=wp.int64),
+    keep_going: wp.array(dtype=wp.int32),
+    diag_f: wp.array2d(dtype=float),
+):
+    """v* = v + dt (g + viscosity) (walls: their own velocity, rest density; :func:`wall_pair_viscosity`); the
+    density solve's warm start and counters."""
+    i = wp.tid()
+    if i == 0:
+        solve_stats[STAT_ITERATIONS] = wp.int64(0)
+        keep_going[0] = 1
+    warm = WARM_START_DENSITY * kappa_density[i]
+    kappa_density[i] = 0.0
+    if active[i] == 0:
+        v_star[i] = v[i]
+        increment[i] = 0.0
+        return
+    xi = x[i]
+    vi = v[i]
+    rhoi = rho[i]
+    support2 = prm.support * prm.support
+    a = wp.vec3(0.0)
+    c = grid_cell(g, xi)
+    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
+        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
+            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
+                cell = grid_index(g, cx, cy, cz)
+                for j in range(cell_start[cell], cell_end[cell]):
+                    r = xi - x[j]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    vij = vi - v[j]
+                    a += viscous_pair(prm, prm.mass, r, r2, kernel_gradient(prm, r, r2), vij, vij, rhoi, rho[j])
+                for kk in range(b_cell_start[cell], b_cell_end[cell]):
+                    b = b_order[kk]
+                    r = xi - bx[b]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    a += wall_pair_viscosity(prm, b_volume[b], r, r2, vi - bv[b], rhoi)
+    a += prm.gravity
+    v_star[i] = vi + dt[0] * a
+    increment[i] = warm
+    wp.atomic_max(diag_f, row[0], DIAG_MAX_ACCEL, wp.length(a))
+
+
+@wp.kernel
+def compute_wall_reaction(
+    # Model
+    prm: SPHParams,
+    g: GridSpec,
+    vessels: wp.array(dtype=VesselGeometry),
+    b_volume: wp.array(dtype=float),
+    b_vessel: wp.array(dtype=wp.int32),
+    # State in
+    motions: wp.array(dtype=VesselMotion),
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    kappa_density: wp.array(dtype=float),
+    kappa_divergence: wp.array(dtype=float),
+    active: wp.array(dtype=wp.int32),
+    bx: wp.array(dtype=wp.vec3),
+    bv: wp.array(dtype=wp.vec3),
+    b_order: wp.array(dtype=wp.int32),
+    b_cell_start: wp.array(dtype=wp.int32),
+    b_cell_end: wp.array(dtype=wp.int32),
+    substep_weight: wp.array(dtype=float),
+    # Out
+    wall_force: wp.array2d(dtype=wp.vec3),
+    wall_torque: wp.array2d(dtype=wp.vec3),
+    # State in/out
+    p: wp.array(dtype=float),
+):
+    """The force each particle exerted on each vessel this substep, the opposite of what its wall neighbours gave
+    it: per wall particle the pressure m (kappa_i / rho_i) rho0 V_b grad W_ib over both solves (kappa_i enters
+    linearly, so the sum over the iterations is exact) and the viscous term with the velocity the non-pressure
+    stage saw (``v``, before the density solve), and its moment about the vessel's centre of mass. Also adds this
+    substep's share (``substep_weight`` = 1 / substeps of the interval) of the reported pressure p_i = rho_i kappa_i
+    (Pa): the pressure is the interval's average, as the wrenches are (one substep's stiffness is the multiplier of
+    that substep's residual, noisy from substep to substep)."""
+    i = wp.tid()
+    for k in range(prm.n_vessels):
+        wall_force[k, i] = wp.vec3(0.0)
+        wall_torque[k, i] = wp.vec3(0.0)
+    if active[i] == 0:
+        return
+    kappa = kappa_density[i] + kappa_divergence[i]
+    rhoi = rho[i]
+    p[i] = p[i] + substep_weight[0] * rhoi * kappa
+    xi = x[i]
+    vi = v[i]
+    ki = kappa / rhoi
+    support2 = prm.support * prm.support
+    c = grid_cell(g, xi)
+    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
+        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
+            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
+                cell = grid_index(g, cx, cy, cz)
+                for kk in range(b_cell_start[cell], b_cell_end[cell]):
+                    b = b_order[kk]
+                    xb = bx[b]
+                    r = xi - xb
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    ab = wall_pair_viscosity(prm, b_volume[b], r, r2, vi - bv[b], rhoi)
+                    ab -= (prm.rest_density * b_volume[b] * ki) * kernel_gradient(prm, r, r2)
+                    kv = b_vessel[b]
+                    m = motions[kv]
+                    com = m.p_now + m.r_now @ vessels[kv].com
+                    f_vessel = -prm.mass_out * ab
+                    wall_force[kv, i] = wall_force[kv, i] + f_vessel
+                    wall_torque[kv, i] = wall_torque[kv, i] + wp.cross(xb - com, f_vessel)
+
+
+@wp.kernel
+def integrate(
+    # Model
+    prm: SPHParams,
+    vessels: wp.array(dtype=VesselGeometry),
+    domain_min: wp.vec3,
+    domain_max: wp.vec3,
+    guard_margin: float,
+    max_penetration: float,
+    # State in
+    motions: wp.array(dtype=VesselMotion),
+    dt: wp.array(dtype=float),
+    row: wp.array(dtype=wp.int32),
+    v_star: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    # State in/out
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    active: wp.array(dtype=wp.int32),
+    # Out
+    diag_f: wp.array2d(dtype=float),
+    diag_i: wp.array2d(dtype=wp.int32),
+):
+    """x += dt v* (the velocity both solves corrected), then the shared guard, deactivation and diagnostics."""
+    i = wp.tid()
+    if active[i] == 0:
+        return
+    x_old = x[i]
+    vi = v_star[i]
+    finish_particle(
+        prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, row[0], i, x_old, x_old + dt[0] * vi, vi, rho[i],
+        x, v, active, diag_f, diag_i,
+    )

@@ -1,0 +1,190 @@
+"""Warp functions and kernels both pressure solvers share: the pair kernel gradient, the viscous pair terms, the
+end of a particle's substep (wall guard, deactivation outside the domain, the substep's common diagnostics), the
+reorder of the particle state into cell order and the fixed-order reduction of the wall wrenches."""
+
+from __future__ import annotations
+
+import warp as wp
+
+from cosim.fluid.boundary import VesselGeometry, VesselMotion, guard_vessel, inside_vessel
+from cosim.fluid.diagnostics import (
+    DIAG_ACTIVE,
+    DIAG_BREACHES,
+    DIAG_CORRECTIONS,
+    DIAG_INSIDE0,
+    DIAG_KINETIC_ENERGY,
+    DIAG_MAX_SPEED,
+    DIAG_NONFINITE,
+)
+from cosim.fluid.params import SPHParams
+from cosim.fluid.sph_kernels import kernel_dw
+
+
+@wp.func
+def kernel_gradient(prm: SPHParams, r: wp.vec3, r2: float) -> wp.vec3:
+    """grad_i W(x_i - x_j) for r = x_i - x_j, |r|^2 = r2 > 0 (1/m^(dim+1))."""
+    rl = wp.sqrt(r2)
+    return r * (kernel_dw(rl, prm.inv_h, prm.sigma, prm.kernel) / rl)
+
+
+@wp.func
+def viscous_pair(
+    prm: SPHParams, mass_j: float, r: wp.vec3, r2: float, gw: wp.vec3, v_rel: wp.vec3, v_rel_laminar: wp.vec3, rho_i: float, rho_j: float
+) -> wp.vec3:
+    """Acceleration (m/s^2) of particle i from neighbour j of mass ``mass_j``: Monaghan (1992) artificial viscosity
+    on the approaching relative velocity ``v_rel`` = v_i - v_j (scaled by the configured c0) plus Morris et al.
+    (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the neighbour's, or a wall's no-slip, velocity)."""
+    a = wp.vec3(0.0)
+    vr = wp.dot(v_rel, r)
+    if vr < 0.0:
+        mu = prm.h * vr / (r2 + prm.eta2)
+        a += (mass_j * prm.alpha * prm.sound_speed * mu / (0.5 * (rho_i + rho_j))) * gw
+    a += (mass_j * prm.nu * (1.0 / rho_i + 1.0 / rho_j) * wp.dot(r, gw) / (r2 + prm.eta2)) * v_rel_laminar
+    return a
+
+
+@wp.func
+def finish_particle(
+    prm: SPHParams,
+    vessels: wp.array(dtype=VesselGeometry),
+    motions: wp.array(dtype=VesselMotion),
+    domain_min: wp.vec3,
+    domain_max: wp.vec3,
+    guard_margin: float,
+    max_penetration: float,
+    s: int,
+    i: int,
+    x_old: wp.vec3,
+    x_new: wp.vec3,
+    v_new: wp.vec3,
+    rho_new: float,
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    active: wp.array(dtype=wp.int32),
+    diag_f: wp.array2d(dtype=float),
+    diag_i: wp.array2d(dtype=wp.int32),
+) -> int:
+    """Store the particle's new position and velocity after the non-penetration guard of every vessel; deactivate
+    it if non-finite or outside the domain. Records wall corrections/breaches, per-vessel contents, speed, kinetic
+    energy and the active count in row ``s``. Returns 1 if the particle is still active (the caller then stores
+    its density and pressure), else 0."""
+    xi = x_new
+    vi = v_new
+    if prm.dim == 2:
+        vi[1] = 0.0
+        xi[1] = 0.0
+    for k in range(prm.n_vessels):
+        m = motions[k]
+        geo = vessels[k]
+        q_old = wp.transpose(m.r_now) @ (x_old - m.p_now)
+        q_new = wp.transpose(m.r_next) @ (xi - m.p_next)
+        q, normal, depth, hits = guard_vessel(q_old, q_new, geo, prm.dim, guard_margin)
+        if hits > 0:
+            xi = m.p_next + m.r_next @ q
+            n_world = m.r_next @ normal
+            v_wall = m.lin_vel + wp.cross(m.ang_vel, xi - m.p_next)
+            vn = wp.dot(vi - v_wall, n_world)
+            if vn < 0.0:
+                vi = vi - vn * n_world
+            wp.atomic_add(diag_i, s, DIAG_CORRECTIONS, 1)
+            if depth > max_penetration:
+                wp.atomic_add(diag_i, s, DIAG_BREACHES, 1)
+        if inside_vessel(q, geo, prm.dim) != 0:
+            wp.atomic_add(diag_i, s, DIAG_INSIDE0 + k, 1)
+    if not (wp.isfinite(xi) and wp.isfinite(vi) and wp.isfinite(rho_new)):
+        wp.atomic_add(diag_i, s, DIAG_NONFINITE, 1)
+        active[i] = 0
+        return 0
+    outside = False
+    for a in range(3):
+        if xi[a] < domain_min[a] or xi[a] > domain_max[a]:
+            outside = True
+    if outside:
+        active[i] = 0
+        x[i] = xi
+        v[i] = wp.vec3(0.0)
+        return 0
+    x[i] = xi
+    v[i] = vi
+    speed = wp.length(vi)
+    wp.atomic_add(diag_i, s, DIAG_ACTIVE, 1)
+    wp.atomic_max(diag_f, s, DIAG_MAX_SPEED, speed)
+    wp.atomic_add(diag_f, s, DIAG_KINETIC_ENERGY, 0.5 * prm.mass_out * speed * speed)
+    return 1
+
+
+@wp.kernel
+def gather_particles(
+    order: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    p: wp.array(dtype=float),
+    active: wp.array(dtype=wp.int32),
+    pid: wp.array(dtype=wp.int32),
+    kappa_density: wp.array(dtype=float),
+    kappa_divergence: wp.array(dtype=float),
+    x_out: wp.array(dtype=wp.vec3),
+    v_out: wp.array(dtype=wp.vec3),
+    rho_out: wp.array(dtype=float),
+    p_out: wp.array(dtype=float),
+    active_out: wp.array(dtype=wp.int32),
+    pid_out: wp.array(dtype=wp.int32),
+    kappa_density_out: wp.array(dtype=float),
+    kappa_divergence_out: wp.array(dtype=float),
+):
+    """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
+    i = wp.tid()
+    src = order[i]
+    x_out[i] = x[src]
+    v_out[i] = v[src]
+    rho_out[i] = rho[src]
+    p_out[i] = p[src]
+    active_out[i] = active[src]
+    pid_out[i] = pid[src]
+    kappa_density_out[i] = kappa_density[src]
+    kappa_divergence_out[i] = kappa_divergence[src]
+
+
+@wp.kernel
+def sum_wall_wrench_chunks(
+    n: int,
+    chunk: int,
+    wall_force: wp.array2d(dtype=wp.vec3),
+    wall_torque: wp.array2d(dtype=wp.vec3),
+    partial_force: wp.array2d(dtype=wp.vec3),
+    partial_torque: wp.array2d(dtype=wp.vec3),
+):
+    """First level of the fixed-order reduction: chunk c of vessel k summed sequentially."""
+    k, c = wp.tid()
+    f = wp.vec3(0.0)
+    t = wp.vec3(0.0)
+    for i in range(c * chunk, wp.min((c + 1) * chunk, n)):
+        f += wall_force[k, i]
+        t += wall_torque[k, i]
+    partial_force[k, c] = f
+    partial_torque[k, c] = t
+
+
+@wp.kernel
+def accumulate_wall_wrench(
+    n_chunks: int,
+    partial_force: wp.array2d(dtype=wp.vec3),
+    partial_torque: wp.array2d(dtype=wp.vec3),
+    force_sum: wp.array(dtype=wp.vec3),
+    torque_sum: wp.array(dtype=wp.vec3),
+):
+    """Second level: the chunks of vessel k in order, added to the interval's running sum."""
+    k = wp.tid()
+    f = wp.vec3(0.0)
+    t = wp.vec3(0.0)
+    for c in range(n_chunks):
+        f += partial_force[k, c]
+        t += partial_torque[k, c]
+    force_sum[k] = force_sum[k] + f
+    torque_sum[k] = torque_sum[k] + t
+
+
+@wp.kernel
+def next_substep(row: wp.array(dtype=wp.int32)):
+    row[0] = row[0] + 1

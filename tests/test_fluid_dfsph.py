@@ -1,0 +1,91 @@
+"""DFSPH (divergence-free SPH): a resting column stays at rest and weighs what it should, moving vessels do not
+leak, runs are deterministic, and the time step follows the flow instead of the artificial sound speed."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
+from cosim.fluid.seeding import fill_vessel
+from cosim.fluid.solver import FluidSolver
+from cosim.frames import Pose, rotation_y
+from cosim.pour_scene import FluidSettings
+from cosim.validation import hydrostatic, moving_vessel
+from cosim.vessel import VesselSpec
+
+B = 0.191  # m, the seed's vessel width
+FILL = 0.1  # m
+# A resting column must stay at rest: after REST_SETTLE of simulated time its fastest particle moves slower than this
+# fraction of the shallow-water wave speed sqrt(g H) (the scale of any sloshing the start-up could excite). DFSPH
+# measured 7.0 % at 12 particles across after 1 s: residual motion of its iterative pressure (the solves stop at a
+# tolerance and only correct compression; see the warm starts in cosim.fluid.dfsph); WCSPH 0.45 %. The bound is
+# what DFSPH is held to (a standing residual slosh of a few mm), not WCSPH's level.
+REST_SPEED_FRACTION = 0.1
+REST_SETTLE = 1.0  # s
+
+
+def _tank(solver=PressureSolver.DFSPH, across=12):
+    tank = VesselSpec(name="tank", inner_width=B, inner_height=0.2)
+    cfg = FluidConfig(
+        dim=2, spacing=B / across, pressure_solver=solver, max_expected_speed=2 * math.sqrt(GRAVITY * FILL),
+        domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.35),
+    )
+    return FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, FILL, cfg)), cfg
+
+
+def test_resting_column_stays_at_rest_and_weighs_its_weight():
+    fluid, cfg = _tank()
+    while fluid.time < REST_SETTLE - 1e-9:
+        fluid.advance(0.02)
+    speed = np.linalg.norm(fluid.velocities(), axis=1).max()
+    assert speed <= REST_SPEED_FRACTION * math.sqrt(GRAVITY * FILL)
+    weight = fluid.n_particles * cfg.particle_volume * cfg.rest_density * GRAVITY
+    assert -fluid.vessel_wrenches()[0, 2] == pytest.approx(weight, rel=hydrostatic.WEIGHT_TOLERANCE)
+    assert fluid.last_report.last.active == fluid.n_particles
+    assert fluid.last_report.last.volume_in_vessel[0] == pytest.approx(fluid.n_particles * cfg.particle_volume)
+    hist = fluid.history()
+    assert hist["density_iterations"].min() >= 1 and hist["density_iterations"].max() <= cfg.max_solver_iterations
+    assert hist["density_solve_error"][-1] <= cfg.density_tolerance or hist["density_iterations"][-1] == cfg.max_solver_iterations
+
+
+def test_time_step_follows_the_flow_not_the_sound_speed():
+    fluid, cfg = _tank()
+    wcsph, _ = _tank(PressureSolver.WCSPH)
+    for f in (fluid, wcsph):
+        f.advance(0.02)
+        f.advance(0.02)
+    acoustic = cfg.cfl * cfg.smoothing_length / cfg.sound_speed
+    assert wcsph.last_report.dt <= acoustic
+    # bounded by the expected flow speed instead of c0 = sound_speed_factor x that speed: about that factor longer
+    assert fluid.last_report.dt >= 0.5 * cfg.sound_speed_factor * acoustic
+
+
+@pytest.mark.parametrize("case", ["tilt", "shake"])
+def test_moving_vessel_never_leaks(case):
+    p = moving_vessel.Params(particles_across=16, rate=60.0, periods=2.0, solver="dfsph")
+    r = (moving_vessel.run_tilt if case == "tilt" else moving_vessel.run_shake)(p)
+    assert r.raw["failure"] == ""
+    assert r.metrics[1].measured == 0, "particles inside a wall"
+    assert r.metrics[2].measured == 0, "particles through a wall"
+    if case == "tilt":  # tilted to 90 degrees about the lip, most of the liquid has poured out
+        assert r.raw["volume_left_in_vessel"] < 0.5 * r.raw["initial_volume"]
+
+
+def test_runs_are_deterministic():
+    a, _ = _tank()
+    b, _ = _tank()
+    for f in (a, b):
+        f.set_vessel_poses([Pose((0.0, 0.0, 0.0), rotation_y(0.05))])
+        for _ in range(5):
+            f.advance(0.004)
+    assert np.array_equal(a.positions(), b.positions())
+    assert np.array_equal(a.vessel_wrenches(), b.vessel_wrenches())
+    assert np.array_equal(a.history()["density_iterations"], b.history()["density_iterations"])
+
+
+def test_scene_selects_the_solver():
+    assert FluidSettings(pressure_solver="dfsph").fluid_config(B).pressure_solver is PressureSolver.DFSPH
+    assert FluidSettings().fluid_config(B).pressure_solver is PressureSolver.WCSPH
