@@ -21,6 +21,7 @@ SUBCOMMAND_MODULES: list[str] = [
     "cosim.cli.pour",
     "cosim.cli.scene",
     "cosim.cli.validate",
+    "cosim.cli.bench",
     "cosim.cli.stress",
     "cosim.cli.replay",
     "cosim.cli.view",

@@ -189,7 +189,9 @@ class CoupledPour:
     def finished(self) -> bool:
         if self.time >= self.settings.max_duration - 1e-12:
             return True
-        return self.done_at is not None and self.time >= self.done_at + self.settings.settle_time - 1e-12
+        if not self.settings.stop_when_done or self.done_at is None:
+            return False
+        return self.time >= self.done_at + self.settings.settle_time - 1e-12
 
     def run(self, on_step: Callable[["CoupledPour"], None] | None = None) -> dict:
         while not self.finished:

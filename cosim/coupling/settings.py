@@ -22,6 +22,7 @@ class CouplingSettings:
         wrist force-torque sensor compensating its payload would; only with two-way coupling.
     start_delay: s, the controller idles this long (catcher pre-positioning) before the pour starts. [0, 10]
     settle_time: s simulated after the controller reports the pour done (the last liquid lands). [0, 10]
+    stop_when_done: end the run settle_time after the pour is done (False: always run to max_duration).
     max_duration: s, the run stops here even if the pour is not done. (0, 600]
     """
 
@@ -29,6 +30,7 @@ class CouplingSettings:
     wrench_feedforward: bool = True
     start_delay: float = 0.2
     settle_time: float = 1.0
+    stop_when_done: bool = True
     max_duration: float = 120.0
 
     def __post_init__(self) -> None:

@@ -12,6 +12,9 @@ from cosim.checks import check_choice, check_device, check_int, check_positive
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
 
+# FluidConfig fields a case's numerics may override (the rest is the case's geometry, physics and solver).
+NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor")
+
 
 @dataclass(frozen=True)
 class Metric:
@@ -58,6 +61,8 @@ class FluidCaseParams:
     spacing: m, particle spacing (None: the case's default resolution). dim: 2 or 3. device: 'cpu' or 'cuda[:N]'.
     depth: m, tank depth perpendicular to the pour plane (3-D extent; 2-D out-of-plane scale).
     solver: pressure solver, :class:`PressureSolver` or its name ('wcsph', 'dfsph').
+    numerics: overrides of the solver's numerical settings, (FluidConfig field, value) pairs, e.g.
+        (("kernel", "cubic_spline"), ("cfl", 0.4)); one of NUMERICS_FIELDS each (the benchmark's axes).
     """
 
     spacing: float | None = None
@@ -65,6 +70,7 @@ class FluidCaseParams:
     device: str = "cpu"
     depth: float = 0.1
     solver: PressureSolver = PressureSolver.WCSPH
+    numerics: tuple[tuple[str, Any], ...] = ()
 
     def validate_common(self) -> None:
         if self.spacing is not None:
@@ -73,6 +79,10 @@ class FluidCaseParams:
         check_device("device", self.device)
         check_positive("depth", self.depth, "m", 2.0)
         object.__setattr__(self, "solver", check_choice("solver", self.solver, PressureSolver))
+        for name, _ in self.numerics:
+            if name not in NUMERICS_FIELDS:
+                raise InputError(f"numerics: {name!r} cannot be overridden; choose from {', '.join(NUMERICS_FIELDS)}")
+        FluidConfig(**dict(self.numerics))  # the values' own range checks, before anything runs
 
 
 def reference_speed(liquid_height: float) -> float:
@@ -83,9 +93,11 @@ def reference_speed(liquid_height: float) -> float:
 
 
 def case_fluid_config(
-    dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max, solver: PressureSolver = PressureSolver.WCSPH
+    dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max, solver: PressureSolver = PressureSolver.WCSPH,
+    numerics=(),
 ) -> FluidConfig:
-    """The fluid configuration every case uses: project defaults, c0 from :func:`reference_speed`."""
+    """The fluid configuration every case uses: project defaults (or ``numerics``, see :class:`FluidCaseParams`),
+    c0 from :func:`reference_speed`."""
     return FluidConfig(
         dim=dim,
         pressure_solver=solver,
@@ -94,6 +106,7 @@ def case_fluid_config(
         depth_2d=depth,
         domain_min=tuple(domain_min),
         domain_max=tuple(domain_max),
+        **dict(numerics),
     )
 
 

@@ -86,7 +86,7 @@ def run(p: Params) -> CaseResult:
     scene = RobotScene.load()
     pourer = scene.arms[ArmRole.POUR].vessel
     spacing = p.spacing if p.spacing is not None else pourer.inner_width / PARTICLES_ACROSS
-    cfg = pour_fluid_config(scene, FluidConfig(dim=p.dim, spacing=spacing, pressure_solver=p.solver), p.fill)
+    cfg = pour_fluid_config(scene, FluidConfig(dim=p.dim, spacing=spacing, pressure_solver=p.solver, **dict(p.numerics)), p.fill)
     poses = vessel_poses(scene)
     fluid = FluidSolver(cfg, [scene.arms[r].vessel for r in ROLES], poses, fill_vessel(pourer, p.fill, cfg, poses[0]), device=p.device)
     settings = CouplingSettings()

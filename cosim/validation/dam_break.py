@@ -88,6 +88,7 @@ def run(p: Params) -> CaseResult:
         p.dim, dx, p.height, p.depth,
         (wall - margin, -0.5 * p.depth - margin, -margin), (-wall + margin, 0.5 * p.depth + margin, tank.inner_height + margin),
         p.solver,
+        numerics=p.numerics,
     )
     column = liquid_block((wall, -0.5 * p.depth, 0.0), (wall + a, 0.5 * p.depth, p.height), cfg)
     solver = FluidSolver(cfg, [tank], [Pose()], column, device=p.device)

@@ -69,7 +69,8 @@ def run(p: Params) -> CaseResult:
     margin = 0.05 * p.width + 10 * dx
     half = 0.5 * p.width + margin
     cfg = case_fluid_config(
-        p.dim, dx, p.fill, p.depth, (-half, -0.5 * p.depth - margin, -margin), (half, 0.5 * p.depth + margin, tank.inner_height + margin), p.solver
+        p.dim, dx, p.fill, p.depth, (-half, -0.5 * p.depth - margin, -margin), (half, 0.5 * p.depth + margin, tank.inner_height + margin), p.solver,
+        numerics=p.numerics,
     )
     solver = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, p.fill, cfg), device=p.device)
     start = time.perf_counter()

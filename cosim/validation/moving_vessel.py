@@ -64,7 +64,8 @@ class Params(FluidCaseParams):
 def _run(name: str, p: Params, pose_at: PoseScript) -> CaseResult:
     spec = p.spec()
     dx = p.resolved_spacing
-    cfg = case_fluid_config(p.dim, dx, max(p.fill, FALL_HEIGHT), spec.section_depth, *domain_around(spec, p.amplitude), p.solver)
+    cfg = case_fluid_config(p.dim, dx, max(p.fill, FALL_HEIGHT), spec.section_depth, *domain_around(spec, p.amplitude), p.solver,
+                            numerics=p.numerics)
     run = run_scripted(spec, p.fill, cfg, pose_at, p.duration_for(name), device=p.device)
     solver, leaks, failure = run.solver, run.leaks, run.failure
     hist = solver.history()

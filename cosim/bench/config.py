@@ -1,0 +1,91 @@
+"""One benchmark configuration: which case, at which resolution and numerics, on which device (frozen, validated).
+
+A configuration is a pure value: its :meth:`BenchConfig.key` (with the code version) names its cached result.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass
+from enum import Enum
+
+from cosim.checks import check_choice, check_device, check_int, check_positive, check_range
+from cosim.errors import InputError
+from cosim.fluid.config import KernelType, PressureSolver
+
+
+class BenchCase(Enum):
+    """What a configuration runs."""
+
+    HYDROSTATIC = "hydrostatic"  # cosim.validation.hydrostatic: pressure against rho0 g (H - z)
+    SLOSH = "slosh"  # cosim.validation.slosh: first-mode frequency against the seed's Eq. 17
+    DAM_BREAK = "dam-break"  # cosim.validation.dam_break: surge front against Martin & Moyce (1952)
+    COUPLING_STATIC = "coupling-static"  # cosim.validation.coupling_static: reaction against the liquid's weight
+    POUR = "pour"  # the pour scene, compared with another pour run (a finer reference, or the same without a skip)
+
+
+OptionValue = str | bool | int | float
+
+
+@dataclass(frozen=True)
+class BenchConfig:
+    """case: :class:`BenchCase`.
+    dim: 2 or 3.
+    particles_across: resolution, particles across the case's width (tank width B for hydrostatic and slosh,
+        column width a for the dam break, the pourer's inner width for coupling-static and the pour). [8, 400]
+    kernel: :class:`cosim.fluid.config.KernelType`.
+    cfl: Courant number. (0, 0.6]
+    pressure_solver: :class:`cosim.fluid.config.PressureSolver`.
+    device: 'cpu' or 'cuda[:N]'.
+    length: how long the case runs, in the case's own unit: hydrostatic s held, slosh periods after the pulse,
+        dam-break dimensionless time T = t sqrt(2 g / a), coupling-static s held, pour s simulated
+        (coupling.max_duration). (0, 600]
+    options: pour scene options as (dotted scene key, value) pairs, e.g. (("coupling.coupling", "one_way"),),
+        sorted by key; only for the pour.
+    """
+
+    case: BenchCase
+    particles_across: int
+    length: float
+    dim: int = 2
+    kernel: KernelType = KernelType.WENDLAND_C2
+    cfl: float = 0.25
+    pressure_solver: PressureSolver = PressureSolver.WCSPH
+    device: str = "cpu"
+    options: tuple[tuple[str, OptionValue], ...] = ()
+
+    def __post_init__(self) -> None:
+        s = object.__setattr__
+        s(self, "case", check_choice("case", self.case, BenchCase))
+        check_int("particles_across", self.particles_across, 8, 400)
+        check_positive("length", self.length, "", 600.0)
+        check_int("dim", self.dim, 2, 3)
+        s(self, "kernel", check_choice("kernel", self.kernel, KernelType))
+        check_range("cfl", self.cfl, 0.0, 0.6, lo_open=True)
+        s(self, "pressure_solver", check_choice("pressure_solver", self.pressure_solver, PressureSolver))
+        check_device("device", self.device)
+        if self.options and self.case is not BenchCase.POUR:
+            raise InputError(f"options: scene options apply to the pour only, not to {self.case.value}")
+        s(self, "options", tuple(sorted((str(k), v) for k, v in self.options)))
+
+    def to_json(self) -> dict:
+        """Plain JSON values (enums by value)."""
+        return {
+            "case": self.case.value, "particles_across": self.particles_across, "length": self.length, "dim": self.dim,
+            "kernel": self.kernel.value, "cfl": self.cfl, "pressure_solver": self.pressure_solver.value,
+            "device": self.device, "options": [list(o) for o in self.options],
+        }
+
+    def key(self, code_version: str) -> str:
+        """Cache key: a hash of every parameter and of ``code_version`` (see :func:`cosim.bench.cache.code_version`)."""
+        text = json.dumps({"config": self.to_json(), "code": code_version}, sort_keys=True)
+        return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+    @property
+    def label(self) -> str:
+        """Short human name, e.g. 'pour 2-D 32 wendland_c2 cfl0.25 wcsph cpu one_way'."""
+        parts = [self.case.value, f"{self.dim}-D", str(self.particles_across), self.kernel.value, f"cfl{self.cfl:g}",
+                 self.pressure_solver.value, self.device]
+        parts += [f"{k.rsplit('.', 1)[-1]}={v}" for k, v in self.options]
+        return " ".join(parts)

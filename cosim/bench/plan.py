@@ -1,0 +1,143 @@
+"""Which configurations the benchmark runs: axes around the default scene's settings, not hand-written rows.
+
+Per case: a resolution sweep at the default numerics, then one axis at a time at the case's default resolution
+(the pour: at 24 across) (every other kernel, the CFL levels, every other pressure solver); on every device
+present. The pour adds a
+fine reference (:data:`REFERENCE_ACROSS`) that its resolution and numerics rows are compared with, and the skip
+options: pairs of runs that differ only in what a scene may skip, the second doing the full work.
+
+Cost: the full plan is sized to finish cold in about half an hour on a 2-core CPU; the pour runs
+:data:`POUR_SECONDS` of simulated time (the first slosh-induced outflow and about two thirds of the liquid), not
+the whole ~10 s pour.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from cosim.bench.config import BenchCase, BenchConfig
+from cosim.fluid.config import KernelType, PressureSolver
+from cosim.fluid.runtime import cuda_available
+from cosim.pour_scene import FluidSettings
+
+POUR_SECONDS = 3.0  # s simulated per pour row
+REFERENCE_ACROSS = 48  # particles across the pourer of the reference pour (1.5 x the default scene's 32)
+CFL_LEVELS = (0.15, 0.4)  # besides the default 0.25 (the stress matrix goes to twice the default)
+# s, max_duration of the early-stop pair at 24 across (the pour is done after about 10 s; the run without the early
+# stop goes on to this; the default scene's 60 s would cost 5 x more)
+FULL_POUR_SECONDS = 14.0
+DIM_PAIR_SECONDS = 2.0  # s simulated by the 2-D/3-D pair at 16 across (3-D costs about 30 x 2-D there)
+
+
+@dataclass(frozen=True)
+class CaseAxes:
+    """resolutions: particles across, coarse to the case default (the last). length: the case's run length
+    (see :class:`BenchConfig`). cfl_levels: the CFL numbers tried besides the default. axes_at: the resolution of
+    the one-axis-at-a-time rows (None: the case default)."""
+
+    resolutions: tuple[int, ...]
+    length: float
+    cfl_levels: tuple[float, ...] = CFL_LEVELS
+    axes_at: int | None = None
+
+
+# Resolution sweeps end at each case's own default resolution (cosim.validation: 40 across the tank, 50 across
+# the dam-break column, 24 across the pourer for coupling-static; the default scene: 32 across the pourer).
+FULL_AXES = {
+    BenchCase.HYDROSTATIC: CaseAxes((20, 30, 40), 1.0),  # s held (the validation holds 2 s)
+    BenchCase.SLOSH: CaseAxes((20, 30, 40), 3.0),  # periods (the validation measures 5), fill A = 0.108 m
+    BenchCase.DAM_BREAK: CaseAxes((25, 50), 3.0),  # T up to the acceptance window's end
+    BenchCase.COUPLING_STATIC: CaseAxes((16, 24), 0.5),  # s held
+    # the pour varies kernel, CFL and solver at 24 across (32 costs about 2.8 x more) and leaves out CFL 0.15 (1.7 x
+    # the cost), to keep the plan within its budget
+    BenchCase.POUR: CaseAxes((16, 24, 32), POUR_SECONDS, cfl_levels=(0.4,), axes_at=24),
+}
+SMOKE_AXES = {  # seconds of CPU: for tests and a quick check of the machinery, not for numbers
+    BenchCase.HYDROSTATIC: CaseAxes((8,), 0.02),
+    BenchCase.DAM_BREAK: CaseAxes((8,), 1.0),
+}
+
+
+@dataclass(frozen=True)
+class SkipOption:
+    """A scene option that skips work: ``skip`` runs with it, ``full`` without (everything else equal)."""
+
+    name: str
+    setting: str
+    skip: BenchConfig
+    full: BenchConfig
+
+
+@dataclass(frozen=True)
+class BenchPlan:
+    """rows: every configuration to run, in order, without duplicates. defaults: per case, the configuration with
+    the default scene's settings. reference: the fine pour the pour rows are compared with (None without pours).
+    skips: the skip-option pairs."""
+
+    rows: tuple[BenchConfig, ...]
+    defaults: dict[BenchCase, BenchConfig]
+    reference: BenchConfig | None = None
+    skips: tuple[SkipOption, ...] = ()
+
+    def compared_pours(self) -> list[BenchConfig]:
+        """Pour rows compared with the reference: every other pour row of the same length."""
+        ref = self.reference
+        return [c for c in self.rows if ref is not None and c.case is BenchCase.POUR and c.length == ref.length and c != ref]
+
+
+def default_numerics(device: str = "cpu") -> dict:
+    """The default scene's numerical settings (pour_scene.FluidSettings, the solver's default pressure solver)."""
+    scene = FluidSettings()
+    return {"dim": scene.dim, "kernel": scene.kernel, "cfl": scene.cfl, "pressure_solver": scene.pressure_solver,
+            "device": device}
+
+
+def _axis_rows(case: BenchCase, axes: CaseAxes, device: str) -> list[BenchConfig]:
+    base = BenchConfig(case, axes.axes_at or axes.resolutions[-1], axes.length, **default_numerics(device))
+    rows = [replace(base, particles_across=n) for n in axes.resolutions]
+    rows += [replace(base, kernel=k) for k in KernelType if k is not base.kernel]
+    rows += [replace(base, cfl=c) for c in axes.cfl_levels if c != base.cfl]
+    rows += [replace(base, pressure_solver=s) for s in PressureSolver if s is not base.pressure_solver]
+    return rows
+
+
+def _skip_options(device: str) -> list[SkipOption]:
+    d = default_numerics(device)
+    at = {n: BenchConfig(BenchCase.POUR, n, POUR_SECONDS, **d) for n in (16, 24)}
+
+    def opt(cfg: BenchConfig, key: str, value) -> BenchConfig:
+        return replace(cfg, options=cfg.options + ((key, value),))
+
+    flat = replace(at[16], length=DIM_PAIR_SECONDS)
+    full_stop = replace(at[24], length=FULL_POUR_SECONDS)
+    return [
+        SkipOption("2-D liquid in the pour plane", "fluid.dim = 2 (full: 3)", flat, replace(flat, dim=3)),
+        SkipOption("SIM only when the fill needs it", "controller.sim.mode = auto (full: always)", at[24],
+                   opt(at[24], "controller.sim.mode", "always")),
+        SkipOption("one-way coupling", "coupling.coupling = one_way (full: two_way)",
+                   opt(at[24], "coupling.coupling", "one_way"), at[24]),
+        SkipOption("logging off", "logging.enabled = false (full: true, every particle at 30 Hz)", at[24],
+                   opt(at[24], "logging.enabled", True)),
+        SkipOption("early stop when the pour is done", "coupling.stop_when_done = true (full: false)", full_stop,
+                   opt(full_stop, "coupling.stop_when_done", False)),
+    ]
+
+
+def build_plan(name: str = "full") -> BenchPlan:
+    """The 'full' plan (the numbers in docs/benchmarks.md) or the 'smoke' plan (tiny, seconds); CPU rows always,
+    CUDA rows when a CUDA device is present."""
+    devices = ["cpu"] + (["cuda"] if cuda_available() else [])
+    axes = FULL_AXES if name == "full" else SMOKE_AXES
+    rows: list[BenchConfig] = []
+    defaults = {}
+    reference, skips = None, []
+    for case, case_axes in axes.items():
+        for device in devices:
+            rows += _axis_rows(case, case_axes, device)
+        defaults[case] = BenchConfig(case, case_axes.resolutions[-1], case_axes.length, **default_numerics())
+    if BenchCase.POUR in axes:
+        reference = replace(defaults[BenchCase.POUR], particles_across=REFERENCE_ACROSS)
+        skips = _skip_options("cpu")
+        rows = [reference] + rows + [c for s in skips for c in (s.skip, s.full)]
+    unique = list(dict.fromkeys(rows))
+    return BenchPlan(tuple(unique), defaults, reference, tuple(skips))

@@ -1,0 +1,87 @@
+"""``cosim bench``: wall time against error for the solver's resolutions and numerics, and the scenes' skip options.
+
+For each configuration of the plan (:mod:`cosim.bench.plan`: dimension, particles across, kernel, CFL number,
+pressure solver, device) it measures the wall time per simulated second and the errors: the validation cases
+(hydrostatic, slosh, dam-break, coupling-static) against their references, the pour against a finer reference pour
+(poured-volume curve, landing point, joint trajectories). Writes ``bench.csv``, ``bench.md`` and one Pareto plot
+per case (``bench_<case>.png``) to ``--out``; with ``--docs FILE`` it also rewrites the generated part of that
+Markdown file and puts the plots beside it. Results are cached per configuration under ``--cache`` (key: the
+configuration and the simulation code's version), so a rerun, or a run after an interruption, only computes what
+is missing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+from datetime import datetime, timezone
+from pathlib import Path
+
+from cosim.atomic_files import write_text_atomic
+from cosim.bench.cache import ResultCache
+from cosim.bench.plan import build_plan
+from cosim.bench.report import build_rows, markdown, plot_case, rows_csv, skip_table, update_document
+from cosim.bench.run import run_plan
+from cosim.errors import InputError
+
+DEFAULT_OUT = Path("recordings") / "bench"
+PLANS = ("full", "smoke")
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("bench", help="wall time against error: resolutions, numerics, skip options (CSV, PNG, Markdown)",
+                              description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--plan", default="full", help=f"which configurations: {' or '.join(PLANS)} (smoke: seconds, for checks; default full)")
+    p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for bench.csv, bench.md and the plots (default {DEFAULT_OUT})")
+    p.add_argument("--cache", type=Path, help="result cache folder (default OUT/cache)")
+    p.add_argument("--docs", type=Path, help="also rewrite the generated part of this Markdown file (e.g. docs/benchmarks.md), plots beside it")
+    p.add_argument("--fresh", action="store_true", help="recompute every configuration (overwrites the cache)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=run)
+
+
+def _header(command: str, code_versions: dict) -> str:
+    from cosim.fluid.benchmark import _machine
+    from cosim.fluid.runtime import cuda_available
+    from cosim.pour_run import _versions
+
+    versions = ", ".join(f"{k} {v}" for k, v in _versions().items() if k != "cosim")
+    cuda = "a CUDA device is present: cuda rows included" if cuda_available() else "no CUDA device here: CPU rows only"
+    return (f"## Wall time against error ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
+            f"Machine: {_machine()}; {cuda}. Versions: {versions}.\n"
+            f"Command: `{command}`. Code versions (cosim.bench.cache.code_version): "
+            f"{', '.join(f'{k.value} {v}' for k, v in code_versions.items())}.\n")
+
+
+def run(args) -> int:
+    if args.plan not in PLANS:
+        raise InputError(f"--plan: must be one of {', '.join(PLANS)}, got {args.plan!r}")
+    if args.docs is not None and args.docs.suffix != ".md":
+        raise InputError(f"--docs: must be a Markdown file (.md), got {args.docs}")
+    if args.out.exists() and not args.out.is_dir():
+        raise InputError(f"--out: {args.out} exists and is not a folder")
+    plan = build_plan(args.plan)
+    cache = ResultCache(args.cache or args.out / "cache")
+    outcome = run_plan(plan, cache, fresh=args.fresh, progress=not args.quiet)
+    rows = build_rows(plan, outcome.results, outcome.keys)
+    skips = skip_table(plan, outcome.results)
+    plot_dir = args.docs.parent if args.docs is not None else args.out
+    plots = {}
+    for case, default in plan.defaults.items():
+        name = f"bench_{case.value.replace('-', '_')}.png"
+        if plot_case(rows, case, default, args.out / name):
+            plots[case] = name
+            if args.docs is not None:
+                plot_dir.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(args.out / name, plot_dir / name)
+    command = "cosim bench" + (f" --plan {args.plan}" if args.plan != "full" else "") + (f" --docs {args.docs}" if args.docs else "")
+    text = markdown(plan, outcome.results, rows, skips, plots, _header(command, outcome.versions))
+    write_text_atomic(args.out / "bench.csv", rows_csv(rows))
+    write_text_atomic(args.out / "bench.md", text)
+    if args.docs is not None:
+        update_document(args.docs, text)
+    print(f"wrote {args.out / 'bench.csv'}, {args.out / 'bench.md'} and {len(plots)} plots"
+          + (f"; updated {args.docs}" if args.docs else "") + f" ({outcome.computed} configurations computed, "
+          f"{len(plan.rows) - outcome.computed} from the cache)")
+    return 0
+

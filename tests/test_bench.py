@@ -1,0 +1,168 @@
+"""`cosim bench`: Pareto front, cache and resume, CSV/Markdown generation, pour comparison, bad input exits 2."""
+
+import csv
+import io
+import math
+
+import pytest
+from dataclasses import replace
+
+from cosim.bench.cache import ResultCache
+from cosim.bench.config import BenchCase, BenchConfig
+from cosim.bench.pareto import pareto_front
+from cosim.bench.plan import build_plan
+from cosim.bench.pour_compare import compare_pours
+from cosim.bench.report import CSV_COLUMNS, GENERATED_BEGIN, GENERATED_END, build_rows, markdown, rows_csv, update_document
+from cosim.bench.run import run_plan
+from cosim.bench.runners import pour_scene, run_config
+from cosim.cli.main import main
+from cosim.coupling.settings import Coupling
+from cosim.errors import InputError
+from cosim.fluid.solver import FluidInstabilityError
+from cosim.validation import CASES
+
+
+def test_pareto_front_of_a_known_example():
+    # (cost, error): 1 is dominated by 0 (same cost, larger error), 3 by 2, 5 is a duplicate of 4, 6 has a NaN
+    points = [(1.0, 0.5), (1.0, 0.6), (2.0, 0.2), (3.0, 0.3), (4.0, 0.1), (4.0, 0.1), (0.5, math.nan), (5.0, 0.1)]
+    assert pareto_front(points) == [0, 2, 4]
+    assert pareto_front([]) == []
+    assert pareto_front([(2.0, 1.0), (1.0, 2.0)]) == [1, 0]  # by increasing cost
+
+
+def _fake_runner(calls):
+    """Stands in for run_config in the cache tests: records the calls, returns a well-formed validation result."""
+
+    def run(cfg):
+        calls.append(cfg)
+        return {"config": cfg.to_json(), "status": "ok", "wall_s": 0.5 * cfg.particles_across, "sim_s": cfg.length,
+                "particles": cfg.particles_across**2, "errors": {"pressure_error": 1.0 / cfg.particles_across, "density_error": 0.01}}
+
+    return run
+
+
+def test_second_run_reads_the_cache_and_resumes_after_interruption(tmp_path):
+    plan = build_plan("smoke")
+    calls = []
+    first = run_plan(plan, ResultCache(tmp_path), progress=False, runner=_fake_runner(calls))
+    timed = [c for c in calls if c in plan.rows]
+    assert first.computed == len(plan.rows) == len(timed)
+    calls.clear()
+    second = run_plan(plan, ResultCache(tmp_path), progress=False, runner=_fake_runner(calls))
+    assert second.computed == 0 and calls == []  # nothing recomputed, not even the warm-up
+    assert second.results == first.results
+    # an interrupted run left some entries: only the missing ones run
+    missing = plan.rows[1:3]
+    for cfg in missing:
+        (tmp_path / f"{first.keys[cfg]}.json").unlink()
+    third = run_plan(plan, ResultCache(tmp_path), progress=False, runner=_fake_runner(calls))
+    assert third.computed == 2 and [c for c in calls if c in plan.rows] == list(missing)
+
+
+def test_cache_key_covers_every_parameter_and_the_code_version():
+    a = BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0)
+    variants = [BenchConfig(BenchCase.HYDROSTATIC, 21, 1.0), BenchConfig(BenchCase.HYDROSTATIC, 20, 2.0),
+                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, cfl=0.3), BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, kernel="cubic_spline"),
+                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, dim=3), BenchConfig(BenchCase.SLOSH, 20, 1.0)]
+    keys = {a.key("v1"), a.key("v2"), *(v.key("v1") for v in variants)}
+    assert len(keys) == 2 + len(variants)
+    assert a.key("v1") == BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0).key("v1")
+
+
+def test_real_smoke_rows_csv_and_markdown(tmp_path):
+    plan = build_plan("smoke")
+    outcome = run_plan(plan, ResultCache(tmp_path), progress=False)
+    rows = build_rows(plan, outcome.results, outcome.keys)
+    assert all(r.status == "ok" and r.sim_s > 0 and r.wall_s > 0 for r in rows)
+    table = list(csv.DictReader(io.StringIO(rows_csv(rows))))
+    assert len(table) == len(plan.rows) and tuple(table[0]) == CSV_COLUMNS
+    hydro = [t for t in table if t["case"] == "hydrostatic"]
+    assert hydro and all(0 <= float(t["pressure_error"]) < math.inf and t["front_error"] == "" for t in hydro)
+    text = markdown(plan, outcome.results, rows, [], {}, "## header")
+    assert "### hydrostatic" in text and "### dam-break" in text and "**default**" in text
+    assert text.count("| cfl 0.4 |") == 2 and "pressure_solver dfsph" in text  # one row per CFL level and solver per case
+    assert "load average" in text
+
+
+def test_update_document_keeps_the_text_around_the_generated_block(tmp_path):
+    doc = tmp_path / "benchmarks.md"
+    doc.write_text("# Benchmarks\n\nintro\n\n## Fluid step throughput\n\n| table |\n")
+    update_document(doc, "generated one")
+    update_document(doc, "generated two")
+    text = doc.read_text()
+    assert text.count(GENERATED_BEGIN) == 1 and text.count(GENERATED_END) == 1
+    assert "generated two" in text and "generated one" not in text
+    assert text.startswith("# Benchmarks\n") and "intro" in text and text.rstrip().endswith("| table |")
+
+
+def _pour_raw(poured, landing, q, initial=1.0):
+    t = [0.0, 1.0, 2.0]
+    return {"status": "ok", "outcome": {"initial_volume": initial, "caught_volume": 0.8 * poured[-1]},
+            "series": {"t": t, "poured_volume": poured, "landing_measured_x": landing, "trajectory_time": t,
+                       "joint_names": ["a/j"], "joint_positions": [[x] for x in q]}}
+
+
+def test_pour_comparison_against_hand_computed_values():
+    ref = _pour_raw([0.0, 0.0, 0.3], [None, 0.30, 0.32], [0.0, 0.1, 0.2])
+    run = _pour_raw([0.0, 0.3, 0.3], [None, None, 0.25], [0.0, 0.1, 0.5])
+    err = compare_pours(run, ref)
+    assert err["poured_curve_error"] == pytest.approx(math.sqrt(0.09 / 3))
+    assert err["landing_error_m"] == pytest.approx(0.31 - 0.25)
+    assert err["joint_rms_rad"] == pytest.approx(math.sqrt(0.09 / 3))
+    assert err["final_caught_error"] == pytest.approx(0.0)
+    assert compare_pours(_pour_raw([0.0, 0.1, 0.2], [None] * 3, [0, 0, 0]), ref)["final_caught_error"] == pytest.approx(0.08)
+    assert math.isnan(compare_pours(_pour_raw([0, 0, 0], [None] * 3, [0, 0, 0]), ref)["landing_error_m"])
+
+
+def test_pour_scene_options_map_onto_the_scene_and_are_checked():
+    cfg = BenchConfig(BenchCase.POUR, 20, 2.0, kernel="cubic_spline", cfl=0.3, options=(("coupling.coupling", "one_way"),))
+    scene = pour_scene(cfg)
+    assert scene.fluid.particles_across == 20 and scene.fluid.cfl == 0.3 and scene.fluid.kernel.value == "cubic_spline"
+    assert scene.coupling.coupling is Coupling.ONE_WAY and scene.coupling.max_duration == 2.0
+    assert scene.logging.enabled is False
+    with pytest.raises(InputError, match="coupling.coupling"):
+        pour_scene(BenchConfig(BenchCase.POUR, 20, 2.0, options=(("coupling.coupling", "sideways"),)))
+
+
+def test_a_broken_simulation_is_a_failed_row_not_a_crash(monkeypatch):
+    def explode(params):
+        raise FluidInstabilityError(12, 0.003, "compression 0.4 exceeds fluid.max_density_error = 0.3")
+
+    monkeypatch.setitem(CASES, "hydrostatic", replace(CASES["hydrostatic"], run=explode))
+    result = run_config(BenchConfig(BenchCase.HYDROSTATIC, 8, 0.05))
+    assert result["status"] == "failed" and "SPH step 12" in result["message"]
+
+
+@pytest.mark.parametrize("argv", [["bench", "--plan", "huge"], ["bench", "--docs", "notes.txt"]])
+def test_bad_input_exits_2_with_one_line(argv, capsys, tmp_path):
+    assert main(argv + ["--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("cosim bench: error:")
+    assert not (tmp_path / "out").exists()
+
+
+def test_bad_config_is_one_input_error():
+    with pytest.raises(InputError, match="particles_across"):
+        BenchConfig(BenchCase.POUR, 4, 1.0)
+    with pytest.raises(InputError, match="options"):
+        BenchConfig(BenchCase.SLOSH, 20, 1.0, options=(("coupling.coupling", "one_way"),))
+
+
+def test_code_version_is_per_case_sources():
+    from cosim.bench.cache import SOURCES, code_version
+
+    assert not any(s.startswith("controllers") for s in SOURCES[BenchCase.HYDROSTATIC])  # a controller edit keeps them
+    assert code_version(BenchCase.HYDROSTATIC) == code_version(BenchCase.SLOSH)
+    assert code_version(BenchCase.HYDROSTATIC) != code_version(BenchCase.POUR) != code_version(BenchCase.COUPLING_STATIC)
+
+
+def test_cli_smoke_writes_csv_markdown_plots_and_the_doc_block(tmp_path, capsys):
+    doc = tmp_path / "docs" / "benchmarks.md"
+    out = tmp_path / "out"
+    argv = ["bench", "--plan", "smoke", "--out", str(out), "--docs", str(doc), "--quiet"]
+    assert main(argv) == 0
+    assert "2 from the cache" not in capsys.readouterr().out
+    assert {"bench.csv", "bench.md", "bench_hydrostatic.png", "bench_dam_break.png"} <= {p.name for p in out.iterdir()}
+    assert (doc.parent / "bench_hydrostatic.png").exists() and GENERATED_BEGIN in doc.read_text()
+    assert main(argv) == 0
+    assert "(0 configurations computed" in capsys.readouterr().out
