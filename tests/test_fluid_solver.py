@@ -49,9 +49,18 @@ def test_slosh_coarse_frequency_matches_eq17():
     assert abs(r.metrics[0].error) <= slosh.FREQUENCY_TOLERANCE
 
 
-@pytest.mark.parametrize("case, dim, across, rate", [("tilt", 2, 16, 60.0), ("shake", 2, 16, 60.0), ("tilt", 3, 8, 60.0)])
-def test_moving_vessel_never_leaks(case, dim, across, rate):
-    p = moving_vessel.Params(dim=dim, particles_across=across, rate=rate, periods=2.0)
+@pytest.mark.parametrize(
+    "case, dim, across, rate, solver",
+    [
+        ("tilt", 2, 16, 60.0, "wcsph"),
+        ("shake", 2, 16, 60.0, "wcsph"),
+        ("tilt", 3, 8, 60.0, "wcsph"),
+        ("tilt", 2, 16, 60.0, "dfsph"),
+        ("shake", 2, 16, 60.0, "dfsph"),
+    ],
+)
+def test_moving_vessel_never_leaks(case, dim, across, rate, solver):
+    p = moving_vessel.Params(dim=dim, particles_across=across, rate=rate, periods=2.0, solver=solver)
     r = (moving_vessel.run_tilt if case == "tilt" else moving_vessel.run_shake)(p)
     assert r.raw["failure"] == ""
     assert r.metrics[1].measured == 0, "particles inside a wall"
