@@ -71,6 +71,18 @@ def rotation_vector(r: np.ndarray) -> np.ndarray:
     return angle * axis / (2.0 * math.sin(angle))
 
 
+def rotation_from_vector(w: np.ndarray) -> np.ndarray:
+    """Rotation matrix of an axis-angle vector (rad): the exp map (Rodrigues), the inverse of
+    :func:`rotation_vector`."""
+    w = np.asarray(w, dtype=float)
+    angle = float(np.linalg.norm(w))
+    if angle < 1e-12:
+        return np.eye(3)
+    k = w / angle
+    kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * kx + (1.0 - math.cos(angle)) * (kx @ kx)
+
+
 class Pose:
     """A rigid pose: ``position`` (3,) m and ``rotation`` (3, 3), mapping frame vectors to world vectors."""
 

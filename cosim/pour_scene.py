@@ -19,7 +19,7 @@ from cosim.config_mapping import from_mapping, to_toml
 from cosim.coupling.pose_filter import PoseFilterLimits
 from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig, KernelType, PressureSolver
+from cosim.fluid.config import FluidConfig, GridReset, KernelType, PressureSolver
 from cosim.io.recording import RecordingConfig
 from cosim.trajectory.limits import JointLimitOverride
 
@@ -47,6 +47,10 @@ class FluidSettings:
       (divergence-free SPH, time step set by the flow speed).
     smoothing_ratio: h / dx. [1.0, 2.5]
     cfl: Courant number of the time step (on the sound speed for WCSPH, on the flow speed for DFSPH). (0, 0.6]
+    grid_reset: 'occupied' resets only the neighbour-grid cells the liquid and walls occupied (work restricted to
+      where they are) or 'whole' (every cell of the domain); identical results.
+    adaptive_time_step: true plans each 2 ms interval's step from the last one's largest speed and acceleration and
+      the vessels' speed; false runs one fixed step from the expected speed (nothing to measure, nothing shortens it).
     sound_speed_factor: c0 / expected maximum speed (>= 10 keeps density errors near 1 %). [10, 100]
     artificial_viscosity: Monaghan alpha. [0, 1]
     density_diffusion: delta-SPH delta. [0, 1]
@@ -60,6 +64,8 @@ class FluidSettings:
     pressure_solver: PressureSolver = PressureSolver.WCSPH
     smoothing_ratio: float = 1.5
     cfl: float = 0.25
+    adaptive_time_step: bool = True
+    grid_reset: GridReset = GridReset.OCCUPIED
     sound_speed_factor: float = 10.0
     artificial_viscosity: float = 0.01
     density_diffusion: float = 0.1
@@ -79,6 +85,8 @@ class FluidSettings:
             pressure_solver=self.pressure_solver,
             smoothing_ratio=self.smoothing_ratio,
             cfl=self.cfl,
+            adaptive_time_step=self.adaptive_time_step,
+            grid_reset=self.grid_reset,
             sound_speed_factor=self.sound_speed_factor,
             artificial_viscosity=self.artificial_viscosity,
             density_diffusion=self.density_diffusion,

@@ -120,6 +120,10 @@ def _skip_options(device: str) -> list[SkipOption]:
                    opt(at[24], "logging.enabled", True)),
         SkipOption("early stop when the pour is done", "coupling.stop_when_done = true (full: false)", full_stop,
                    opt(full_stop, "coupling.stop_when_done", False)),
+        SkipOption("adaptive time step", "fluid.adaptive_time_step = true (full: false, the fixed step of the expected "
+                   "speed)", at[24], opt(at[24], "fluid.adaptive_time_step", False)),
+        SkipOption("neighbour grid restricted to the liquid", "fluid.grid_reset = occupied (full: whole)", at[24],
+                   opt(at[24], "fluid.grid_reset", "whole")),
     ]
 
 

@@ -5,7 +5,8 @@ appending one row per configuration to ``OUT/stress.csv`` (rewritten atomically 
 configurations already in the file, so an interrupted run continues where it stopped (``--fresh`` starts over).
 Then writes ``OUT/stability.md`` and ``OUT/stability.png``. ``--docs DIR`` runs nothing and writes the report
 from ``OUT/stress.csv`` into DIR. Exit status 1 when any configuration is ``silent`` (garbage without an error)
-``refused`` (the solver's one-line input error at set-up) or ``error`` (an unexpected exception).
+or ``error`` (an unexpected exception); ``instability`` (the solver's clear error) and ``refused`` (its one-line
+input error at set-up) are acceptable outcomes.
 """
 
 from __future__ import annotations

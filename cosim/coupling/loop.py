@@ -216,7 +216,9 @@ class CoupledPour:
         return outflow_timing(rows["t"], rows["poured_volume"], rows["phase"] == "cfs", self.controller.config.start_time)
 
     def summary(self) -> dict:
-        """Volumes (m^3), phases (name, start s, end s), times (s) of the run so far."""
+        """Volumes (m^3), phases (name, start s, end s), times (s) of the run so far; ``energy_created``: the most
+        energy the SPH numerics had created at any time, over M g L (``cosim.fluid.energy``; the run stops with an
+        instability past ``fluid.max_energy_creation``)."""
         last = self.fluid.last_report.last
         initial = self.geometry.initial_volume
         in_pourer, in_catcher = last.volume_in_vessel
@@ -243,6 +245,7 @@ class CoupledPour:
             "mujoco_steps": self.steps,
             "sph_steps": self.fluid.step_count,
             "particles": self.fluid.n_particles,
+            "energy_created": self.fluid.energy_account.peak_created,
         }
 
 

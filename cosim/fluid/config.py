@@ -25,6 +25,13 @@ class KernelType(Enum):
     WENDLAND_C2 = "wendland_c2"  # Wendland (1995) C2; no pairing instability at large neighbour counts
 
 
+class GridReset(Enum):
+    """How the neighbour grid's cell ranges are reset before each build (``cosim.fluid.neighbors``)."""
+
+    OCCUPIED = "occupied"  # only the cells the liquid and the walls occupied: work restricted to where they are
+    WHOLE = "whole"  # every cell of the domain
+
+
 class PressureSolver(Enum):
     """How pressure is obtained."""
 
@@ -51,6 +58,14 @@ class FluidConfig:
     density_diffusion: delta of delta-SPH (Antuono et al. 2010, renormalised density gradient). [0, 1]
     cfl: Courant number: dt <= cfl h / (c0 + v_max + v_wall) (WCSPH) or cfl h / (v_max + v_wall) (DFSPH, no sound
         speed). (0, 0.6]
+    grid_reset: :class:`GridReset`: 'occupied' resets only the neighbour-grid cells the last build occupied (the
+        grid's work restricted to the region holding liquid and walls, O(particles)); 'whole' resets every cell of
+        the domain (O(cells)). Identical neighbours either way.
+    adaptive_time_step: True: every interval plans its step from the previous interval's largest speed and
+        acceleration and the walls' speed (the CFL above plus the force criterion). False: one fixed step for the
+        whole run from the expected speed alone, cfl h / (c0 + max_expected_speed) (WCSPH) or
+        cfl h / max_expected_speed (DFSPH), no force criterion: nothing is measured to plan it, and nothing
+        shortens it when the flow or the walls outrun the expectation.
     density_tolerance: DFSPH: the density solve stops when the average compression (rho* - rho0) / rho0 is below
         this (0.01 %, SPlisHSPlasH's default for DFSPH; 0.1 % leaves a pressure noise of tens of % between
         substeps that kicks particles over rims). (0, 0.05]
@@ -69,6 +84,11 @@ class FluidConfig:
     max_wall_penetration: penetration into a wall (in units of dx) above which the run is declared unstable;
         shallower contacts are corrected by the non-penetration guard and counted. (0, 10]
     min_time_step: s, a CFL step below this is an instability. (0, 1e-3]
+    max_energy_creation: energy the numerics may create, in units of M g L (liquid mass M, L the tallest vessel's
+        inner height), before the run is declared unstable (``cosim.fluid.energy``): a quarter of the work of
+        lifting the whole liquid by the vessel's height. (0, 10]. Not zero: the symplectic step is not
+        energy-exact under impulsive wall loads (a tilt starting from rest at 5 rad/s within one 2 ms interval
+        creates 0.1-0.24 on coarse grids whose other measures stay clean, docs/stability.md).
     gravity: m/s^2, world-frame gravity vector.
     """
 
@@ -85,6 +105,8 @@ class FluidConfig:
     artificial_viscosity: float = 0.01
     density_diffusion: float = 0.1
     cfl: float = 0.25
+    adaptive_time_step: bool = True
+    grid_reset: GridReset = GridReset.OCCUPIED
     density_tolerance: float = 0.0001
     divergence_tolerance: float = 0.001
     max_solver_iterations: int = 100
@@ -95,6 +117,7 @@ class FluidConfig:
     max_density_error: float = 0.3
     max_wall_penetration: float = 0.5
     min_time_step: float = 1.0e-7
+    max_energy_creation: float = 0.25
     gravity: tuple[float, float, float] = field(default=(0.0, 0.0, -GRAVITY))
 
     def __post_init__(self) -> None:
@@ -112,6 +135,9 @@ class FluidConfig:
         s(self, "artificial_viscosity", check_range("fluid.artificial_viscosity", self.artificial_viscosity, 0.0, 1.0))
         s(self, "density_diffusion", check_range("fluid.density_diffusion", self.density_diffusion, 0.0, 1.0))
         s(self, "cfl", check_range("fluid.cfl", self.cfl, 0.0, 0.6, lo_open=True))
+        s(self, "grid_reset", check_choice("fluid.grid_reset", self.grid_reset, GridReset))
+        if not isinstance(self.adaptive_time_step, bool):
+            raise InputError(f"fluid.adaptive_time_step: must be true or false, got {self.adaptive_time_step!r}")
         s(self, "density_tolerance", check_range("fluid.density_tolerance", self.density_tolerance, 0.0, 0.05, lo_open=True))
         s(self, "divergence_tolerance", check_range("fluid.divergence_tolerance", self.divergence_tolerance, 0.0, 0.05, lo_open=True))
         s(self, "max_solver_iterations", check_int("fluid.max_solver_iterations", self.max_solver_iterations, 2, 1000))
@@ -130,6 +156,7 @@ class FluidConfig:
         s(self, "max_density_error", check_range("fluid.max_density_error", self.max_density_error, 0.0, 1.0, lo_open=True))
         s(self, "max_wall_penetration", check_range("fluid.max_wall_penetration", self.max_wall_penetration, 0.0, 10.0, lo_open=True))
         s(self, "min_time_step", check_range("fluid.min_time_step", self.min_time_step, 0.0, 1.0e-3, "s", lo_open=True))
+        s(self, "max_energy_creation", check_range("fluid.max_energy_creation", self.max_energy_creation, 0.0, 10.0, lo_open=True))
         s(self, "gravity", check_vector("fluid.gravity", self.gravity, 3))
 
     # ---- derived quantities ------------------------------------------------------------------------------------

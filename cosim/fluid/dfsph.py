@@ -502,6 +502,8 @@ def integrate(
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
+    wall_force: wp.array2d(dtype=wp.vec3),
+    wall_torque: wp.array2d(dtype=wp.vec3),
     # Out
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
@@ -513,6 +515,6 @@ def integrate(
     x_old = x[i]
     vi = v_star[i]
     finish_particle(
-        prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, row[0], i, x_old, x_old + dt[0] * vi, vi, rho[i],
-        x, v, active, diag_f, diag_i,
+        prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, row[0], i, x_old, x_old + dt[0] * vi, vi, rho[i], dt[0],
+        x, v, active, wall_force, wall_torque, diag_f, diag_i,
     )

@@ -1,7 +1,7 @@
 """Per-substep diagnostics: layout of the device rows and the host-side record.
 
 Each substep writes one row of floats and one row of ints (atomics: max for maxima, integer adds for counts, so
-every field but the kinetic energy is order-independent and deterministic on any device).
+every field but the energies is order-independent and deterministic on any device).
 """
 
 from __future__ import annotations
@@ -19,7 +19,10 @@ DIAG_KINETIC_ENERGY = wp.constant(3)  # J (3-D equivalent)
 DIAG_MAX_COMPRESSION = wp.constant(4)  # max (rho - rho0) / rho0 (the part an instability shows in)
 DIAG_DIVERGENCE_ERROR = wp.constant(5)  # DFSPH: average compressing density rate x dt / rho0 left by its solve
 DIAG_DENSITY_SOLVE_ERROR = wp.constant(6)  # DFSPH: average predicted compression / rho0 left by its solve
-N_DIAG_FLOAT = 7
+DIAG_POTENTIAL_ENERGY = wp.constant(7)  # J (3-D equivalent), -sum m g . x of the active particles
+DIAG_REMOVED_ENERGY = wp.constant(8)  # J, kinetic + potential energy of the particles that left the domain
+DIAG_INTERNAL_ENERGY = wp.constant(9)  # J, WCSPH: elastic energy the compressed (or stretched) liquid stores
+N_DIAG_FLOAT = 10
 # int row
 DIAG_NONFINITE = wp.constant(0)  # particles with a non-finite position, velocity or density
 DIAG_BREACHES = wp.constant(1)  # wall contacts deeper than max_wall_penetration (instability)

@@ -72,7 +72,7 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
     b_vessel = np.concatenate([np.full(len(s), k, dtype=np.int32) for k, s in enumerate(samples)]) if samples else np.zeros(0, np.int32)
     reach = np.array([np.linalg.norm(s, axis=1).max() for s in samples]) if samples else np.zeros(0)
     thickness = np.array([numerical_wall_thickness(s, cfg.spacing, cfg.support_radius) for s in specs])
-    make_grid = lambda capacity: CellGrid(cfg.domain_min, cfg.domain_max, cfg.support_radius, cfg.dim, capacity, device)  # noqa: E731
+    make_grid = lambda capacity: CellGrid(cfg.domain_min, cfg.domain_max, cfg.support_radius, cfg.dim, capacity, device, cfg.grid_reset)  # noqa: E731
     return FluidModel(
         config=cfg,
         device=device,

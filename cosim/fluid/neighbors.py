@@ -6,6 +6,11 @@ stable, so the order is deterministic) and records each cell's [start, end) rang
 caller reorders its particle arrays by the returned permutation, so neighbours are contiguous in memory.
 Chosen over ``wp.HashGrid`` because the 2-D query visits 9 cells instead of 27 and the reorder makes neighbour
 access coherent (measured in docs/benchmarks.md).
+
+The cell ranges must be reset before each build. :attr:`GridReset.OCCUPIED` clears only the cells the previous
+build occupied (from its sorted keys): O(points), so the grid costs what the region holding the liquid (or the
+walls) needs, however large the domain. :attr:`GridReset.WHOLE` clears every cell of the domain: O(cells). Both
+leave the same ranges, so the neighbour lists, and every result, are identical.
 """
 
 from __future__ import annotations
@@ -15,6 +20,8 @@ from typing import Callable
 
 import numpy as np
 import warp as wp
+
+from cosim.fluid.config import GridReset
 
 
 @wp.struct
@@ -85,6 +92,23 @@ def find_cell_ranges(
         cell_end[k] = i + 1
 
 
+@wp.kernel
+def clear_occupied_cells(
+    # Model
+    n_cells: int,
+    # State in
+    keys: wp.array(dtype=wp.int32),
+    # Out
+    cell_start: wp.array(dtype=wp.int32),
+    cell_end: wp.array(dtype=wp.int32),
+):
+    """Zero the range of the cell each point occupied in the previous build (its sorted key; sentinels skipped)."""
+    k = keys[wp.tid()]
+    if k < n_cells:
+        cell_start[k] = 0
+        cell_end[k] = 0
+
+
 class CellGrid:
     """A reusable sorted cell list for up to ``capacity`` points.
 
@@ -92,7 +116,7 @@ class CellGrid:
     ``cell_start``/``cell_end`` give each cell's range in that order.
     """
 
-    def __init__(self, domain_min, domain_max, cell_size: float, dim: int, capacity: int, device):
+    def __init__(self, domain_min, domain_max, cell_size: float, dim: int, capacity: int, device, reset: GridReset = GridReset.OCCUPIED):
         lo = np.asarray(domain_min, dtype=float)
         hi = np.asarray(domain_max, dtype=float)
         counts = [max(1, math.ceil((hi[a] - lo[a]) / cell_size)) for a in range(3)]
@@ -107,8 +131,9 @@ class CellGrid:
         self.n_cells = counts[0] * counts[1] * counts[2]
         self.capacity = capacity
         self.device = device
+        self.reset = reset
         n2 = max(2 * capacity, 2)
-        self.keys = wp.zeros(n2, dtype=wp.int32, device=device)
+        self.keys = wp.full(n2, self.n_cells, dtype=wp.int32, device=device)  # sentinels: no cell occupied yet
         self.order = wp.zeros(n2, dtype=wp.int32, device=device)
         self.cell_start = wp.zeros(self.n_cells, dtype=wp.int32, device=device)
         self.cell_end = wp.zeros(self.n_cells, dtype=wp.int32, device=device)
@@ -132,7 +157,12 @@ class CellGrid:
         def sort() -> None:
             wp.utils.radix_sort_pairs(self.keys, self.order, n, 0, bits)
 
-        return [keys.launch, sort, self.cell_start.zero_, self.cell_end.zero_, ranges.launch]
+        if self.reset is GridReset.WHOLE:
+            return [keys.launch, sort, self.cell_start.zero_, self.cell_end.zero_, ranges.launch]
+        clear = wp.launch(
+            clear_occupied_cells, dim=n, inputs=[self.n_cells, self.keys], outputs=[self.cell_start, self.cell_end], device=self.device, record_cmd=True
+        )
+        return [clear.launch, keys.launch, sort, ranges.launch]
 
     def build(self, x: wp.array, active: wp.array, n: int) -> None:
         """Sort the first ``n`` points by cell and record the cell ranges (one-off; loops use build_commands)."""

@@ -34,7 +34,10 @@ from cosim.fluid import boundary as bd
 from cosim.fluid import dfsph, wcsph
 from cosim.fluid.config import FluidConfig, PressureSolver
 from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, sum_wall_wrench_chunks
-from cosim.fluid.diagnostics import N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, rows_to_records
+from cosim.fluid.diagnostics import (
+    DIAG_INTERNAL_ENERGY, DIAG_KINETIC_ENERGY, DIAG_POTENTIAL_ENERGY, DIAG_REMOVED_ENERGY, N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, rows_to_records,
+)
+from cosim.fluid.energy import EnergyAccount
 from cosim.fluid.model import FluidModel, FluidState, build_model
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
@@ -105,6 +108,7 @@ class FluidSolver:
         self._history: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         self._last_report: IntervalReport | None = None
         self._allocate(particles)
+        self.energy_account = EnergyAccount(config, vessels, particles.positions, particles.velocities, self._internal_energy())
 
     # ---- set-up ----------------------------------------------------------------------------------------------
     def _planar(self, pose: Pose) -> Pose:
@@ -166,6 +170,14 @@ class FluidSolver:
         self._upload_motions(zero, zero, zero, zero)
         self._wrench = np.zeros((m.n_vessels, 6))
 
+    def _internal_energy(self) -> float:
+        """Elastic energy the liquid stores (J): WCSPH's Tait liquid; DFSPH's incompressible one stores none."""
+        if self.config.pressure_solver is not PressureSolver.WCSPH:
+            return 0.0
+        energy = wp.zeros(self.n_particles, dtype=float, device=self.device)
+        wp.launch(wcsph.measure_internal_energy, dim=self.n_particles, inputs=[self.model.params, self.state.rho], outputs=[energy], device=self.device)
+        return float(energy.numpy().astype(np.float64).sum())
+
     def _ensure_rows(self, n: int) -> None:
         """Room for ``n`` substeps of diagnostics (the recorded operations are rebuilt when the rows grow)."""
         if n <= self._rows_capacity:
@@ -203,15 +215,20 @@ class FluidSolver:
 
     def plan_time_step(self, duration: float, wall_speed: float) -> tuple[int, float]:
         """(substeps, dt) for an interval: CFL with the wall speed (acoustic for WCSPH, on the flow speed alone for
-        DFSPH), force and viscous criteria."""
+        DFSPH), force and viscous criteria; with ``adaptive_time_step`` off, the fixed step of the expected speed
+        (and the viscous criterion)."""
         cfg = self.config
         h = cfg.smoothing_length
-        if cfg.pressure_solver is PressureSolver.WCSPH:
-            signal = cfg.sound_speed + self._last_max_speed + wall_speed
-        else:  # the expected speed bounds the step before the flow has reached it (a jet forms within an interval)
-            signal = max(cfg.max_expected_speed, self._last_max_speed) + wall_speed
-        dt = cfg.cfl * h / max(signal, 1e-9)
-        dt = min(dt, FORCE_CFL * math.sqrt(h / max(self._last_max_accel, 1e-9)))
+        sound = cfg.sound_speed if cfg.pressure_solver is PressureSolver.WCSPH else 0.0
+        if not cfg.adaptive_time_step:
+            dt = cfg.cfl * h / (sound + cfg.max_expected_speed)
+        else:
+            if cfg.pressure_solver is PressureSolver.WCSPH:
+                signal = sound + self._last_max_speed + wall_speed
+            else:  # the expected speed bounds the step before the flow has reached it (a jet forms within an interval)
+                signal = max(cfg.max_expected_speed, self._last_max_speed) + wall_speed
+            dt = cfg.cfl * h / max(signal, 1e-9)
+            dt = min(dt, FORCE_CFL * math.sqrt(h / max(self._last_max_accel, 1e-9)))
         if cfg.kinematic_viscosity > 0.0:
             dt = min(dt, VISCOUS_CFL * h * h / cfg.kinematic_viscosity)
         if dt < cfg.min_time_step:
@@ -251,11 +268,15 @@ class FluidSolver:
         t0 = self.time
         self.step_count += n_sub
         self.time += duration
-        self._poses = list(self._targets)
         self._history.append((np.full(n_sub, dt), rows_f, rows_i))
         scale = 1.0 / n_sub
         wrench = np.concatenate([self._force_sum.numpy(), self._torque_sum.numpy()], axis=1)[: m.n_vessels]
         self._wrench = wrench.astype(np.float64) * scale
+        self.energy_account.update(
+            float(rows_f[-1, DIAG_KINETIC_ENERGY] + rows_f[-1, DIAG_INTERNAL_ENERGY]), float(rows_f[-1, DIAG_POTENTIAL_ENERGY]), float(rows_f[:, DIAG_REMOVED_ENERGY].sum()),
+            self._wrench, self._poses, lin, ang, duration,
+        )
+        self._poses = list(self._targets)
         self._check(first, t0, dt, rows_f, rows_i)
         self._last_max_speed = float(rows_f[:, 0].max())
         self._last_max_accel = float(rows_f[:, 1].max())
@@ -330,7 +351,7 @@ class FluidSolver:
         ))
         ops.append(rec(
             wcsph.integrate, n, [*self._integrate_model_args(), self._drho, self._acc],
-            [st.x, st.v, st.rho, st.p, st.active, self._diag_f, self._diag_i],
+            [st.x, st.v, st.rho, st.p, st.active, self._wall_force, self._wall_torque, self._diag_f, self._diag_i],
         ))
         return ops
 
@@ -377,7 +398,7 @@ class FluidSolver:
                 ],
                 [self._wall_force, self._wall_torque, st.p],
             ),
-            rec(dfsph.integrate, n, [*self._integrate_model_args(), self._v_star, st.rho], [st.x, st.v, st.active, self._diag_f, self._diag_i]),
+            rec(dfsph.integrate, n, [*self._integrate_model_args(), self._v_star, st.rho], [st.x, st.v, st.active, self._wall_force, self._wall_torque, self._diag_f, self._diag_i]),
             self._solve_stats.zero_,
         ]
 
@@ -403,6 +424,14 @@ class FluidSolver:
         if bad:
             s, describe = min(bad, key=lambda b: b[0])
             raise FluidInstabilityError(first + s, t0 + (s + 1) * dt, describe(s))
+        if self.energy_account.created > cfg.max_energy_creation:
+            s = len(rows_f) - 1
+            raise FluidInstabilityError(
+                first + s, t0 + (s + 1) * dt,
+                f"the numerics created {self.energy_account.created:.3g} M g L of energy beyond the walls' work "
+                f"(fluid.max_energy_creation = {cfg.max_energy_creation:g}); a finer fluid.spacing, a larger "
+                "fluid.sound_speed_factor or a gentler vessel motion",
+            )
 
     # ---- readers (numpy, original particle order) ---------------------------------------------------------------
     def _in_id_order(self, arr: wp.array) -> np.ndarray:
@@ -456,7 +485,7 @@ class FluidSolver:
 
     def history(self) -> dict[str, np.ndarray]:
         """Every substep so far: 'dt' (s), 'time' (s, end of substep), 'max_speed', 'max_acceleration',
-        'max_density_error', 'kinetic_energy', 'nonfinite', 'wall_breaches', 'wall_corrections', 'active',
+        'max_density_error', 'kinetic_energy', 'potential_energy' (J, -sum m g . x), 'nonfinite', 'wall_breaches', 'wall_corrections', 'active',
         'volume_in_vessel' (steps, V) m^3; DFSPH's 'divergence_iterations', 'density_iterations' and the errors
         its solves left, 'divergence_error', 'density_solve_error' (relative; zero under WCSPH)."""
         if not self._history:
@@ -472,6 +501,7 @@ class FluidSolver:
             "max_density_error": f[:, 2],
             "max_compression": f[:, 4],
             "kinetic_energy": f[:, 3],
+            "potential_energy": f[:, 7],
             "nonfinite": i[:, 0],
             "wall_breaches": i[:, 1],
             "wall_corrections": i[:, 2],

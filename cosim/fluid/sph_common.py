@@ -13,6 +13,8 @@ from cosim.fluid.diagnostics import (
     DIAG_CORRECTIONS,
     DIAG_INSIDE0,
     DIAG_KINETIC_ENERGY,
+    DIAG_POTENTIAL_ENERGY,
+    DIAG_REMOVED_ENERGY,
     DIAG_MAX_SPEED,
     DIAG_NONFINITE,
 )
@@ -58,16 +60,22 @@ def finish_particle(
     x_new: wp.vec3,
     v_new: wp.vec3,
     rho_new: float,
+    dt: float,
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
+    wall_force: wp.array2d(dtype=wp.vec3),
+    wall_torque: wp.array2d(dtype=wp.vec3),
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
 ) -> int:
     """Store the particle's new position and velocity after the non-penetration guard of every vessel; deactivate
-    it if non-finite or outside the domain. Records wall corrections/breaches, per-vessel contents, speed, kinetic
-    energy and the active count in row ``s``. Returns 1 if the particle is still active (the caller then stores
-    its density and pressure), else 0."""
+    it if non-finite or outside the domain. The velocity a guard removes is a wall impulse: its reaction
+    -m dv / dt is added to the particle's force and torque on that vessel (``wall_force``/``wall_torque``, N and
+    N m about the vessel's centre of mass), so the reaction wrench balances every boundary force. Records wall
+    corrections/breaches, per-vessel contents, speed, kinetic and potential energy (and the energy of a particle
+    leaving the domain), and the active count in row ``s``. Returns 1 if the particle is still active (the caller
+    then stores its density and pressure), else 0."""
     xi = x_new
     vi = v_new
     if prm.dim == 2:
@@ -86,6 +94,10 @@ def finish_particle(
             vn = wp.dot(vi - v_wall, n_world)
             if vn < 0.0:
                 vi = vi - vn * n_world
+                f_vessel = (prm.mass_out * vn / dt) * n_world  # -m dv / dt with dv = -vn n
+                com = m.p_now + m.r_now @ geo.com
+                wall_force[k, i] = wall_force[k, i] + f_vessel
+                wall_torque[k, i] = wall_torque[k, i] + wp.cross(xi - com, f_vessel)
             wp.atomic_add(diag_i, s, DIAG_CORRECTIONS, 1)
             if depth > max_penetration:
                 wp.atomic_add(diag_i, s, DIAG_BREACHES, 1)
@@ -101,6 +113,7 @@ def finish_particle(
             outside = True
     if outside:
         active[i] = 0
+        wp.atomic_add(diag_f, s, DIAG_REMOVED_ENERGY, prm.mass_out * (0.5 * wp.dot(vi, vi) - wp.dot(prm.gravity, xi)))
         x[i] = xi
         v[i] = wp.vec3(0.0)
         return 0
@@ -110,6 +123,7 @@ def finish_particle(
     wp.atomic_add(diag_i, s, DIAG_ACTIVE, 1)
     wp.atomic_max(diag_f, s, DIAG_MAX_SPEED, speed)
     wp.atomic_add(diag_f, s, DIAG_KINETIC_ENERGY, 0.5 * prm.mass_out * speed * speed)
+    wp.atomic_add(diag_f, s, DIAG_POTENTIAL_ENERGY, -prm.mass_out * wp.dot(prm.gravity, xi))
     return 1
 
 

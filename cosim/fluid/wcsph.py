@@ -20,7 +20,7 @@ from __future__ import annotations
 import warp as wp
 
 from cosim.fluid.boundary import VesselGeometry, VesselMotion
-from cosim.fluid.diagnostics import DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR
+from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair
@@ -35,6 +35,16 @@ MIN_DENSITY_RATIO = wp.constant(0.8)
 def tait_pressure(prm: SPHParams, rho: float) -> float:
     """Tait equation of state (seed Eq. 5) with the artificial sound speed: p = B ((rho/rho0)^gamma - 1)."""
     return prm.eos_b * (wp.pow(rho / prm.rest_density, prm.gamma) - 1.0)
+
+
+@wp.func
+def tait_internal_energy(prm: SPHParams, rho: float) -> float:
+    """Elastic energy per unit mass the Tait liquid stores at density rho (J/kg): u = integral of p / rho^2 from
+    rho0 to rho = (B / rho0) (r^(gamma - 1) / (gamma - 1) + 1 / r - gamma / (gamma - 1)), r = rho / rho0 (>= 0,
+    zero at rest density)."""
+    r = rho / prm.rest_density
+    g1 = prm.gamma - 1.0
+    return (prm.eos_b / prm.rest_density) * (wp.pow(r, g1) / g1 + 1.0 / r - prm.gamma / g1)
 
 
 @wp.kernel
@@ -228,6 +238,8 @@ def integrate(
     rho: wp.array(dtype=float),
     p: wp.array(dtype=float),
     active: wp.array(dtype=wp.int32),
+    wall_force: wp.array2d(dtype=wp.vec3),
+    wall_torque: wp.array2d(dtype=wp.vec3),
     # Out
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
@@ -246,13 +258,24 @@ def integrate(
     # stops the rare runaway expansion of a fragment whose support emptied (its density would otherwise fall
     # without bound, even below zero).
     rhoi = wp.max(rho[i] + h * drho[i], MIN_DENSITY_RATIO * prm.rest_density)
-    kept = finish_particle(prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, s, i, x_old, xi, vi, rhoi, x, v, active, diag_f, diag_i)
+    kept = finish_particle(
+        prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, s, i, x_old, xi, vi, rhoi, h,
+        x, v, active, wall_force, wall_torque, diag_f, diag_i,
+    )
     if kept == 0:
         return
     rho[i] = rhoi
     p[i] = tait_pressure(prm, rhoi)
+    wp.atomic_add(diag_f, s, DIAG_INTERNAL_ENERGY, prm.mass_out * tait_internal_energy(prm, rhoi))
     wp.atomic_max(diag_f, s, DIAG_MAX_DENSITY_ERROR, wp.abs(rhoi - prm.rest_density) / prm.rest_density)
     wp.atomic_max(diag_f, s, DIAG_MAX_COMPRESSION, (rhoi - prm.rest_density) / prm.rest_density)
+
+
+@wp.kernel
+def measure_internal_energy(prm: SPHParams, rho: wp.array(dtype=float), energy: wp.array(dtype=float)):
+    """Each particle's elastic energy (J, 3-D equivalent) at its density (the energy account's start)."""
+    i = wp.tid()
+    energy[i] = prm.mass_out * tait_internal_energy(prm, rho[i])
 
 
 @wp.kernel
