@@ -27,7 +27,8 @@ class LiquidMeasurement:
       surface stands higher at the lip wall. Measured as: take the liquid particles inside the pourer's inner box
       (vessel x in [-B/2, B/2], z in [0, L]); express them in the vessel frame; split x in
       [-B/2 + h, B/2 - h] (h = SPH smoothing length) into equal columns of width h; in each column with
-      particles keep the particle with the largest vessel z; fit z = c + m x to those by least squares;
+      particles keep the particle with the largest vessel z (of several at that height, the one with the largest
+      vessel x); fit z = c + m x to those by least squares;
       theta1 = atan(m). Fewer than three columns: theta1 = tilt (nothing to fit). A liquid at rest gives
       theta1 = tilt; equivalently theta1 = tilt + atan(dz/dx) of the same surface fitted in world x-z.
     h_q: m, height of the free surface over the crest point, along world z. Where liquid lies over the crest

@@ -5,11 +5,23 @@ import math
 import numpy as np
 import pytest
 
-from cosim.coupling.landing import landing_accuracy, stream_crossing_x
+import warp as wp
+
+from cosim.coupling.landing import landing_accuracy
+from cosim.coupling.measure import LiquidProbe, MeasurementGeometry
+from cosim.vessel import seed_pouring_vessel
 from cosim.io.pour_series import COLUMNS, read_series_csv, write_series_csv
 
 G = 9.81
 DX = 0.006  # m
+
+
+def stream_crossing_x(x, v, rim_z, lip_z, dx, gravity, active=None):
+    """The probe's rim-plane crossing of numpy particles on the CPU."""
+    geo = MeasurementGeometry(seed_pouring_vessel(), 3 * dx, 0.16, 1.5 * dx, dx, initial_volume=0.003, dim=2)
+    active = np.ones(len(x), np.int32) if active is None else active.astype(np.int32)
+    arrays = [wp.array(a.astype(np.float32), dtype=wp.vec3, device="cpu") for a in (x, v)] + [wp.array(active, dtype=wp.int32, device="cpu")]
+    return LiquidProbe(geo, len(x), "cpu").stream_crossing_x(*arrays, rim_z, lip_z, gravity)
 
 
 def test_crossing_is_the_falling_stream_only() -> None:
@@ -25,6 +37,10 @@ def test_crossing_is_the_falling_stream_only() -> None:
     v[13, 2] = -2.8
     assert stream_crossing_x(x, v, rim_z, lip_z, DX, G) == pytest.approx(0.31)
     assert math.isnan(stream_crossing_x(x[5:13], v[5:13], rim_z, lip_z, DX, G))
+    spilled = np.ones(len(x), bool)
+    spilled[:3] = False  # three of the five stream particles deactivated (moved away): not counted
+    x[:3, 0] = 0.5
+    assert stream_crossing_x(x, v, rim_z, lip_z, DX, G, active=spilled) == pytest.approx(0.31)
 
 
 def test_prediction_is_paired_with_the_arrival_of_its_liquid() -> None:

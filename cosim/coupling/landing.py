@@ -3,12 +3,11 @@
 The controller predicts, each control step, the world x at which liquid leaving the pour lip *now* crosses the
 height of vessel B's rim (seed Eqs. 6-7 with the SPH v_q). The liquid it speaks about arrives there one fall time
 later. So the prediction made at the launch time t_l = t - t_fall is compared with the stream measured crossing the
-rim plane at t: the median x of the falling particles in a thin band around the rim height.
+rim plane at t: the median x of the falling particles in a thin band around the rim height
+(:meth:`cosim.coupling.measure.LiquidProbe.stream_crossing_x`, on the fluid's device).
 """
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 
@@ -18,20 +17,6 @@ BAND_SPACINGS = 1.0
 # A particle counts as part of the falling stream when it moves down faster than this fraction of the free-fall
 # speed from the lip to the rim (splashes and the liquid already in vessel B move slower).
 MIN_FALL_SPEED_FRACTION = 0.5
-
-
-def stream_crossing_x(
-    positions: np.ndarray, velocities: np.ndarray, rim_z: float, lip_z: float, spacing: float, gravity: float
-) -> float:
-    """Median world x (m) of the active particles falling through the plane z = ``rim_z`` (within
-    BAND_SPACINGS x ``spacing``); NaN when none is. ``positions``/``velocities``: (N, 3) m, m/s, active only."""
-    drop = max(lip_z - rim_z, 0.0)
-    min_speed = MIN_FALL_SPEED_FRACTION * math.sqrt(2.0 * gravity * drop)
-    band = BAND_SPACINGS * spacing
-    falling = (np.abs(positions[:, 2] - rim_z) <= band) & (velocities[:, 2] < -min_speed)
-    if not falling.any():
-        return math.nan
-    return float(np.median(positions[falling, 0]))
 
 
 def landing_accuracy(

@@ -29,9 +29,9 @@ from controllers.measurement import PourCommand
 from controllers.pour import PourController
 from controllers.catcher import fall_time
 from cosim.coupling.exchange import ROLES, vessel_poses, wrench_at_body_com
-from cosim.coupling.landing import landing_accuracy, stream_crossing_x
+from cosim.coupling.landing import landing_accuracy
 from cosim.coupling.outflow import outflow_timing
-from cosim.coupling.measure import MeasurementGeometry, measure
+from cosim.coupling.measure import LiquidProbe, MeasurementGeometry
 from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
 from cosim.coupling.settings import Coupling, CouplingSettings
 from cosim.fluid.config import FluidConfig
@@ -117,6 +117,7 @@ class CoupledPour:
         }
         self._ik = {r: ArmIK(scene.model, scene.arms[r].joints, frame_site(scene.arms[r].vessel), scene.arms[r].home_q, TARGET_IK) for r in ROLES}
         self.geometry = geometry
+        self.probe = LiquidProbe(geometry, fluid.n_particles, fluid.device)
         self.settings = settings
         self.dt = float(scene.model.opt.timestep)
         self.control_every = max(1, round(controller.dt / self.dt))
@@ -152,8 +153,8 @@ class CoupledPour:
         poses = fluid.vessel_poses()
         last = fluid.last_report.last if fluid.last_report else None
         in_pourer = last.volume_in_vessel[0] if last else self.geometry.initial_volume
-        x, v, active = fluid.positions(), fluid.velocities(), fluid.active_mask()
-        m = measure(self.time, self.geometry, poses[0], poses[1], x, v, active, in_pourer)
+        state = fluid.state  # the device arrays as they are: the probe reads them where they live
+        m = self.probe.measure(self.time, poses[0], poses[1], state.x, state.v, state.active, in_pourer)
         cmd = self.controller.step(m)
         self.command = cmd
         targets = {ArmRole.POUR: cmd.pourer, ArmRole.CATCH: cmd.catcher}
@@ -170,8 +171,7 @@ class CoupledPour:
         in_catcher = last.volume_in_vessel[1] if last else 0.0
         gravity = self.fluid.config.gravity_magnitude
         flowing = m.h_q > 0.0 and m.v_q > 0.0
-        crossing = stream_crossing_x(x[active], v[active], m.catcher_rim_z, m.lip_z,
-                                     self.geometry.spacing, gravity)
+        crossing = self.probe.stream_crossing_x(state.x, state.v, state.active, m.catcher_rim_z, m.lip_z, gravity)
         self.log.append(
             t=self.time, tilt=m.tilt, theta1=m.theta1, h_q=m.h_q, v_q=m.v_q, v_q_z=m.v_q_z,
             volume_in_pourer=in_pourer, volume_in_catcher=in_catcher, poured_volume=m.poured_volume,

@@ -7,7 +7,11 @@ lip used here is where the simulated liquid leaves the vessel: the outer top edg
 it (``FluidModel.wall_thickness``, at least the dummy-particle layers), which is also the wall thickness given to
 the controller, so that its jet launch point is the simulated one.
 
-Vectorised numpy over the particles (one pass per control step, outside the SPH step).
+Computed on the fluid's device, from its particle arrays as they are (any order): warp kernels reduce the
+particles to per-column maxima, the crest's highest particle, fixed-order chunk sums of the stream leaving the lip
+and the few particles crossing vessel B's rim plane; the host reads back only those, so its work per control
+step does not grow with the particle count. Every reduction is order-independent (maxima, a median of a set) or
+summed in a fixed order (chunks), so the measurement is deterministic on any device.
 """
 
 from __future__ import annotations
@@ -16,13 +20,18 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import warp as wp
 
 from controllers.geometry import height_above
 from controllers.measurement import LiquidMeasurement
+from cosim.coupling.landing import BAND_SPACINGS, MIN_FALL_SPEED_FRACTION
 from cosim.frames import Pose, tilt_about_y
 from cosim.vessel import VesselSpec
 
 MIN_FIT_COLUMNS = 3  # the contract: fewer columns than this and theta1 = tilt
+CHUNKS = 64  # fixed-order reduction of the leaving stream: per-chunk sums, then the chunks in order
+LOWEST = -1.0e30  # "no particle" for the maxima
+_SUMS = 5  # per chunk: count, sum vx, sum vz, sum x, sum z of the leaving particles
 
 
 @dataclass(frozen=True)
@@ -46,83 +55,287 @@ class MeasurementGeometry:
     def lip_local(self) -> np.ndarray:
         return np.array([0.5 * self.pourer.inner_width + self.wall_thickness, 0.0, self.pourer.inner_height])
 
+    @property
+    def column_start(self) -> float:
+        """Vessel x (m) where the surface columns start: -B/2 + h."""
+        return -0.5 * self.pourer.inner_width + self.smoothing_length
 
-def free_surface_fit(local: np.ndarray, width: float, h: float) -> tuple[float, float, int]:
-    """(c, slope, columns): least-squares line z = c + slope x through the highest particle of each column of
-    width h over x in [-B/2 + h, B/2 - h] (vessel frame, particles already restricted to the inner box)."""
-    lo, hi = -0.5 * width + h, 0.5 * width - h
-    n_cols = int(math.floor((hi - lo) / h + 1e-9))
-    if n_cols < 1 or len(local) == 0:
-        return 0.0, 0.0, 0
-    sel = (local[:, 0] >= lo) & (local[:, 0] < lo + n_cols * h)
-    col = np.floor((local[sel, 0] - lo) / h).astype(int)
-    x, z = local[sel, 0], local[sel, 2]
-    top = np.full(n_cols, -np.inf)
-    np.maximum.at(top, col, z)
-    # the x of each column's top particle
-    top_x = np.full(n_cols, np.nan)
-    is_top = z == top[col]
-    top_x[col[is_top]] = x[is_top]
-    used = np.isfinite(top)
-    if used.sum() < MIN_FIT_COLUMNS:
-        return 0.0, 0.0, int(used.sum())
-    slope, c = np.polyfit(top_x[used], top[used], 1)
-    return float(c), float(slope), int(used.sum())
+    @property
+    def columns(self) -> int:
+        """Number of surface columns of width h over [-B/2 + h, B/2 - h]."""
+        span = self.pourer.inner_width - 2.0 * self.smoothing_length
+        return max(int(math.floor(span / self.smoothing_length + 1e-9)), 0)
 
 
-def measure(
-    t: float,
-    geo: MeasurementGeometry,
-    pourer_pose: Pose,
-    catcher_pose: Pose,
-    positions: np.ndarray,
-    velocities: np.ndarray,
-    active: np.ndarray,
-    volume_in_pourer: float,
-) -> LiquidMeasurement:
-    """The controller's measurement from world-frame particle positions (N, 3) m, velocities (N, 3) m/s, the
-    active mask (N,) and the solver's count-based volume in the pourer (m^3)."""
-    spec, dx, h = geo.pourer, geo.spacing, geo.smoothing_length
-    b, d, height = 0.5 * spec.inner_width, 0.5 * spec.section_depth, spec.inner_height
-    x, v = positions[active], velocities[active]
-    tilt = tilt_about_y(pourer_pose.rotation)
-    local = pourer_pose.inverse_transform(x)
-    inner = (np.abs(local[:, 0]) <= b) & (local[:, 2] >= 0.0) & (local[:, 2] <= height)
-    if geo.dim == 3:
-        inner &= np.abs(local[:, 1]) <= d
-    c, slope, columns = free_surface_fit(local[inner], spec.inner_width, h)
-    theta1 = math.atan(slope) if columns >= MIN_FIT_COLUMNS else tilt
+@wp.struct
+class PourerFrame:
+    """The pourer at the measurement (world frame): origin (m) and rotation; inner half width b, half depth d and
+    height (m); 3 when the y extent counts (3-D); the surface columns' start (m, vessel x), width h (m) and count."""
 
-    crest = pourer_pose.transform(geo.crest_local[None, :])[0]
-    over_crest = (np.abs(x[:, 0] - crest[0]) <= dx) & (x[:, 2] > crest[2])
-    if over_crest.any():
-        h_q = float(x[over_crest, 2].max() + 0.5 * dx - crest[2])
-    elif columns >= MIN_FIT_COLUMNS:
-        h_q = min(height_above((geo.crest_local[0], geo.crest_local[2]), c, theta1, tilt), 0.0)
-    else:
-        h_q = -height  # no surface to measure: far below the crest
+    origin: wp.vec3
+    rotation: wp.mat33
+    half_width: float
+    half_depth: float
+    height: float
+    dim: int
+    column_start: float
+    column_width: float
+    columns: int
 
-    lip = pourer_pose.transform(geo.lip_local[None, :])[0]
-    top = lip[2] + dx + max(h_q, 0.0)
-    leaving = (x[:, 0] >= lip[0] - dx) & (x[:, 0] <= lip[0] + 3 * dx) & (x[:, 2] >= lip[2] - 3 * dx) & (x[:, 2] <= top) & ~inner
-    if leaving.any():
-        v_q, v_q_z = (float(c) for c in v[leaving][:, [0, 2]].mean(axis=0))
-        jet_dx, jet_dz = (float(c) for c in x[leaving][:, [0, 2]].mean(axis=0) - lip[[0, 2]])
-    else:
-        v_q = v_q_z = jet_dx = jet_dz = 0.0
-    rim = catcher_pose.transform(np.array([[0.0, 0.0, geo.catcher_height]]))[0]
-    return LiquidMeasurement(
-        t=t,
-        tilt=tilt,
-        theta1=theta1,
-        h_q=h_q,
-        v_q=v_q,
-        volume_in_pourer=volume_in_pourer,
-        poured_volume=max(geo.initial_volume - volume_in_pourer, 0.0),
-        lip_x=float(lip[0]),
-        lip_z=float(lip[2]),
-        catcher_rim_z=float(rim[2]),
-        v_q_z=v_q_z,
-        jet_dx=jet_dx,
-        jet_dz=jet_dz,
-    )
+
+@wp.func
+def inner_local(f: PourerFrame, x: wp.vec3) -> wp.vec4:
+    """(vessel x, y, z, 1 if inside the inner box else 0) of a world point."""
+    q = wp.transpose(f.rotation) @ (x - f.origin)
+    inside = wp.abs(q[0]) <= f.half_width and q[2] >= 0.0 and q[2] <= f.height
+    if f.dim == 3 and wp.abs(q[1]) > f.half_depth:
+        inside = False
+    flag = float(0.0)
+    if inside:
+        flag = 1.0
+    return wp.vec4(q[0], q[1], q[2], flag)
+
+
+@wp.func
+def column_of(f: PourerFrame, qx: float) -> int:
+    """Surface column of a vessel x, or -1 outside the columns."""
+    if qx < f.column_start or qx >= f.column_start + float(f.columns) * f.column_width:
+        return -1
+    return wp.min(int(wp.floor((qx - f.column_start) / f.column_width)), f.columns - 1)
+
+
+@wp.kernel
+def find_column_tops(
+    # Model
+    f: PourerFrame,
+    crest: wp.vec3,
+    dx: float,
+    # State in
+    x: wp.array(dtype=wp.vec3),
+    active: wp.array(dtype=wp.int32),
+    # Out
+    column_top: wp.array(dtype=float),
+    crest_top: wp.array(dtype=float),
+):
+    """The highest vessel z of each surface column (inner particles) and the highest world z over the crest."""
+    i = wp.tid()
+    if active[i] == 0:
+        return
+    xi = x[i]
+    q = inner_local(f, xi)
+    if q[3] > 0.0:
+        c = column_of(f, q[0])
+        if c >= 0:
+            wp.atomic_max(column_top, c, q[2])
+    if wp.abs(xi[0] - crest[0]) <= dx and xi[2] > crest[2]:
+        wp.atomic_max(crest_top, 0, xi[2])
+
+
+@wp.kernel
+def find_column_top_x(
+    # Model
+    f: PourerFrame,
+    # State in
+    x: wp.array(dtype=wp.vec3),
+    active: wp.array(dtype=wp.int32),
+    column_top: wp.array(dtype=float),
+    # Out
+    column_top_x: wp.array(dtype=float),
+):
+    """The vessel x of each column's top particle (of several at the same height: the largest x)."""
+    i = wp.tid()
+    if active[i] == 0:
+        return
+    q = inner_local(f, x[i])
+    if q[3] > 0.0:
+        c = column_of(f, q[0])
+        if c >= 0 and q[2] == column_top[c]:
+            wp.atomic_max(column_top_x, c, q[0])
+
+
+@wp.kernel
+def sum_leaving_stream(
+    # Model
+    f: PourerFrame,
+    lip: wp.vec3,
+    dx: float,
+    top: float,
+    n: int,
+    chunk: int,
+    # State in
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    active: wp.array(dtype=wp.int32),
+    # Out
+    sums: wp.array2d(dtype=float),
+):
+    """Per chunk of ``chunk`` consecutive particles, in order: count, sum vx, sum vz, sum x, sum z of the particles
+    leaving over the lip (outside the inner box, x in [x_lip - dx, x_lip + 3 dx], z in [z_lip - 3 dx, top])."""
+    k = wp.tid()
+    count = float(0.0)
+    svx = float(0.0)
+    svz = float(0.0)
+    sx = float(0.0)
+    sz = float(0.0)
+    for i in range(k * chunk, wp.min((k + 1) * chunk, n)):
+        if active[i] == 0:
+            continue
+        xi = x[i]
+        if xi[0] < lip[0] - dx or xi[0] > lip[0] + 3.0 * dx or xi[2] < lip[2] - 3.0 * dx or xi[2] > top:
+            continue
+        if inner_local(f, xi)[3] > 0.0:
+            continue
+        count += 1.0
+        svx += v[i][0]
+        svz += v[i][2]
+        sx += xi[0]
+        sz += xi[2]
+    sums[k, 0] = count
+    sums[k, 1] = svx
+    sums[k, 2] = svz
+    sums[k, 3] = sx
+    sums[k, 4] = sz
+
+
+@wp.kernel
+def collect_rim_crossing(
+    # Model
+    rim_z: float,
+    band: float,
+    min_speed: float,
+    # State in
+    x: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    active: wp.array(dtype=wp.int32),
+    # Out
+    count: wp.array(dtype=wp.int32),
+    crossing_x: wp.array(dtype=float),
+):
+    """World x of the particles falling through the rim plane (within ``band`` of it, moving down faster than
+    ``min_speed``), appended in any order (only their median is used)."""
+    i = wp.tid()
+    if active[i] == 0:
+        return
+    xi = x[i]
+    if wp.abs(xi[2] - rim_z) <= band and v[i][2] < -min_speed:
+        slot = wp.atomic_add(count, 0, 1)
+        crossing_x[slot] = xi[0]
+
+
+def free_surface_line(top_x: np.ndarray, top_z: np.ndarray) -> tuple[float, float, int]:
+    """(c, slope, columns): least-squares line z = c + slope x through the columns' top particles (vessel frame;
+    a column without particles has top z = :data:`LOWEST`); (0, 0, columns) with fewer than MIN_FIT_COLUMNS."""
+    used = top_z > 0.5 * LOWEST
+    columns = int(used.sum())
+    if columns < MIN_FIT_COLUMNS:
+        return 0.0, 0.0, columns
+    slope, c = np.polyfit(top_x[used], top_z[used], 1)
+    return float(c), float(slope), columns
+
+
+class LiquidProbe:
+    """The controller's measurement of a liquid of ``n_particles`` on ``device`` (scratch arrays allocated once).
+
+    Each call reads the particle arrays it is given (world frame: positions (N,) vec3 m, velocities (N,) vec3
+    m/s, active (N,) int32), e.g. the fluid solver's current state."""
+
+    def __init__(self, geo: MeasurementGeometry, n_particles: int, device):
+        self.geo = geo
+        self.n = n_particles
+        self.device = device
+        cols = max(geo.columns, 1)
+        self._column_top = wp.zeros(cols, dtype=float, device=device)
+        self._column_top_x = wp.zeros(cols, dtype=float, device=device)
+        self._crest_top = wp.zeros(1, dtype=float, device=device)
+        self._sums = wp.zeros((CHUNKS, _SUMS), dtype=float, device=device)
+        self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
+        self._crossing_x = wp.zeros(max(n_particles, 1), dtype=float, device=device)
+
+    def _frame(self, pose: Pose) -> PourerFrame:
+        geo, spec = self.geo, self.geo.pourer
+        f = PourerFrame()
+        f.origin = wp.vec3(*pose.position)
+        f.rotation = wp.mat33(*pose.rotation.ravel())
+        f.half_width = 0.5 * spec.inner_width
+        f.half_depth = 0.5 * spec.section_depth
+        f.height = spec.inner_height
+        f.dim = geo.dim
+        f.column_start = geo.column_start
+        f.column_width = geo.smoothing_length
+        f.columns = geo.columns
+        return f
+
+    def measure(
+        self, t: float, pourer_pose: Pose, catcher_pose: Pose, x: wp.array, v: wp.array, active: wp.array,
+        volume_in_pourer: float,
+    ) -> LiquidMeasurement:
+        """The measurement at time ``t`` (s) with the vessels at these poses, from the particle arrays and the
+        solver's count-based volume in the pourer (m^3)."""
+        geo, dx, d = self.geo, self.geo.spacing, self.device
+        height = geo.pourer.inner_height
+        frame = self._frame(pourer_pose)
+        tilt = tilt_about_y(pourer_pose.rotation)
+        crest = pourer_pose.transform(geo.crest_local[None, :])[0]
+        self._column_top.fill_(LOWEST)
+        self._column_top_x.fill_(LOWEST)
+        self._crest_top.fill_(LOWEST)
+        if self.n:
+            wp.launch(find_column_tops, dim=self.n, inputs=[frame, wp.vec3(*crest), dx, x, active],
+                      outputs=[self._column_top, self._crest_top], device=d)
+            wp.launch(find_column_top_x, dim=self.n, inputs=[frame, x, active, self._column_top],
+                      outputs=[self._column_top_x], device=d)
+        top_z = self._column_top.numpy().astype(np.float64)[: geo.columns]
+        top_x = self._column_top_x.numpy().astype(np.float64)[: geo.columns]
+        c, slope, columns = free_surface_line(top_x, top_z)
+        theta1 = math.atan(slope) if columns >= MIN_FIT_COLUMNS else tilt
+
+        crest_top = float(self._crest_top.numpy()[0])
+        if crest_top > 0.5 * LOWEST:
+            h_q = crest_top + 0.5 * dx - crest[2]
+        elif columns >= MIN_FIT_COLUMNS:
+            h_q = min(height_above((geo.crest_local[0], geo.crest_local[2]), c, theta1, tilt), 0.0)
+        else:
+            h_q = -height  # no surface to measure: far below the crest
+
+        lip = pourer_pose.transform(geo.lip_local[None, :])[0]
+        top = lip[2] + dx + max(h_q, 0.0)
+        chunk = max(math.ceil(self.n / CHUNKS), 1)
+        wp.launch(sum_leaving_stream, dim=CHUNKS, inputs=[frame, wp.vec3(*lip), dx, top, self.n, chunk, x, v, active],
+                  outputs=[self._sums], device=d)
+        count, svx, svz, sx, sz = self._sums.numpy().astype(np.float64).sum(axis=0)
+        if count > 0:
+            v_q, v_q_z = svx / count, svz / count
+            jet_dx, jet_dz = sx / count - lip[0], sz / count - lip[2]
+        else:
+            v_q = v_q_z = jet_dx = jet_dz = 0.0
+        rim = catcher_pose.transform(np.array([[0.0, 0.0, geo.catcher_height]]))[0]
+        return LiquidMeasurement(
+            t=t,
+            tilt=tilt,
+            theta1=theta1,
+            h_q=h_q,
+            v_q=float(v_q),
+            volume_in_pourer=volume_in_pourer,
+            poured_volume=max(geo.initial_volume - volume_in_pourer, 0.0),
+            lip_x=float(lip[0]),
+            lip_z=float(lip[2]),
+            catcher_rim_z=float(rim[2]),
+            v_q_z=float(v_q_z),
+            jet_dx=float(jet_dx),
+            jet_dz=float(jet_dz),
+        )
+
+    def stream_crossing_x(self, x: wp.array, v: wp.array, active: wp.array, rim_z: float, lip_z: float, gravity: float) -> float:
+        """Median world x (m) of the active particles falling through the plane z = ``rim_z`` (within
+        BAND_SPACINGS spacings, faster than MIN_FALL_SPEED_FRACTION of the free fall from ``lip_z``); NaN when
+        none is (:mod:`cosim.coupling.landing`)."""
+        drop = max(lip_z - rim_z, 0.0)
+        min_speed = MIN_FALL_SPEED_FRACTION * math.sqrt(2.0 * gravity * drop)
+        self._crossing_count.zero_()
+        if self.n:
+            wp.launch(collect_rim_crossing, dim=self.n, inputs=[rim_z, BAND_SPACINGS * self.geo.spacing, min_speed, x, v, active],
+                      outputs=[self._crossing_count, self._crossing_x], device=self.device)
+        count = int(self._crossing_count.numpy()[0])
+        if count == 0:
+            return math.nan
+        return float(np.median(self._crossing_x[:count].numpy().astype(np.float64)))

@@ -1,0 +1,67 @@
+"""A plain numpy transcription of the measurement contract (controllers.measurement.LiquidMeasurement) and of the
+rim-plane crossing, written over particle arrays: the independent reference the device probe
+(cosim.coupling.measure.LiquidProbe) is checked against on real SPH states."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from controllers.geometry import height_above
+from cosim.coupling.landing import BAND_SPACINGS, MIN_FALL_SPEED_FRACTION
+from cosim.coupling.measure import MIN_FIT_COLUMNS, MeasurementGeometry
+from cosim.frames import Pose, tilt_about_y
+
+
+def reference_measure(geo: MeasurementGeometry, pourer: Pose, catcher: Pose, x: np.ndarray, v: np.ndarray) -> dict:
+    """theta1, h_q, v_q, v_q_z, jet_dx, jet_dz, lip_x, lip_z, catcher_rim_z of the active particles x, v (N, 3)."""
+    spec, dx, h = geo.pourer, geo.spacing, geo.smoothing_length
+    b, d, height = 0.5 * spec.inner_width, 0.5 * spec.section_depth, spec.inner_height
+    tilt = tilt_about_y(pourer.rotation)
+    local = pourer.inverse_transform(x)
+    inner = (np.abs(local[:, 0]) <= b) & (local[:, 2] >= 0.0) & (local[:, 2] <= height)
+    if geo.dim == 3:
+        inner &= np.abs(local[:, 1]) <= d
+    lo, n_cols = -b + h, geo.columns
+    q = local[inner]
+    sel = (q[:, 0] >= lo) & (q[:, 0] < lo + n_cols * h)
+    col = np.minimum(np.floor((q[sel, 0] - lo) / h).astype(int), n_cols - 1)
+    qx, qz = q[sel, 0], q[sel, 2]
+    top = np.full(n_cols, -np.inf)
+    np.maximum.at(top, col, qz)
+    top_x = np.full(n_cols, -np.inf)
+    is_top = qz == top[col]
+    np.maximum.at(top_x, col[is_top], qx[is_top])
+    used = np.isfinite(top)
+    if used.sum() >= MIN_FIT_COLUMNS:
+        slope, c = np.polyfit(top_x[used], top[used], 1)
+        theta1 = math.atan(slope)
+    else:
+        c, theta1 = 0.0, tilt
+    crest = pourer.transform(geo.crest_local[None, :])[0]
+    over = (np.abs(x[:, 0] - crest[0]) <= dx) & (x[:, 2] > crest[2])
+    if over.any():
+        h_q = float(x[over, 2].max() + 0.5 * dx - crest[2])
+    elif used.sum() >= MIN_FIT_COLUMNS:
+        h_q = min(height_above((geo.crest_local[0], geo.crest_local[2]), c, theta1, tilt), 0.0)
+    else:
+        h_q = -height
+    lip = pourer.transform(geo.lip_local[None, :])[0]
+    top_z = lip[2] + dx + max(h_q, 0.0)
+    leaving = (x[:, 0] >= lip[0] - dx) & (x[:, 0] <= lip[0] + 3 * dx) & (x[:, 2] >= lip[2] - 3 * dx) & (x[:, 2] <= top_z) & ~inner
+    if leaving.any():
+        v_q, v_q_z = v[leaving][:, [0, 2]].mean(axis=0)
+        jet_dx, jet_dz = x[leaving][:, [0, 2]].mean(axis=0) - lip[[0, 2]]
+    else:
+        v_q = v_q_z = jet_dx = jet_dz = 0.0
+    rim = catcher.transform(np.array([[0.0, 0.0, geo.catcher_height]]))[0]
+    return dict(theta1=theta1, h_q=h_q, v_q=v_q, v_q_z=v_q_z, jet_dx=jet_dx, jet_dz=jet_dz, lip_x=lip[0], lip_z=lip[2],
+                catcher_rim_z=rim[2], leaving=int(leaving.sum()))
+
+
+def reference_crossing_x(x: np.ndarray, v: np.ndarray, rim_z: float, lip_z: float, spacing: float, gravity: float) -> float:
+    """Median x of the active particles falling through the rim plane (cosim.coupling.landing's definition)."""
+    min_speed = MIN_FALL_SPEED_FRACTION * math.sqrt(2.0 * gravity * max(lip_z - rim_z, 0.0))
+    falling = (np.abs(x[:, 2] - rim_z) <= BAND_SPACINGS * spacing) & (v[:, 2] < -min_speed)
+    return float(np.median(x[falling, 0])) if falling.any() else math.nan
