@@ -252,14 +252,14 @@ GENERATED_BEGIN = "<!-- cosim bench: generated, begin -->"
 GENERATED_END = "<!-- cosim bench: generated, end -->"
 
 
-def update_document(path: Path, generated: str) -> None:
-    """Put ``generated`` between the markers in ``path`` (kept text outside them); without markers the block goes
-    after the document's first heading; a missing file is created."""
+def update_document(path: Path, generated: str, begin: str = GENERATED_BEGIN, end: str = GENERATED_END) -> None:
+    """Put ``generated`` between the markers ``begin`` and ``end`` in ``path`` (kept text outside them); without
+    markers the block goes after the document's first heading; a missing file is created."""
     text = path.read_text() if path.exists() else "# Benchmarks\n"
-    block = f"{GENERATED_BEGIN}\n{generated.strip()}\n{GENERATED_END}"
-    if GENERATED_BEGIN in text and GENERATED_END in text:
-        head, rest = text.split(GENERATED_BEGIN, 1)
-        text = head + block + rest.split(GENERATED_END, 1)[1]
+    block = f"{begin}\n{generated.strip()}\n{end}"
+    if begin in text and end in text:
+        head, rest = text.split(begin, 1)
+        text = head + block + rest.split(end, 1)[1]
     else:
         first, _, rest = text.partition("\n")
         text = f"{first}\n\n{block}\n{rest}"

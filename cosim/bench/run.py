@@ -29,7 +29,7 @@ class BenchOutcome:
     versions: dict[BenchCase, str]
 
 
-def _warm_up(todo: list[BenchConfig], runner: Callable[[BenchConfig], dict]) -> None:
+def warm_up(todo: list[BenchConfig], runner: Callable[[BenchConfig], dict]) -> None:
     """Load (or compile) the kernels of each pressure solver and device before anything is timed."""
     for solver, device in dict.fromkeys((c.pressure_solver, c.device) for c in todo):
         runner(BenchConfig(BenchCase.HYDROSTATIC, pressure_solver=solver, device=device, **WARM_UP))
@@ -51,7 +51,7 @@ def run_plan(plan: BenchPlan, cache: ResultCache, fresh: bool = False, progress:
     print(f"cosim bench: {len(plan.rows)} configurations, {len(plan.rows) - len(todo)} cached, {len(todo)} to run "
           f"(code versions {', '.join(f'{k.value} {v}' for k, v in versions.items())})", file=sys.stderr)
     if todo:
-        _warm_up(todo, runner)
+        warm_up(todo, runner)
     bar = tqdm(todo, unit="config", disable=not progress, file=sys.stderr, mininterval=1.0)
     for cfg in bar:
         bar.set_description_str(cfg.label)
