@@ -10,7 +10,7 @@ import pytest
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.seeding import fill_vessel
-from cosim.fluid.solver import FluidInstabilityError, FluidSolver
+from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
 from cosim.stress.matrix import Motion, StressConfig
 from cosim.validation.scripted import SAMPLE_INTERVAL, domain_around, run_scripted, tilt_about_lip

@@ -21,7 +21,6 @@ from pathlib import Path
 from cosim.atomic_files import write_text_atomic
 from cosim.checks import check_device
 from cosim.errors import InputError
-from cosim.errors import InputError
 from cosim.stress.classify import FAILURES, Outcome, classify
 from cosim.stress.matrix import FILTER_FIELDS, build_matrix, quick_matrix, select
 from cosim.stress.report import write_report
