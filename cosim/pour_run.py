@@ -11,12 +11,10 @@ succeeded, so a failed or interrupted run leaves no half-written folder behind.
 from __future__ import annotations
 
 import json
-import math
 import os
 import platform
 import shutil
 import tempfile
-import time
 from dataclasses import asdict, replace
 from datetime import datetime, timezone
 from importlib import metadata
@@ -26,7 +24,7 @@ import mujoco
 import numpy as np
 from tqdm import tqdm
 
-from controllers.config import CatcherConfig, CfsConfig, PourConfig
+from controllers.config import CatcherConfig, PourConfig
 from controllers.geometry import VesselGeometry
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour, build_pour

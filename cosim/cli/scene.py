@@ -3,7 +3,6 @@ starting point of a scene file for ``cosim pour SCENE.toml``; ``--check FILE`` v
 
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
 from cosim.atomic_files import write_text_atomic
