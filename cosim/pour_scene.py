@@ -53,6 +53,10 @@ class FluidSettings:
       the vessels' speed; false runs one fixed step from the expected speed (nothing to measure, nothing shortens it).
     sound_speed_factor: c0 / expected maximum speed (>= 10 keeps density errors near 1 %). [10, 100]
     artificial_viscosity: Monaghan alpha. [0, 1]
+    free_liquid: true treats the liquid outside both vessels (the stream, spray) as free: no tension, a
+      memoryless density (WCSPH; the stream then falls on its free-fall parabola, ``cosim validate free-fall``).
+    free_artificial_viscosity: Monaghan alpha of pairs with free liquid, which makes its impacts inelastic. [0, 1]
+    max_tension: Pa, the most tension the (WCSPH) liquid carries; more flings thin films at a rim. [0, 1e6]
     density_diffusion: delta-SPH delta. [0, 1]
     kinematic_viscosity: m^2/s (water 1e-6). [0, 0.01]
     max_density_error: compression that counts as an instability (impacts reach about v / c0). (0, 1]
@@ -68,6 +72,9 @@ class FluidSettings:
     grid_reset: GridReset = GridReset.OCCUPIED
     sound_speed_factor: float = 10.0
     artificial_viscosity: float = 0.01
+    free_liquid: bool = True
+    free_artificial_viscosity: float = 0.25
+    max_tension: float = 1000.0
     density_diffusion: float = 0.1
     kinematic_viscosity: float = 1.0e-6
     max_density_error: float = 0.3
@@ -89,6 +96,9 @@ class FluidSettings:
             grid_reset=self.grid_reset,
             sound_speed_factor=self.sound_speed_factor,
             artificial_viscosity=self.artificial_viscosity,
+            free_liquid=self.free_liquid,
+            free_artificial_viscosity=self.free_artificial_viscosity,
+            max_tension=self.max_tension,
             density_diffusion=self.density_diffusion,
             kinematic_viscosity=self.kinematic_viscosity,
             max_density_error=self.max_density_error,

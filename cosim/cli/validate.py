@@ -47,7 +47,7 @@ def _case_params(name: str, args) -> list:
     common = {"dim": args.dim, "device": args.device, "spacing": args.spacing, "solver": args.solver}
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
-    if name in ("tilt", "shake", "coupling-static"):
+    if name in ("tilt", "shake", "free-fall", "coupling-static"):
         geometry.pop("width", None)  # the scene's (seed's) vessel
     if name == "slosh" and args.fill is None:
         return [params(**common, **geometry, fill=fill) for fill in slosh.SEED_FILLS]

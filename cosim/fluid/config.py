@@ -55,6 +55,19 @@ class FluidConfig:
         equation of state: it uses c0 only as the velocity scale of the artificial viscosity, as WCSPH does.
     kinematic_viscosity: m^2/s, laminar viscosity (water 1.0e-6 at 20 C). [0, 0.01]
     artificial_viscosity: Monaghan alpha (dimensionless), also applied against walls. [0, 1]
+    free_liquid: WCSPH: True treats liquid outside every vessel (the falling stream, spray, a splash above a rim)
+        as free liquid: memoryless summation density clamped at rho0, so no tension pulls the stream back toward
+        the vessel it left, back to the continuity density once packed inside a vessel again
+        (:func:`cosim.fluid.wcsph.update_free_liquid`). False: the continuity density everywhere (its tension holds
+        the stream together and lands it short of its free-fall parabola, ``cosim validate free-fall``).
+    free_artificial_viscosity: Monaghan alpha of every pair with a free particle (and of a free particle against
+        walls): free liquid has no tension to hold it together, so this is what makes its impacts inelastic
+        (the first stream hitting an empty vessel, a drop on a wall); alpha acts only on approaching pairs, so
+        the separating particles of a falling stream fly free. [0, 1]
+    max_tension: Pa, the most tension (negative pressure) WCSPH's bound liquid carries: p = max(Tait, -max_tension).
+        Tension holds the continuity-density liquid together (its surface row carries a few hundred Pa), but a film
+        or a last wedge stretched at a rim reaches tens of kPa (7 % under rest density), enough to fling its
+        particles at metres per second; 1 kPa (the hydrostatic pressure of 10 cm of water) keeps them calm. [0, 1e6]
     density_diffusion: delta of delta-SPH (Antuono et al. 2010, renormalised density gradient). [0, 1]
     cfl: Courant number: dt <= cfl h / (c0 + v_max + v_wall) (WCSPH) or cfl h / (v_max + v_wall) (DFSPH, no sound
         speed). (0, 0.6]
@@ -103,6 +116,9 @@ class FluidConfig:
     sound_speed_factor: float = 10.0
     kinematic_viscosity: float = 1.0e-6
     artificial_viscosity: float = 0.01
+    free_liquid: bool = True
+    free_artificial_viscosity: float = 0.25
+    max_tension: float = 1000.0
     density_diffusion: float = 0.1
     cfl: float = 0.25
     adaptive_time_step: bool = True
@@ -133,6 +149,10 @@ class FluidConfig:
         s(self, "sound_speed_factor", check_range("fluid.sound_speed_factor", self.sound_speed_factor, 10.0, 100.0))
         s(self, "kinematic_viscosity", check_range("fluid.kinematic_viscosity", self.kinematic_viscosity, 0.0, 0.01, "m^2/s"))
         s(self, "artificial_viscosity", check_range("fluid.artificial_viscosity", self.artificial_viscosity, 0.0, 1.0))
+        if not isinstance(self.free_liquid, bool):
+            raise InputError(f"fluid.free_liquid: must be true or false, got {self.free_liquid!r}")
+        s(self, "free_artificial_viscosity", check_range("fluid.free_artificial_viscosity", self.free_artificial_viscosity, 0.0, 1.0))
+        s(self, "max_tension", check_range("fluid.max_tension", self.max_tension, 0.0, 1.0e6, "Pa"))
         s(self, "density_diffusion", check_range("fluid.density_diffusion", self.density_diffusion, 0.0, 1.0))
         s(self, "cfl", check_range("fluid.cfl", self.cfl, 0.0, 0.6, lo_open=True))
         s(self, "grid_reset", check_choice("fluid.grid_reset", self.grid_reset, GridReset))

@@ -339,7 +339,7 @@ def wall_pair_viscosity(prm: SPHParams, volume: float, r: wp.vec3, r2: float, v_
     """Viscous acceleration of a particle from one wall particle (of rest density, ``volume``, relative velocity
     ``v_rel`` against the wall's own): the same call in compute_nonpressure and compute_wall_reaction, so the
     vessel receives exactly the opposite force."""
-    return viscous_pair(prm, prm.rest_density * volume, r, r2, kernel_gradient(prm, r, r2), v_rel, v_rel, rho_i, prm.rest_density)
+    return viscous_pair(prm, prm.alpha, prm.rest_density * volume, r, r2, kernel_gradient(prm, r, r2), v_rel, v_rel, rho_i, prm.rest_density)
 
 
 @wp.kernel
@@ -399,7 +399,7 @@ def compute_nonpressure(
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
                     vij = vi - v[j]
-                    a += viscous_pair(prm, prm.mass, r, r2, kernel_gradient(prm, r, r2), vij, vij, rhoi, rho[j])
+                    a += viscous_pair(prm, prm.alpha, prm.mass, r, r2, kernel_gradient(prm, r, r2), vij, vij, rhoi, rho[j])
                 for kk in range(b_cell_start[cell], b_cell_end[cell]):
                     b = b_order[kk]
                     r = xi - bx[b]

@@ -96,7 +96,9 @@ class FluidState:
     x: m; v: m/s; rho: kg/m^3; p: Pa; active: 1 while simulated, 0 once spilled or broken; pid: the particle's
     original index (to return results in the order the particles were given); kappa_density, kappa_divergence:
     DFSPH only, m^2/s^2, the stiffness (p / rho) each of its two solves applied in the last substep (the warm start
-    of the next; zero under WCSPH).
+    of the next; zero under WCSPH); free: WCSPH only, 1 while the particle is free liquid (memoryless summation
+    density, no tension: :func:`cosim.fluid.wcsph.update_free_liquid`), 0 while its density follows the continuity
+    equation.
     """
 
     x: wp.array
@@ -107,6 +109,7 @@ class FluidState:
     pid: wp.array
     kappa_density: wp.array
     kappa_divergence: wp.array
+    free: wp.array
 
     @staticmethod
     def allocate(n: int, device) -> "FluidState":
@@ -119,7 +122,8 @@ class FluidState:
             pid=wp.zeros(n, dtype=wp.int32, device=device),
             kappa_density=wp.zeros(n, dtype=float, device=device),
             kappa_divergence=wp.zeros(n, dtype=float, device=device),
+            free=wp.zeros(n, dtype=wp.int32, device=device),
         )
 
     def arrays(self) -> list[wp.array]:
-        return [self.x, self.v, self.rho, self.p, self.active, self.pid, self.kappa_density, self.kappa_divergence]
+        return [self.x, self.v, self.rho, self.p, self.active, self.pid, self.kappa_density, self.kappa_divergence, self.free]

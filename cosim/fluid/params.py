@@ -11,11 +11,13 @@ from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma, lattice_gradient_s
 @wp.struct
 class SPHParams:
     """Static SPH parameters (SI). ``mass`` is the SPH particle mass (kg, or kg/m of depth in 2-D); ``mass_out``
-    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``eta2`` = 0.01 h^2 (m^2); then DFSPH's stopping rule (relative tolerances and
-    the iteration cap of each solve) and ``lattice_density``, the summation density of a resting lattice over rho0
-    (DFSPH divides its summation density by it, so the liquid as seeded is at rest density) and
-    ``lattice_factor_denominator``, sum_j |m grad W|^2 of a particle inside that lattice (kg^2/m^(2 dim + 2)), the
-    scale below which DFSPH does not let a factor's denominator fall."""
+    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``alpha_free`` the artificial
+    viscosity of pairs with free liquid (WCSPH); ``max_tension`` (Pa) the clamp of WCSPH's negative pressure,
+    reached at ``tension_density`` (kg/m^3); ``eta2`` = 0.01 h^2 (m^2); then DFSPH's stopping rule (relative
+    tolerances and the iteration cap of each solve) and ``lattice_density``, the summation density of a resting
+    lattice over rho0 (DFSPH and WCSPH's free liquid divide their summation density by it, so the liquid as seeded
+    is at rest density) and ``lattice_factor_denominator``, sum_j |m grad W|^2 of a particle inside that lattice
+    (kg^2/m^(2 dim + 2)), the scale below which DFSPH does not let a factor's denominator fall."""
 
     dim: int
     kernel: int
@@ -31,6 +33,9 @@ class SPHParams:
     gamma: float
     nu: float
     alpha: float
+    alpha_free: float
+    max_tension: float
+    tension_density: float
     delta: float
     eta2: float
     gravity: wp.vec3
@@ -56,9 +61,13 @@ def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
     p.rest_density = cfg.rest_density
     p.sound_speed = cfg.sound_speed
     p.eos_b = cfg.rest_density * cfg.sound_speed**2 / cfg.gamma
+    # the density below which the Tait pressure is clamped at -max_tension (0: the clamp is never reached)
+    p.tension_density = cfg.rest_density * (1.0 - cfg.max_tension / p.eos_b) ** (1.0 / cfg.gamma) if cfg.max_tension < p.eos_b else 0.0
     p.gamma = cfg.gamma
     p.nu = cfg.kinematic_viscosity
     p.alpha = cfg.artificial_viscosity
+    p.alpha_free = cfg.free_artificial_viscosity
+    p.max_tension = cfg.max_tension
     p.delta = cfg.density_diffusion
     p.eta2 = 0.01 * h * h
     p.gravity = wp.vec3(*cfg.gravity)

@@ -6,8 +6,8 @@ its current pose to that one at constant linear and angular velocity while the l
 substeps as the CFL, force and viscous criteria need (computed from the previous interval's maxima and the wall
 speed). Each substep runs the named stages of the configured pressure solver, WCSPH (``cosim.fluid.wcsph``)
 
-    move_vessels; place_wall_particles; find_neighbors; extrapolate_wall_state; compute_forces;
-    compute_density_rate; integrate (+ wall guard); reduce_wrenches
+    move_vessels; place_wall_particles; find_neighbors; update_free_liquid; extrapolate_wall_state;
+    compute_forces; compute_density_rate; integrate (+ wall guard); reduce_wrenches
 
 or DFSPH (``cosim.fluid.dfsph``)
 
@@ -240,7 +240,7 @@ class FluidSolver:
         """Advance the liquid by ``duration`` (s), moving each vessel to its target pose meanwhile."""
         if not (duration > 0.0 and math.isfinite(duration)):
             raise InputError(f"fluid.advance: duration must be > 0 s, got {duration}")
-        m, d = self.model, self.device
+        m = self.model
         lin = np.array([(t.position - p.position) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
         ang = np.array([rotation_vector(t.rotation @ p.rotation.T) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
         wall_speed = max((np.linalg.norm(lin[k]) + np.linalg.norm(ang[k]) * m.b_reach[k] for k in range(m.n_vessels)), default=0.0)
@@ -321,10 +321,18 @@ class FluidSolver:
         ]
 
     def _wcsph_commands(self, st: FluidState) -> list:
-        """extrapolate_wall_state; compute_forces; compute_density_rate; integrate (``cosim.fluid.wcsph``)."""
+        """update_free_liquid (if ``free_liquid``); extrapolate_wall_state; compute_forces; compute_density_rate;
+        integrate (``cosim.fluid.wcsph``)."""
         m, prm, n, nb = self.model, self.model.params, self.n_particles, self.model.n_boundary
         rec = self._rec
         ops = []
+        if self.config.free_liquid:
+            ops.append(rec(
+                wcsph.update_free_liquid, n,
+                [prm, m.grid.spec, m.vessels, m.b_volume, self._motions, st.x, st.active, m.grid.cell_start, m.grid.cell_end,
+                 self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end],
+                [st.free, st.rho, st.p],
+            ))
         if nb:
             ops.append(rec(
                 bd.extrapolate_wall_state, nb,
@@ -335,7 +343,7 @@ class FluidSolver:
             wcsph.compute_forces, n,
             [
                 prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel,
-                self._motions, st.x, st.v, st.rho, st.p, st.active, m.grid.cell_start, m.grid.cell_end,
+                self._motions, st.x, st.v, st.rho, st.p, st.active, st.free, m.grid.cell_start, m.grid.cell_end,
                 self._bx, self._bv, self._b_p, self._b_rho, self._b_v_noslip,
                 m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, self._row,
             ],
@@ -350,7 +358,7 @@ class FluidSolver:
             [self._drho],
         ))
         ops.append(rec(
-            wcsph.integrate, n, [*self._integrate_model_args(), self._drho, self._acc],
+            wcsph.integrate, n, [*self._integrate_model_args(), self._drho, self._acc, st.free],
             [st.x, st.v, st.rho, st.p, st.active, self._wall_force, self._wall_torque, self._diag_f, self._diag_i],
         ))
         return ops
@@ -460,6 +468,11 @@ class FluidSolver:
     def active_mask(self) -> np.ndarray:
         """(N,) bool: still simulated (False once spilled out of the domain)."""
         return self._in_id_order(self.state.active).astype(bool)
+
+    def free_mask(self) -> np.ndarray:
+        """(N,) bool: free liquid (outside every vessel, or back inside but not yet packed: summation density, no
+        tension; ``FluidConfig.free_liquid``). Always False under DFSPH, whose density is the summation density."""
+        return self._in_id_order(self.state.free).astype(bool)
 
     def vessel_poses(self) -> list[Pose]:
         """Current world poses of the vessel frames (as simulated: projected onto the pour plane in 2-D)."""

@@ -31,16 +31,18 @@ def kernel_gradient(prm: SPHParams, r: wp.vec3, r2: float) -> wp.vec3:
 
 @wp.func
 def viscous_pair(
-    prm: SPHParams, mass_j: float, r: wp.vec3, r2: float, gw: wp.vec3, v_rel: wp.vec3, v_rel_laminar: wp.vec3, rho_i: float, rho_j: float
+    prm: SPHParams, alpha: float, mass_j: float, r: wp.vec3, r2: float, gw: wp.vec3, v_rel: wp.vec3, v_rel_laminar: wp.vec3, rho_i: float,
+    rho_j: float,
 ) -> wp.vec3:
     """Acceleration (m/s^2) of particle i from neighbour j of mass ``mass_j``: Monaghan (1992) artificial viscosity
-    on the approaching relative velocity ``v_rel`` = v_i - v_j (scaled by the configured c0) plus Morris et al.
-    (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the neighbour's, or a wall's no-slip, velocity)."""
+    with coefficient ``alpha`` on the approaching relative velocity ``v_rel`` = v_i - v_j (scaled by the configured
+    c0) plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the neighbour's, or a wall's
+    no-slip, velocity)."""
     a = wp.vec3(0.0)
     vr = wp.dot(v_rel, r)
     if vr < 0.0:
         mu = prm.h * vr / (r2 + prm.eta2)
-        a += (mass_j * prm.alpha * prm.sound_speed * mu / (0.5 * (rho_i + rho_j))) * gw
+        a += (mass_j * alpha * prm.sound_speed * mu / (0.5 * (rho_i + rho_j))) * gw
     a += (mass_j * prm.nu * (1.0 / rho_i + 1.0 / rho_j) * wp.dot(r, gw) / (r2 + prm.eta2)) * v_rel_laminar
     return a
 
@@ -138,6 +140,7 @@ def gather_particles(
     pid: wp.array(dtype=wp.int32),
     kappa_density: wp.array(dtype=float),
     kappa_divergence: wp.array(dtype=float),
+    free: wp.array(dtype=wp.int32),
     x_out: wp.array(dtype=wp.vec3),
     v_out: wp.array(dtype=wp.vec3),
     rho_out: wp.array(dtype=float),
@@ -146,6 +149,7 @@ def gather_particles(
     pid_out: wp.array(dtype=wp.int32),
     kappa_density_out: wp.array(dtype=float),
     kappa_divergence_out: wp.array(dtype=float),
+    free_out: wp.array(dtype=wp.int32),
 ):
     """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
     i = wp.tid()
@@ -158,6 +162,7 @@ def gather_particles(
     pid_out[i] = pid[src]
     kappa_density_out[i] = kappa_density[src]
     kappa_divergence_out[i] = kappa_divergence[src]
+    free_out[i] = free[src]
 
 
 @wp.kernel

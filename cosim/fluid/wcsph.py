@@ -1,5 +1,13 @@
 """Weakly compressible SPH stages (warp kernels).
 
+update_free_liquid: free liquid (``FluidConfig.free_liquid``): a particle outside every vessel's inner volume
+  takes the memoryless, tension-free summation density max(sum_j m W_ij, rho0) each substep; back inside a
+  vessel it stays free until packed (summation density >= rho0), then the continuity equation takes over from
+  there. Why: the continuity density's tension (a stretched stream is below rest density) pulls the falling
+  stream back toward the vessel it left, 16-22 mm short of its parabola in ``cosim validate free-fall``; but
+  without tension the continuity density cannot hold caught liquid together, because it remembers the loose
+  packing a drop arrived in (its offset from the summation density) and props the caught liquid up. Free liquid
+  pairs use ``free_artificial_viscosity``, so its impacts are inelastic.
 compute_forces: per particle, over fluid and wall neighbours,
   - the acceleration: symmetric pressure gradient, the dummy wall particles entering like liquid particles of
     mass rho0 V_w with their extrapolated pressure (Adami et al. 2012, see ``cosim.fluid.boundary``); Monaghan
@@ -10,7 +18,8 @@ compute_density_rate: continuity equation (liquid and wall particles) evaluated 
   delta-SPH diffusion with the renormalised density gradient of Antuono et al. (2010), so a resting column keeps
   its hydrostatic density profile and loose liquid exchanges nothing.
 integrate: symplectic Euler, i.e. leapfrog with velocities at half steps: v += dt a(rho_n); rho += dt
-  Drho(v_new) (safety floor 0.8 rho0, see the kernel); x += dt v_new; p from the Tait equation. (Updating rho with the old velocity instead would be forward Euler for the acoustic
+  Drho(v_new) (safety floor 0.8 rho0, see the kernel; free liquid keeps its summation density); x += dt v_new;
+  p from the Tait equation. (Updating rho with the old velocity instead would be forward Euler for the acoustic
   waves and amplify them every step.) Then the wall guard, deactivation outside the domain, the equation of
   state and the substep's diagnostics.
 """
@@ -19,11 +28,12 @@ from __future__ import annotations
 
 import warp as wp
 
-from cosim.fluid.boundary import VesselGeometry, VesselMotion
+from cosim.fluid.boundary import VesselGeometry, VesselMotion, inside_vessel
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair
+from cosim.fluid.sph_kernels import kernel_w
 
 # The renormalisation matrix L^-1 (identity for a full kernel support) is used only where det L exceeds this:
 # near-empty supports (spray, a lone particle) give no meaningful density gradient.
@@ -33,18 +43,103 @@ MIN_DENSITY_RATIO = wp.constant(0.8)
 
 @wp.func
 def tait_pressure(prm: SPHParams, rho: float) -> float:
-    """Tait equation of state (seed Eq. 5) with the artificial sound speed: p = B ((rho/rho0)^gamma - 1)."""
-    return prm.eos_b * (wp.pow(rho / prm.rest_density, prm.gamma) - 1.0)
+    """Tait equation of state (seed Eq. 5) with the artificial sound speed, p = B ((rho/rho0)^gamma - 1), its
+    tension clamped at ``max_tension`` (``FluidConfig.max_tension``)."""
+    return wp.max(prm.eos_b * (wp.pow(rho / prm.rest_density, prm.gamma) - 1.0), -prm.max_tension)
+
+
+@wp.func
+def tait_elastic_energy(prm: SPHParams, rho: float) -> float:
+    """The unclamped Tait liquid's u = integral of p / rho^2 from rho0 to rho =
+    (B / rho0) (r^(gamma - 1) / (gamma - 1) + 1 / r - gamma / (gamma - 1)), r = rho / rho0 (J/kg)."""
+    r = rho / prm.rest_density
+    g1 = prm.gamma - 1.0
+    return (prm.eos_b / prm.rest_density) * (wp.pow(r, g1) / g1 + 1.0 / r - prm.gamma / g1)
 
 
 @wp.func
 def tait_internal_energy(prm: SPHParams, rho: float) -> float:
-    """Elastic energy per unit mass the Tait liquid stores at density rho (J/kg): u = integral of p / rho^2 from
-    rho0 to rho = (B / rho0) (r^(gamma - 1) / (gamma - 1) + 1 / r - gamma / (gamma - 1)), r = rho / rho0 (>= 0,
-    zero at rest density)."""
-    r = rho / prm.rest_density
-    g1 = prm.gamma - 1.0
-    return (prm.eos_b / prm.rest_density) * (wp.pow(r, g1) / g1 + 1.0 / r - prm.gamma / g1)
+    """Elastic energy per unit mass the liquid stores at density rho (J/kg), the integral of p / rho^2 from rho0
+    to rho of :func:`tait_pressure` (>= 0, zero at rest density): the Tait energy, and below the tension clamp's
+    density rho_t, u(rho_t) + max_tension (1 / rho - 1 / rho_t)."""
+    if rho >= prm.tension_density:
+        return tait_elastic_energy(prm, rho)
+    rt = prm.tension_density
+    return tait_elastic_energy(prm, rt) + prm.max_tension * (1.0 / rho - 1.0 / rt)
+
+
+@wp.func
+def inside_any_vessel(prm: SPHParams, vessels: wp.array(dtype=VesselGeometry), motions: wp.array(dtype=VesselMotion), x: wp.vec3) -> bool:
+    """Whether x is in some vessel's inner volume (below its rim) at the substep's start pose."""
+    for k in range(prm.n_vessels):
+        m = motions[k]
+        if inside_vessel(wp.transpose(m.r_now) @ (x - m.p_now), vessels[k], prm.dim) != 0:
+            return True
+    return False
+
+
+@wp.kernel
+def update_free_liquid(
+    # Model
+    prm: SPHParams,
+    g: GridSpec,
+    vessels: wp.array(dtype=VesselGeometry),
+    b_volume: wp.array(dtype=float),
+    # State in
+    motions: wp.array(dtype=VesselMotion),
+    x: wp.array(dtype=wp.vec3),
+    active: wp.array(dtype=wp.int32),
+    cell_start: wp.array(dtype=wp.int32),
+    cell_end: wp.array(dtype=wp.int32),
+    bx: wp.array(dtype=wp.vec3),
+    b_order: wp.array(dtype=wp.int32),
+    b_cell_start: wp.array(dtype=wp.int32),
+    b_cell_end: wp.array(dtype=wp.int32),
+    # State in/out
+    free: wp.array(dtype=wp.int32),
+    rho: wp.array(dtype=float),
+    p: wp.array(dtype=float),
+):
+    """Free liquid: a particle outside every vessel's inner volume (the falling stream, spray, a splash above a
+    rim) is free, and stays free until, back inside a vessel, it is packed into the liquid there. A free particle's
+    density is the summation density sum_j m W_ij + sum_b rho0 V_b W_ib (normalised by a resting lattice's kernel
+    sum), clamped below at rho0: memoryless (it sees the packing, whatever the particle went through in flight) and
+    without tension (liquid in the air is at ambient pressure; the continuity density's tension would pull the
+    stream back toward the vessel it left). It becomes bound when its summation density reaches rho0 inside a
+    vessel; the continuity equation then continues from that density, so the pressure is continuous and the
+    caught liquid keeps no memory of the loose packing it arrived in."""
+    i = wp.tid()
+    if active[i] == 0:
+        return
+    xi = x[i]
+    inside = inside_any_vessel(prm, vessels, motions, xi)
+    if inside and free[i] == 0:
+        return
+    support2 = prm.support * prm.support
+    density = prm.mass * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
+    c = grid_cell(g, xi)
+    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
+        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
+            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
+                cell = grid_index(g, cx, cy, cz)
+                for j in range(cell_start[cell], cell_end[cell]):
+                    r = xi - x[j]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2 or r2 < 1.0e-24:
+                        continue
+                    density += prm.mass * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                for kk in range(b_cell_start[cell], b_cell_end[cell]):
+                    b = b_order[kk]
+                    r = xi - bx[b]
+                    r2 = wp.dot(r, r)
+                    if r2 >= support2:
+                        continue
+                    density += prm.rest_density * b_volume[b] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+    density = density / prm.lattice_density
+    free[i] = wp.where(inside and density >= prm.rest_density, 0, 1)
+    rhoi = wp.max(density, prm.rest_density)
+    rho[i] = rhoi
+    p[i] = tait_pressure(prm, rhoi)
 
 
 @wp.kernel
@@ -62,6 +157,7 @@ def compute_forces(
     rho: wp.array(dtype=float),
     p: wp.array(dtype=float),
     active: wp.array(dtype=wp.int32),
+    free: wp.array(dtype=wp.int32),
     cell_start: wp.array(dtype=wp.int32),
     cell_end: wp.array(dtype=wp.int32),
     bx: wp.array(dtype=wp.vec3),
@@ -98,6 +194,8 @@ def compute_forces(
     # walls only push: a particle's tension (p < 0) must not pull it onto a wall (it would crawl along overhanging
     # outer faces, an artificial teapot effect); the walls' own pressure is clamped at 0 when extrapolated
     pi_wall_term = wp.max(p[i], 0.0) / (rhoi * rhoi)
+    free_i = free[i]
+    alpha_wall = wp.where(free_i != 0, prm.alpha_free, prm.alpha)
     support2 = prm.support * prm.support
     a = wp.vec3(0.0)
     moment = wp.mat33(0.0)
@@ -119,7 +217,8 @@ def compute_forces(
                     moment += vol * wp.outer(-r, gw)
                     gsum += (vol * (rhoj - rhoi)) * gw
                     a -= prm.mass * (pi_term + p[j] / (rhoj * rhoj)) * gw
-                    a += viscous_pair(prm, prm.mass, r, r2, gw, vij, vij, rhoi, rhoj)
+                    alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
+                    a += viscous_pair(prm, alpha, prm.mass, r, r2, gw, vij, vij, rhoi, rhoj)
                 for kk in range(b_cell_start[cell], b_cell_end[cell]):
                     b = b_order[kk]
                     xb = bx[b]
@@ -131,7 +230,7 @@ def compute_forces(
                     mw = prm.rest_density * b_volume[b]
                     rhob = b_rho[b]
                     ab = -(mw * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
-                    ab += viscous_pair(prm, mw, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
+                    ab += viscous_pair(prm, alpha_wall, mw, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
                     a += ab
                     kv = b_vessel[b]
                     m = motions[kv]
@@ -232,6 +331,7 @@ def integrate(
     row: wp.array(dtype=wp.int32),
     drho: wp.array(dtype=float),
     acc: wp.array(dtype=wp.vec3),
+    free: wp.array(dtype=wp.int32),
     # State in/out
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
@@ -258,6 +358,8 @@ def integrate(
     # stops the rare runaway expansion of a fragment whose support emptied (its density would otherwise fall
     # without bound, even below zero).
     rhoi = wp.max(rho[i] + h * drho[i], MIN_DENSITY_RATIO * prm.rest_density)
+    if free[i] != 0:
+        rhoi = rho[i]  # free liquid: the summation density, recomputed at the next substep's start
     kept = finish_particle(
         prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, s, i, x_old, xi, vi, rhoi, h,
         x, v, active, wall_force, wall_torque, diag_f, diag_i,

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from cosim.validation import coupling_static, dam_break, hydrostatic, moving_vessel, slosh
+from cosim.validation import coupling_static, dam_break, free_fall, hydrostatic, moving_vessel, slosh
 from cosim.validation.common import CaseResult
 
 
@@ -30,5 +30,6 @@ CASES: dict[str, Case] = {
         coupling_static.Params, coupling_static.run, coupling_static.plot, "held full vessel: reaction and joint torques"
     ),
     "shake": Case(moving_vessel.Params, moving_vessel.run_shake, moving_vessel.plot, "full vessel shaken at resonance"),
+    "free-fall": Case(free_fall.Params, free_fall.run, free_fall.plot, "outflow particles vs their free-fall parabolas (seed Eqs. 6-7)"),
 }
-DEFAULT_CASES = ("hydrostatic", "slosh", "dam-break", "coupling-static")
+DEFAULT_CASES = ("hydrostatic", "slosh", "dam-break", "free-fall", "coupling-static")

@@ -1,0 +1,154 @@
+"""Free fall of the outflow: particles leaving over the pour lip must follow the parabola of seed Eqs. 6-7.
+
+The seed's vessel, filled to A, is tilted about its pour lip at ``rate`` up to ``angle`` and held, as in the
+``tilt`` case; the liquid pours over the lip and falls. Every particle is followed (numpy, from positions and
+velocities at every 2 ms sample): its launch state is taken at the first sample where it is more than
+``launch_spacings`` particle spacings beyond the lip (the outer top edge of the wall the liquid sees), outside the
+vessel; it lands where it first crosses the plane ``drop`` below the lip (linear interpolation between samples).
+Its landing error is the landed x minus the x its own launch state predicts for free fall (z = z0 + v_z t -
+g t^2 / 2, x = x0 + v_x t; shared/reference/README.md, "free fall of the outflow jet").
+
+This isolates the liquid's physics from the controller's measurement of the jet (``cosim pour``'s landing
+prediction from the mean outflow velocity at the lip): a stream that the liquid's own forces pull back while it
+falls (continuity WCSPH's tension, README) lands short of every particle's parabola.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from cosim.checks import check_positive, check_range
+from cosim.fluid.config import GRAVITY
+from cosim.fluid.solver import FluidSolver
+from cosim.frames import Pose
+from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
+from cosim.validation.scripted import FALL_HEIGHT, domain_around, run_scripted, tilt_about_lip
+from cosim.vessel import VesselSpec, seed_pouring_vessel
+
+# Acceptance: the median landing error of the followed particles within 10 mm, the landing accuracy issue 4 asks
+# of the pour (there measured against the controller's prediction, which adds the measurement of the jet).
+LANDING_TOLERANCE = 0.010  # m
+MIN_FOLLOWED = 20  # particles that must land for the median to mean something
+
+
+@dataclass(frozen=True)
+class Params(FluidCaseParams):
+    """fill: m. rate: deg/s. angle: deg. hold: s the tilted vessel is held while the liquid keeps pouring. drop: m
+    below the lip where particles land. launch_spacings: how far beyond the lip (in particle spacings) the launch
+    state is taken. particles_across: resolution across the vessel's inner width when ``spacing`` is not given
+    (the default scene's 32)."""
+
+    fill: float = 0.159
+    rate: float = 57.3
+    angle: float = 75.0
+    hold: float = 1.0
+    drop: float = 0.25
+    launch_spacings: float = 1.0
+    particles_across: int = 32
+
+    def __post_init__(self) -> None:
+        self.validate_common()
+        check_positive("fill", self.fill, "m", seed_pouring_vessel().inner_height)
+        check_positive("rate", self.rate, "deg/s", 600.0)
+        check_range("angle", self.angle, 0.0, 120.0, "deg", lo_open=True)
+        check_range("hold", self.hold, 0.0, 60.0, "s")
+        check_range("drop", self.drop, 0.05, FALL_HEIGHT, "m")
+        check_range("launch_spacings", self.launch_spacings, 0.0, 10.0)
+
+    def spec(self) -> VesselSpec:
+        return seed_pouring_vessel()
+
+    @property
+    def resolved_spacing(self) -> float:
+        return self.spacing if self.spacing is not None else self.spec().inner_width / self.particles_across
+
+
+class ParticleFollower:
+    """Observer of :func:`run_scripted`: each particle's launch state and landing x (world frame, m, m/s)."""
+
+    def __init__(self, spec: VesselSpec, launch_offset: float, drop: float) -> None:
+        self.spec = spec
+        self.launch_offset = launch_offset
+        self.drop = drop
+
+    def start(self, solver: FluidSolver) -> None:
+        # the lip the liquid sees: the outer top edge of the wall's dummy layers (vessel frame)
+        self.lip_local = np.array([0.5 * self.spec.inner_width + float(solver.model.wall_thickness[0]), 0.0, self.spec.inner_height])
+        n = solver.n_particles
+        self.launch = np.full((n, 5), np.nan)  # t, x, z, v_x, v_z at launch
+        self.landed_x = np.full(n, np.nan)
+        self.previous = solver.positions()
+        self.t_previous = solver.time
+
+    def sample(self, solver: FluidSolver, before: Pose, after: Pose, x: np.ndarray, active: np.ndarray) -> None:
+        lip = after.transform(self.lip_local[None, :])[0]
+        new = np.isnan(self.launch[:, 0]) & active & (x[:, 0] > lip[0] + self.launch_offset)
+        if new.any():
+            v = solver.velocities()
+            self.launch[new] = np.column_stack([np.full(new.sum(), solver.time), x[new, 0], x[new, 2], v[new, 0], v[new, 2]])
+        plane = self.launch[:, 2] - self.drop
+        crossing = np.isfinite(self.launch[:, 0]) & np.isnan(self.landed_x) & (self.previous[:, 2] >= plane) & (x[:, 2] < plane)
+        crossing &= np.abs(x[:, 2] - self.previous[:, 2]) > 0.0
+        s = (self.previous[crossing, 2] - plane[crossing]) / (self.previous[crossing, 2] - x[crossing, 2])
+        self.landed_x[crossing] = self.previous[crossing, 0] + s * (x[crossing, 0] - self.previous[crossing, 0])
+        self.previous = x
+
+    def errors(self) -> tuple[np.ndarray, np.ndarray]:
+        """(launch times s, landing errors m: landed x minus the free-fall prediction) of the landed particles."""
+        done = np.isfinite(self.landed_x)
+        t, x0, z0, vx, vz = self.launch[done].T
+        fall = (vz + np.sqrt(vz * vz + 2.0 * GRAVITY * self.drop)) / GRAVITY
+        return t, self.landed_x[done] - (x0 + vx * fall)
+
+
+def run(p: Params) -> CaseResult:
+    spec = p.spec()
+    dx = p.resolved_spacing
+    cfg = case_fluid_config(p.dim, dx, max(p.fill, FALL_HEIGHT), spec.section_depth, *domain_around(spec, 0.0), p.solver, numerics=p.numerics)
+    pose_at = tilt_about_lip(spec, math.radians(p.rate), math.radians(p.angle))
+    duration = p.angle / p.rate + p.hold
+    follower = ParticleFollower(spec, p.launch_spacings * dx, p.drop)
+    run_ = run_scripted(spec, p.fill, cfg, pose_at, duration, device=p.device, observer=follower)
+    t_launch, errors = follower.errors()
+    count = len(errors)
+    median = float(np.median(np.abs(errors))) if count else float("nan")
+    mean = float(np.mean(errors)) if count else float("nan")
+    metrics = [
+        Metric("run completed", 0.0 if run_.failure else 1.0, 1.0, 1.0 if run_.failure else 0.0, 0.0, "", absolute=True),
+        Metric("particles followed to the landing plane", float(count), float(MIN_FOLLOWED), 0.0 if count >= MIN_FOLLOWED else 1.0, 0.0, "",
+               absolute=True),
+        Metric("landing error vs own parabola (median |.|)", median, 0.0, median, LANDING_TOLERANCE, "m", absolute=True),
+    ]
+    raw = {
+        "failure": run_.failure,
+        "launch_time": t_launch.tolist(),
+        "landing_error": errors.tolist(),
+        "median_abs_error": median,
+        "mean_error": mean,
+        "p90_abs_error": float(np.quantile(np.abs(errors), 0.9)) if count else float("nan"),
+        "particles": run_.solver.n_particles,
+        "steps": run_.solver.step_count,
+        "simulated_time": run_.solver.time,
+    }
+    params = dict(fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, rate=p.rate, angle=p.angle, hold=p.hold,
+                  drop=p.drop, launch_spacings=p.launch_spacings)
+    return CaseResult("free-fall", params, metrics, raw, run_.wall_time)
+
+
+def plot(result: CaseResult, path) -> None:
+    fig, ax, plt = new_figure(
+        f"Free fall ({result.parameters['dim']}-D): landing {result.parameters['drop']:g} m below the lip vs each particle's parabola"
+    )
+    t, e = np.asarray(result.raw["launch_time"]), np.asarray(result.raw["landing_error"])
+    ax.plot(t, 1e3 * e, "o", ms=3, label="SPH particle: landed x - free-fall x")
+    tol = 1e3 * LANDING_TOLERANCE
+    ax.axhspan(-tol, tol, color="g", alpha=0.15, label=f"+-{tol:g} mm")
+    ax.set_xlabel("launch time (s)")
+    ax.set_ylabel("landing error (mm)")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
