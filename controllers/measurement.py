@@ -35,9 +35,10 @@ class LiquidMeasurement:
       (particles within one particle spacing dx of the crest's world x, above it): z of the highest such particle
       centre + dx/2 - z of the crest. Otherwise: the height of the theta1 fit line above the crest along world z,
       clipped to <= 0 (:func:`controllers.geometry.height_above`). h_q > 0 means outflow.
-    v_q: m/s, mean world-x velocity of the liquid particles leaving over the lip: those outside the inner box
-      with world x in [x_lip - dx, x_lip + 3 dx] and z in [z_lip - 3 dx, z_lip + dx + max(h_q, 0)] (the stream
-      within a few spacings of the lip); 0 when there are none.
+    v_q: m/s, mean world-x velocity of the liquid particles that have just left over the lip: those outside the
+      inner box with world x in [x_lip + dx, x_lip + 4 dx] and z in [z_lip - 6 dx, z_lip + dx + max(h_q, 0)] (the
+      stream one to four spacings past the lip, where it already falls freely: nearer the lip the liquid behind
+      still pushes it, and a launch state taken there predicts a landing 4-5 mm short); 0 when there are none.
     volume_in_pourer: m^3, liquid inside the pourer's inner box.
     poured_volume: m^3, liquid that has left the pourer since the start (initial minus in-pourer volume).
     lip_x, lip_z: m, world position of the pour lip (outer top edge of the +x wall).

@@ -67,10 +67,12 @@ def test_liquid_over_the_crest_and_leaving_at_the_lip():
     crest = np.array([0.5 * SPEC.inner_width, 0.0, SPEC.inner_height])
     over = crest + np.array([0.0, 0.0, 0.004])  # a particle centre 4 mm over the crest
     lip = GEO.lip_local
-    leaving = np.array([lip + [0.002, 0.0, 0.001], lip + [-0.003, 0.0, 0.0]])
+    # two particles past the lip by one to four spacings (measured), one still at the lip (not: the liquid behind
+    # it still pushes it there)
+    leaving = np.array([lip + [1.5 * DX, 0.0, 0.001], lip + [3.5 * DX, 0.0, -5.0 * DX], lip + [0.5 * DX, 0.0, 0.0]])
     x = np.vstack([over, leaving])
-    v = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, -0.1], [0.5, 0.0, -0.3]])
-    m = measure(0.5, GEO, pose, Pose((0.4, 0.0, -0.3)), x, v, np.ones(3, bool), 0.0029)
+    v = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, -0.1], [0.5, 0.0, -0.3], [0.1, 0.0, 0.0]])
+    m = measure(0.5, GEO, pose, Pose((0.4, 0.0, -0.3)), x, v, np.ones(4, bool), 0.0029)
     # the probe reads float32 positions, as the solver holds them
     assert m.h_q == pytest.approx(float(np.float32(over[2])) + 0.5 * DX - crest[2], abs=1e-12)
     assert m.v_q == pytest.approx(0.4)

@@ -170,7 +170,8 @@ def sum_leaving_stream(
     sums: wp.array2d(dtype=float),
 ):
     """Per chunk of ``chunk`` consecutive particles, in order: count, sum vx, sum vz, sum x, sum z of the particles
-    leaving over the lip (outside the inner box, x in [x_lip - dx, x_lip + 3 dx], z in [z_lip - 3 dx, top])."""
+    that have just left over the lip (outside the inner box, x in [x_lip + dx, x_lip + 4 dx], z in
+    [z_lip - 6 dx, top])."""
     k = wp.tid()
     count = float(0.0)
     svx = float(0.0)
@@ -181,7 +182,7 @@ def sum_leaving_stream(
         if active[i] == 0:
             continue
         xi = x[i]
-        if xi[0] < lip[0] - dx or xi[0] > lip[0] + 3.0 * dx or xi[2] < lip[2] - 3.0 * dx or xi[2] > top:
+        if xi[0] < lip[0] + dx or xi[0] > lip[0] + 4.0 * dx or xi[2] < lip[2] - 6.0 * dx or xi[2] > top:
             continue
         if inner_local(f, xi)[3] > 0.0:
             continue

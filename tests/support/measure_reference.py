@@ -49,7 +49,7 @@ def reference_measure(geo: MeasurementGeometry, pourer: Pose, catcher: Pose, x: 
         h_q = -height
     lip = pourer.transform(geo.lip_local[None, :])[0]
     top_z = lip[2] + dx + max(h_q, 0.0)
-    leaving = (x[:, 0] >= lip[0] - dx) & (x[:, 0] <= lip[0] + 3 * dx) & (x[:, 2] >= lip[2] - 3 * dx) & (x[:, 2] <= top_z) & ~inner
+    leaving = (x[:, 0] >= lip[0] + dx) & (x[:, 0] <= lip[0] + 4 * dx) & (x[:, 2] >= lip[2] - 6 * dx) & (x[:, 2] <= top_z) & ~inner
     if leaving.any():
         v_q, v_q_z = v[leaving][:, [0, 2]].mean(axis=0)
         jet_dx, jet_dz = x[leaving][:, [0, 2]].mean(axis=0) - lip[[0, 2]]
