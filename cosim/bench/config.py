@@ -21,6 +21,7 @@ class BenchCase(Enum):
     HYDROSTATIC = "hydrostatic"  # cosim.validation.hydrostatic: pressure against rho0 g (H - z)
     SLOSH = "slosh"  # cosim.validation.slosh: first-mode frequency against the seed's Eq. 17
     DAM_BREAK = "dam-break"  # cosim.validation.dam_break: surge front against Martin & Moyce (1952)
+    FREE_FALL = "free-fall"  # cosim.validation.free_fall: outflow particles against their free-fall parabolas
     COUPLING_STATIC = "coupling-static"  # cosim.validation.coupling_static: reaction against the liquid's weight
     POUR = "pour"  # the pour scene, compared with another pour run (a finer reference, or the same without a skip)
 
@@ -39,7 +40,8 @@ class BenchConfig:
     pressure_solver: :class:`cosim.fluid.config.PressureSolver`.
     device: 'cpu' or 'cuda[:N]'.
     length: how long the case runs, in the case's own unit: hydrostatic s held, slosh periods after the pulse,
-        dam-break dimensionless time T = t sqrt(2 g / a), coupling-static s held, pour s simulated
+        dam-break dimensionless time T = t sqrt(2 g / a), free-fall s held after the tilt, coupling-static s held,
+        pour s simulated
         (coupling.max_duration). (0, 600]
     options: pour scene options as (dotted scene key, value) pairs, e.g. (("coupling.coupling", "one_way"),),
         sorted by key; only for the pour.

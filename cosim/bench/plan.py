@@ -42,11 +42,13 @@ class CaseAxes:
 
 
 # Resolution sweeps end at each case's own default resolution (cosim.validation: 40 across the tank, 50 across
-# the dam-break column, 24 across the pourer for coupling-static; the default scene: 32 across the pourer).
+# the dam-break column, 32 across the pourer for free-fall, 24 across the pourer for coupling-static; the default
+# scene: 32 across the pourer).
 FULL_AXES = {
     BenchCase.HYDROSTATIC: CaseAxes((20, 30, 40), 1.0),  # s held (the validation holds 2 s)
     BenchCase.SLOSH: CaseAxes((20, 30, 40), 3.0),  # periods (the validation measures 5), fill A = 0.108 m
     BenchCase.DAM_BREAK: CaseAxes((25, 50), 3.0),  # T up to the acceptance window's end
+    BenchCase.FREE_FALL: CaseAxes((16, 24, 32), 1.0),  # s held after the tilt (as the validation)
     BenchCase.COUPLING_STATIC: CaseAxes((16, 24), 0.5),  # s held
     # the pour varies kernel, CFL and solver at 24 across (32 costs about 2.8 x more) and leaves out CFL 0.15 (1.7 x
     # the cost), to keep the plan within its budget

@@ -25,6 +25,7 @@ CASE_ERRORS = {
     BenchCase.HYDROSTATIC: ("pressure_error", "density_error"),
     BenchCase.SLOSH: ("frequency_error",),
     BenchCase.DAM_BREAK: ("front_error",),
+    BenchCase.FREE_FALL: ("fall_error_m",),
     BenchCase.COUPLING_STATIC: ("reaction_error", "torque_error"),
     BenchCase.POUR: POUR_ERRORS,
 }
@@ -33,6 +34,7 @@ ERROR_TITLES = {
     "density_error": "max density error",
     "frequency_error": "slosh frequency error vs Eq. 17",
     "front_error": "worst front error vs Martin & Moyce (T <= 3)",
+    "fall_error_m": "median landing error vs own free-fall parabola (m)",
     "reaction_error": "vertical reaction error vs weight",
     "torque_error": "joint torque error vs rigid payload",
     "poured_curve_error": "poured-volume curve RMS diff / initial volume",

@@ -46,6 +46,8 @@ def case_width(cfg: BenchConfig) -> float:
         from cosim.robots.scene_config import ArmRole
 
         return RobotScene.load().arms[ArmRole.POUR].vessel.inner_width
+    if cfg.case is BenchCase.FREE_FALL:
+        return CASES[cfg.case.value].params().spec().inner_width
     return CASES[cfg.case.value].params().width
 
 
@@ -54,7 +56,7 @@ def _validation_params(cfg: BenchConfig):
     common = dict(spacing=spacing, dim=cfg.dim, device=cfg.device, solver=cfg.pressure_solver, numerics=numerics(cfg))
     length = {
         BenchCase.HYDROSTATIC: "duration", BenchCase.SLOSH: "periods", BenchCase.DAM_BREAK: "t_max",
-        BenchCase.COUPLING_STATIC: "duration",
+        BenchCase.FREE_FALL: "hold", BenchCase.COUPLING_STATIC: "duration",
     }[cfg.case]
     return CASES[cfg.case.value].params(**common, **{length: cfg.length})
 
@@ -69,12 +71,16 @@ def validation_errors(case: BenchCase, result: CaseResult) -> dict[str, float]:
     if case is BenchCase.DAM_BREAK:
         scored = [abs(x.error) for x in m if math.isfinite(x.tolerance)]  # the acceptance window T <= 3
         return {"front_error": max(scored) if scored else math.nan}
+    if case is BenchCase.FREE_FALL:
+        return {"fall_error_m": float(result.raw["median_abs_error"])}
     return {"reaction_error": abs(m[0].error), "torque_error": abs(m[1].error)}
 
 
 def _simulated_time(case: BenchCase, result: CaseResult) -> float:
     if case in (BenchCase.SLOSH, BenchCase.DAM_BREAK):
         return float(result.raw["t"][-1])
+    if case is BenchCase.FREE_FALL:
+        return float(result.raw["simulated_time"])
     return float(result.parameters["duration"])
 
 
