@@ -82,12 +82,16 @@ class FluidSettings:
     def __post_init__(self) -> None:
         check_int("fluid.dim", self.dim, 2, 3)
         check_int("fluid.particles_across", self.particles_across, 8, 400)
+        FluidConfig(**self._numerics())  # every numerical setting's own range check, when the scene is read
 
     def fluid_config(self, pourer_width: float) -> FluidConfig:
         """The solver configuration (domain and expected speed are set from the robot scene by the coupling)."""
-        return FluidConfig(
+        return FluidConfig(spacing=pourer_width / self.particles_across, **self._numerics())
+
+    def _numerics(self) -> dict:
+        """The FluidConfig fields these settings set (all but the spacing, domain and expected speed)."""
+        return dict(
             dim=self.dim,
-            spacing=pourer_width / self.particles_across,
             kernel=self.kernel,
             pressure_solver=self.pressure_solver,
             smoothing_ratio=self.smoothing_ratio,

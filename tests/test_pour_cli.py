@@ -134,6 +134,8 @@ def test_same_scene_twice_gives_byte_identical_trajectories(tmp_path):
         ("[liquid]\nfill_depth = 0.5\n", "liquid.fill_depth"),
         ("[liquid]\nfill_depth = nan\n", "liquid.fill_depth"),
         ("[controller.cfs]\nh_q_ref = 1.0\n", "cfs.h_q_ref"),
+        ("[fluid]\nmax_tension = -1.0\n", "fluid.max_tension"),
+        ("[fluid]\nfree_artificial_viscosity = 2.0\n", "fluid.free_artificial_viscosity"),
         ("device = 'tpu'\n", "scene.device"),
         ("this is not toml", "not a valid TOML file"),
     ],
@@ -167,3 +169,12 @@ def test_scene_dump_round_trips(tmp_path, capsys):
     path.write_text(text)
     assert main(["scene", "--check", str(path)]) == 0
     assert capsys.readouterr().out == text
+
+
+def test_scene_check_refuses_a_numerical_setting_out_of_range(tmp_path, capsys):
+    # the fluid's numerical settings are range-checked when the scene is read, not only when a pour builds the solver
+    path = tmp_path / "scene.toml"
+    path.write_text("[fluid]\ncfl = 0.9\n")
+    assert main(["scene", "--check", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "fluid.cfl" in err[0]
