@@ -7,8 +7,8 @@ fine reference (:data:`REFERENCE_ACROSS`) that its resolution and numerics rows 
 options: pairs of runs that differ only in what a scene may skip, the second doing the full work.
 
 Cost: the full plan is sized to finish cold in about half an hour on a 2-core CPU; the pour runs
-:data:`POUR_SECONDS` of simulated time (the first slosh-induced outflow and about two thirds of the liquid), not
-the whole ~10 s pour.
+:data:`POUR_SECONDS` of simulated time (the slosh induction and the first outflow, 7 to 16 % of the liquid), not
+the whole ~19 s pour.
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ from cosim.pour_scene import FluidSettings
 POUR_SECONDS = 3.0  # s simulated per pour row
 REFERENCE_ACROSS = 48  # particles across the pourer of the reference pour (1.5 x the default scene's 32)
 CFL_LEVELS = (0.15, 0.4)  # besides the default 0.25 (the stress matrix goes to twice the default)
-# s, max_duration of the early-stop pair at 24 across (the pour is done after about 10 s; the run without the early
-# stop goes on to this; the default scene's 60 s would cost 5 x more)
-FULL_POUR_SECONDS = 14.0
+# s, max_duration of the early-stop pair at 24 across (the pour is done at about 14 s; the run without the early stop
+# goes on to this; the default scene's 60 s would cost 2.5 x more)
+FULL_POUR_SECONDS = 24.0
 DIM_PAIR_SECONDS = 2.0  # s simulated by the 2-D/3-D pair at 16 across (3-D costs about 30 x 2-D there)
 
 
