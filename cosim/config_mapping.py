@@ -1,7 +1,8 @@
 """TOML tables <-> frozen configuration dataclasses, 1:1.
 
 ``from_mapping(cls, table, path)`` builds ``cls`` from a (nested) mapping: keys are field names, nested dataclasses
-are sub-tables, enums are given by their string value, tuples as arrays, ``None`` fields are left out of the
+are sub-tables (a sub-table changes only its own keys of the parent's default, e.g. ``[coupling] start_delay = 1``
+keeps the scene's ``max_duration``, not the section class's), enums are given by their string value, tuples as arrays, ``None`` fields are left out of the
 file. An unknown key, a wrong type or a value out of range is one :class:`InputError` line naming the dotted field
 (range checks are the dataclasses' own ``__post_init__``). ``to_toml(obj)`` writes the TOML document of a
 configuration with every field's documentation (unit and range, from the dataclass docstrings) as a comment.
@@ -52,17 +53,17 @@ def _type_name(tp: Any) -> str:
     return getattr(tp, "__name__", str(tp).replace("typing.", ""))
 
 
-def _convert(value: Any, tp: Any, path: str) -> Any:
+def _convert(value: Any, tp: Any, path: str, default: Any = None) -> Any:
     origin = typing.get_origin(tp)
     if origin in (typing.Union, types.UnionType):
         args = [a for a in typing.get_args(tp) if a is not type(None)]
         if len(args) == 1:
-            return _convert(value, args[0], path)
+            return _convert(value, args[0], path, default)
         raise TypeError(f"unsupported union at {path}")
     if dataclasses.is_dataclass(tp):
         if not isinstance(value, dict):
             raise InputError(f"{path}: must be a table, got {type(value).__name__}")
-        return from_mapping(tp, value, path)
+        return from_mapping(tp, value, path, default if isinstance(default, tp) else None)
     if isinstance(tp, type) and issubclass(tp, enum.Enum):
         allowed = [m.value for m in tp]
         if value not in allowed:
@@ -98,16 +99,30 @@ def _convert(value: Any, tp: Any, path: str) -> Any:
     return value
 
 
-def from_mapping(cls: type, table: dict[str, Any], path: str) -> Any:
-    """Build the dataclass ``cls`` from ``table``; fields missing from the table keep their defaults."""
+def _default(obj: Any, f: dataclasses.Field) -> Any:
+    """The value field ``f`` has when the table leaves it out: ``obj``'s where a parent default is given, else the
+    field's own default (None where it has none)."""
+    if obj is not None:
+        return getattr(obj, f.name)
+    if f.default is not dataclasses.MISSING:
+        return f.default
+    if f.default_factory is not dataclasses.MISSING:
+        return f.default_factory()
+    return None
+
+
+def from_mapping(cls: type, table: dict[str, Any], path: str, default: Any = None) -> Any:
+    """Build the dataclass ``cls`` from ``table``; fields missing from the table keep the values of ``default`` (an
+    instance of ``cls``: the parent's default for this section), or the class defaults where it is None."""
     hints = typing.get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     unknown = sorted(set(table) - set(fields))
     if unknown:
         raise InputError(f"{path}.{unknown[0]}: unknown key (known keys: {', '.join(sorted(fields))})")
-    kwargs = {name: _convert(value, hints[name], f"{path}.{name}") for name, value in table.items()}
+    kwargs = {name: _convert(value, hints[name], f"{path}.{name}", _default(default, fields[name]))
+              for name, value in table.items()}
     try:
-        return cls(**kwargs)
+        return dataclasses.replace(default, **kwargs) if default is not None else cls(**kwargs)
     except InputError:
         raise
     except TypeError as exc:  # a required field is missing

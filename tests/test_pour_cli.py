@@ -15,6 +15,7 @@ from cosim.io.pour_series import read_series_csv
 from cosim.io.rerun_read import entity_paths, read_scalar_series
 from cosim.io.trajectory_csv import read_trajectory_csv
 from cosim.io.trajectory_json import read_trajectory_json
+from cosim.pour_scene import PourScene, load_scene
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 
@@ -178,3 +179,15 @@ def test_scene_check_refuses_a_numerical_setting_out_of_range(tmp_path, capsys):
     assert main(["scene", "--check", str(path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "fluid.cfl" in err[0]
+
+
+@pytest.mark.parametrize("toml", ["[coupling]\nstart_delay = 0.3\n", "[logging.recording]\nparticle_stride = 2\n"])
+def test_a_section_changes_only_its_own_keys_of_the_scene_default(tmp_path, toml):
+    # the scene's defaults for a section (coupling.max_duration 60 s, recording.particle_rate_hz 30 Hz) differ from
+    # the section classes' own defaults; a file that sets one key of the section must keep the scene's others
+    path = tmp_path / "scene.toml"
+    path.write_text(toml)
+    scene, default = load_scene(path), PourScene()
+    assert scene.coupling.max_duration == default.coupling.max_duration == 60.0
+    assert scene.logging.recording.particle_rate_hz == default.logging.recording.particle_rate_hz == 30.0
+    assert scene != default
