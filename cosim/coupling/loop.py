@@ -223,7 +223,7 @@ class CoupledPour:
         initial = self.geometry.initial_volume
         in_pourer, in_catcher = last.volume_in_vessel
         poured = initial - in_pourer
-        spilled = initial - in_pourer - in_catcher
+        spilled = max(initial - in_pourer - in_catcher, 0.0)  # volumes are particle counts x volume: -1e-19 is 0
         return {
             "initial_volume": initial,
             "poured_volume": poured,

@@ -101,7 +101,9 @@ def update_free_liquid(
     p: wp.array(dtype=float),
 ):
     """Free liquid: a particle outside every vessel's inner volume (the falling stream, spray, a splash above a
-    rim) is free, and stays free until, back inside a vessel, it is packed into the liquid there. A free particle's
+    rim) is free, and stays free until, back inside a vessel, it is packed into the liquid there. Liquid leaving a
+    vessel becomes free once it has separated (summation density below rho0); until then the continuity density
+    goes on, so its pressure does not jump when it passes the rim. A free particle's
     density is the summation density sum_j m W_ij + sum_b rho0 V_b W_ib (normalised by a resting lattice's kernel
     sum), clamped below at rho0: memoryless (it sees the packing, whatever the particle went through in flight) and
     without tension (liquid in the air is at ambient pressure; the continuity density's tension would pull the
@@ -136,7 +138,14 @@ def update_free_liquid(
                         continue
                     density += prm.rest_density * b_volume[b] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
     density = density / prm.lattice_density
-    free[i] = wp.where(inside and density >= prm.rest_density, 0, 1)
+    if free[i] == 0:
+        # bound liquid outside every vessel (leaving over a lip) stays bound while it is packed: its summation
+        # density then still carries the particle disorder's +-2-5 %, whose Tait pressure would kick it off the lip
+        if density >= prm.rest_density:
+            return
+        free[i] = 1
+    else:
+        free[i] = wp.where(inside and density >= prm.rest_density, 0, 1)
     rhoi = wp.max(density, prm.rest_density)
     rho[i] = rhoi
     p[i] = tait_pressure(prm, rhoi)
