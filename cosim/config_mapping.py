@@ -2,10 +2,11 @@
 
 ``from_mapping(cls, table, path)`` builds ``cls`` from a (nested) mapping: keys are field names, nested dataclasses
 are sub-tables (a sub-table changes only its own keys of the parent's default, e.g. ``[coupling] start_delay = 1``
-keeps the scene's ``max_duration``, not the section class's), enums are given by their string value, tuples as arrays, ``None`` fields are left out of the
-file. An unknown key, a wrong type or a value out of range is one :class:`InputError` line naming the dotted field
-(range checks are the dataclasses' own ``__post_init__``). ``to_toml(obj)`` writes the TOML document of a
-configuration with every field's documentation (unit and range, from the dataclass docstrings) as a comment.
+keeps the scene's ``max_duration``, not the section class's), enums are given by their string value, tuples as
+arrays, ``None`` fields are left out of the file. An unknown key, a wrong type or a value out of range is one
+:class:`InputError` line naming the dotted field (range checks are the dataclasses' own ``__post_init__``).
+``to_toml(obj)`` writes the TOML document of a configuration with every field's documentation (unit and range, from
+the dataclass docstrings) as a comment.
 """
 
 from __future__ import annotations

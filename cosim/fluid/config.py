@@ -55,11 +55,12 @@ class FluidConfig:
         equation of state: it uses c0 only as the velocity scale of the artificial viscosity, as WCSPH does.
     kinematic_viscosity: m^2/s, laminar viscosity (water 1.0e-6 at 20 C). [0, 0.01]
     artificial_viscosity: Monaghan alpha (dimensionless), also applied against walls. [0, 1]
-    free_liquid: WCSPH: True treats liquid outside every vessel (the falling stream, spray, a splash above a rim)
-        as free liquid: memoryless summation density clamped at rho0, so no tension pulls the stream back toward
-        the vessel it left, back to the continuity density once packed inside a vessel again
-        (:func:`cosim.fluid.wcsph.update_free_liquid`). False: the continuity density everywhere (its tension holds
-        the stream together and lands it short of its free-fall parabola, ``cosim validate free-fall``).
+    free_liquid: WCSPH: True treats liquid outside every vessel (the falling stream, spray, a splash above a rim) as
+        free liquid once it has separated (summation density below rho0): memoryless summation density clamped at
+        rho0, so no tension pulls the stream back toward the vessel it left, back to the continuity density once
+        packed inside a vessel again (:func:`cosim.fluid.wcsph.update_free_liquid`). False: the continuity density
+        everywhere (its tension holds the stream together and lands it short of its free-fall parabola, ``cosim
+        validate free-fall``).
     free_artificial_viscosity: Monaghan alpha of every pair with a free particle (and of a free particle against
         walls): free liquid has no tension to hold it together, so this is what makes its impacts inelastic
         (the first stream hitting an empty vessel, a drop on a wall); alpha acts only on approaching pairs, so

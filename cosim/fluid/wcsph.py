@@ -1,13 +1,13 @@
 """Weakly compressible SPH stages (warp kernels).
 
-update_free_liquid: free liquid (``FluidConfig.free_liquid``): a particle outside every vessel's inner volume
-  takes the memoryless, tension-free summation density max(sum_j m W_ij, rho0) each substep; back inside a
-  vessel it stays free until packed (summation density >= rho0), then the continuity equation takes over from
-  there. Why: the continuity density's tension (a stretched stream is below rest density) pulls the falling
-  stream back toward the vessel it left, 16-22 mm short of its parabola in ``cosim validate free-fall``; but
-  without tension the continuity density cannot hold caught liquid together, because it remembers the loose
-  packing a drop arrived in (its offset from the summation density) and props the caught liquid up. Free liquid
-  pairs use ``free_artificial_viscosity``, so its impacts are inelastic.
+update_free_liquid: free liquid (``FluidConfig.free_liquid``): a particle outside every vessel's inner volume that
+  has separated from the liquid (summation density below rho0) takes the memoryless, tension-free summation density
+  max(sum_j m W_ij, rho0) each substep; back inside a vessel it stays free until packed (summation density >= rho0),
+  then the continuity equation takes over from there. Why: the continuity density's tension (a stretched stream is
+  below rest density) pulls the falling stream back toward the vessel it left, 16-22 mm short of its parabola in
+  ``cosim validate free-fall``; but without tension the continuity density cannot hold caught liquid together,
+  because it remembers the loose packing a drop arrived in (its offset from the summation density) and props the
+  caught liquid up. Free liquid pairs use ``free_artificial_viscosity``, so its impacts are inelastic.
 compute_forces: per particle, over fluid and wall neighbours,
   - the acceleration: symmetric pressure gradient, the dummy wall particles entering like liquid particles of
     mass rho0 V_w with their extrapolated pressure (Adami et al. 2012, see ``cosim.fluid.boundary``); Monaghan
@@ -103,11 +103,11 @@ def update_free_liquid(
     """Free liquid: a particle outside every vessel's inner volume (the falling stream, spray, a splash above a
     rim) is free, and stays free until, back inside a vessel, it is packed into the liquid there. Liquid leaving a
     vessel becomes free once it has separated (summation density below rho0); until then the continuity density
-    goes on, so its pressure does not jump when it passes the rim. A free particle's
-    density is the summation density sum_j m W_ij + sum_b rho0 V_b W_ib (normalised by a resting lattice's kernel
-    sum), clamped below at rho0: memoryless (it sees the packing, whatever the particle went through in flight) and
-    without tension (liquid in the air is at ambient pressure; the continuity density's tension would pull the
-    stream back toward the vessel it left). It becomes bound when its summation density reaches rho0 inside a
+    goes on, so its pressure does not jump when it passes the rim. A free particle's density is the summation
+    density sum_j m W_ij + sum_b rho0 V_b W_ib (normalised by a resting lattice's kernel sum), clamped below at
+    rho0: memoryless (it sees the packing, whatever the particle went through in flight) and without tension
+    (liquid in the air is at ambient pressure; the continuity density's tension would pull the stream back toward
+    the vessel it left). It becomes bound when its summation density reaches rho0 inside a
     vessel; the continuity equation then continues from that density, so the pressure is continuous and the
     caught liquid keeps no memory of the loose packing it arrived in."""
     i = wp.tid()
