@@ -94,15 +94,18 @@ def after_flow_volume(
     max_rate: float,
     max_accel: float,
     tilt_rate: float = 0.0,
+    lag: float = 0.0,
 ) -> float:
     """Volume (m^3) that still leaves after the return starts, to stop a partial pour early by that much.
 
-    The return starts from the current tilt rate ``tilt_rate`` (rad/s, + forward; CFS is usually still tilting
-    forward), turns back with ``max_accel`` (rad/s^2) up to ``max_rate`` (rad/s); the crest rises over the surface
-    in proportion to the angle turned back (and sinks further while the vessel still moves forward) until, after
-    the vector-step angle for -h_q about ``lever`` (a, m), it clears the head ``h_q`` (m). Over a sharp crest the
-    outflow goes as h^(3/2), so the volume is outflow_rate (m^3/s) times the integral of (1 - back / angle)^(3/2)
-    over that time, back(t) the angle turned back.
+    The vessel follows its commands ``lag`` s late (the task-space smoothing and the arm): for that long it still
+    carries out CFS commands given before the stop, which hold the head, so the outflow goes on at
+    ``outflow_rate`` (m^3/s). Then the return acts: it starts from the tilt rate ``tilt_rate`` (rad/s, + forward;
+    CFS is usually still tilting forward), turns back with ``max_accel`` (rad/s^2) up to ``max_rate`` (rad/s); the
+    crest rises over the surface in proportion to the angle turned back (and sinks further while the vessel still
+    moves forward) until, after the vector-step angle for -h_q about ``lever`` (a, m), it clears the head ``h_q``
+    (m). Over a sharp crest the outflow goes as h^(3/2), so that part is outflow_rate times the integral of
+    (1 - back / angle)^(3/2) over that time, back(t) the angle turned back.
     """
     if h_q <= 0.0 or outflow_rate <= 0.0:
         return 0.0
@@ -117,4 +120,4 @@ def after_flow_volume(
     t = np.linspace(0.0, duration, AFTER_FLOW_SAMPLES)
     back = np.where(t < t_turn, -w0 * t + 0.5 * max_accel * t**2, back_at_turn + max_rate * (t - t_turn))
     head = np.clip(1.0 - back / angle, 0.0, None)
-    return float(outflow_rate * np.trapezoid(head**1.5, t))
+    return float(outflow_rate * (max(lag, 0.0) + np.trapezoid(head**1.5, t)))

@@ -101,6 +101,10 @@ class CfsConfig:
     max_tilt_hold: s, holding max_tilt this long also ends the pour (what is left cannot be poured). [0, 60]
     pivot_margin: m, least world height of the CFS pivot above the slosh pendulum's hinge (the pivot is the lip
       while the lip is that high; see controllers.cfs). [0, 0.2]
+    final_head_fraction: a partial pour holds this fraction of h_q_ref in its final stage, so that the outflow
+      (and with it the after-flow the stop has to predict) is smaller when it stops; 1 disables the stage. (0, 1]
+    final_stage_time: s, the final stage starts when the volume still to pour before the predicted after-flow
+      would leave in this time at the current outflow rate. [0, 10]
     """
 
     h_q_ref: float = 0.005
@@ -110,6 +114,8 @@ class CfsConfig:
     empty_fraction: float = 0.02
     max_tilt_hold: float = 3.0
     pivot_margin: float = 0.03
+    final_head_fraction: float = 0.5
+    final_stage_time: float = 0.8
 
     def __post_init__(self) -> None:
         check_range("cfs.h_q_ref", self.h_q_ref, 0.001, 0.05, "m")
@@ -119,6 +125,8 @@ class CfsConfig:
         check_range("cfs.empty_fraction", self.empty_fraction, 0.0, 0.5)
         check_range("cfs.max_tilt_hold", self.max_tilt_hold, 0.0, 60.0, "s")
         check_range("cfs.pivot_margin", self.pivot_margin, 0.0, 0.2, "m")
+        check_range("cfs.final_head_fraction", self.final_head_fraction, 0.0, 1.0, lo_open=True)
+        check_range("cfs.final_stage_time", self.final_stage_time, 0.0, 10.0, "s")
 
 
 @dataclass(frozen=True)

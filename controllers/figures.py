@@ -37,6 +37,7 @@ PHASE_COLOURS = {
     Phase.SIM_HOLD: "#fff3b0",
     Phase.SIM_DAMP: "#d4edda",
     Phase.CFS: "#d6e4f0",
+    Phase.CFS_FINAL: "#c3d5ea",
 }
 
 

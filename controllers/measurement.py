@@ -86,6 +86,7 @@ class Phase(Enum):
     SIM_DAMP = "sim_damp"  # t2: filtered PID on theta1
     APPROACH = "approach"  # without SIM: rate-limited tilt toward the crest about the pendulum hinge
     CFS = "cfs"  # constant flow: h_q held at its reference, about the lip
+    CFS_FINAL = "cfs_final"  # a partial pour's last part: CFS at a lower h_q reference, so that it stops cleanly
     RETURN = "return"  # back upright and home, rate-limited
     DONE = "done"
 

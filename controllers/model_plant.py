@@ -6,12 +6,14 @@ bounds the liquid's area (:mod:`controllers.geometry`); h_q is that line's heigh
 is the sharp-crested weir per unit depth q = (2/3) C_d sqrt(2 g) h_q^(3/2) with v_q = q / h_q (seed Sec. 2.2).
 Limits: linear slosh with the pendulum of the initial fill, no damping, no vertical-acceleration effect, no
 spill over the back wall, tilts below 90 deg. The arm is ideal: the pose moves linearly from one command to
-the next over one control period (a one-period lag).
+the next over one control period (a one-period lag), or carries out each command ``arm_delay_steps`` periods
+late (a slow arm, like the coupled pour's smoothed one).
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, field
 
 import control as ct
@@ -34,6 +36,7 @@ class ModelPlantConfig:
     catcher_rim_z: world z of vessel B's rim.
     discharge_coefficient: C_d of the weir outflow. (0, 1]
     substeps: integration steps per control period (the input is interpolated linearly). [1, 100]
+    arm_delay_steps: control periods by which the arm carries out each command late. [0, 100]
     """
 
     vessel: VesselGeometry = field(default_factory=VesselGeometry)
@@ -44,12 +47,16 @@ class ModelPlantConfig:
     discharge_coefficient: float = 0.6
     substeps: int = 10
     gravity: float = GRAVITY
+    arm_delay_steps: int = 0
 
     def __post_init__(self) -> None:
         check_range("plant.fill_depth", self.fill_depth, 0.0, self.vessel.inner_height, "m", lo_open=True)
         check_range("plant.discharge_coefficient", self.discharge_coefficient, 0.0, 1.0, lo_open=True)
         if isinstance(self.substeps, bool) or not isinstance(self.substeps, int) or not 1 <= self.substeps <= 100:
             raise ControllerInputError(f"plant.substeps: must be an integer in [1, 100], got {self.substeps!r}")
+        steps = self.arm_delay_steps
+        if isinstance(steps, bool) or not isinstance(steps, int) or not 0 <= steps <= 100:
+            raise ControllerInputError(f"plant.arm_delay_steps: must be an integer in [0, 100], got {steps!r}")
 
 
 class ModelPlant:
@@ -69,6 +76,7 @@ class ModelPlant:
         self.pose = PlanarPose()
         self.area = geom.inner_width * config.fill_depth  # m^2 in the pour plane
         self.poured = 0.0  # m^3
+        self._pending: deque[PlanarPose] = deque()  # commands not yet carried out (arm_delay_steps of them)
 
     def _hinge_x(self, pose: PlanarPose) -> np.ndarray:
         """World x offset (m) of the pendulum's hinge, the slosh model's input."""
@@ -101,8 +109,14 @@ class ModelPlant:
         )
 
     def advance(self, target: PlanarPose) -> None:
-        """Move the vessel linearly from its pose to ``target`` over one period and integrate the liquid."""
+        """Move the vessel linearly from its pose to ``target`` (the command given arm_delay_steps periods ago)
+        over one period and integrate the liquid."""
         cfg, start = self.config, self.pose
+        self._pending.append(target)
+        if len(self._pending) <= cfg.arm_delay_steps:
+            target = start
+        else:
+            target = self._pending.popleft()
         weir = (2.0 / 3.0) * cfg.discharge_coefficient * math.sqrt(2.0 * cfg.gravity)
         for i in range(1, cfg.substeps + 1):
             f = i / cfg.substeps

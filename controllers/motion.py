@@ -1,4 +1,5 @@
-"""Rate- and acceleration-limited 1-D tracking: moves a coordinate toward a target without large steps.
+"""Rate- and acceleration-limited 1-D tracking: moves a coordinate toward a target without large steps; and the
+delay of a follower behind its command.
 
 Used for the catcher's position (m), the approach tilt and the return tilt (rad). Units follow the coordinate:
 ``max_rate`` per second, ``max_accel`` per second squared, ``dt`` in s.
@@ -7,6 +8,8 @@ Used for the catcher's position (m), the approach tilt and the return tilt (rad)
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 from controllers.checks import check_range
 
@@ -46,3 +49,16 @@ def stop_time(distance: float, max_rate: float, max_accel: float) -> float:
     if d <= 0.5 * max_rate * max_rate / max_accel:
         return math.sqrt(2.0 * d / max_accel)
     return d / max_rate + 0.5 * max_rate / max_accel
+
+
+def fitted_delay(t: np.ndarray, command: np.ndarray, response: np.ndarray, max_delay: float, resolution: float) -> float:
+    """Delay L (s) for which response(t) best matches command(t - L), by least squares over L in [0, max_delay].
+
+    ``t``: sample times (s, increasing), shared by the two series; command(t - L) is interpolated linearly, held at
+    its first value before t[0]. The grid of candidate delays has step ``resolution`` (s). A command that does not
+    move leaves the delay undetermined: the smallest best-fitting delay is returned, 0 for a constant command.
+    """
+    delays = np.arange(0.0, max_delay + 0.5 * resolution, resolution)
+    shifted = np.interp(t[None, :] - delays[:, None], t, command)
+    cost = np.sum((shifted - response[None, :]) ** 2, axis=1)
+    return float(delays[int(np.argmin(cost))])

@@ -131,7 +131,8 @@ class CatcherSettings:
 class ControllerSettings:
     """control_rate: Hz, rate of the pour controller. [20, 500]
     stream_particles: the CFS liquid height over the crest is at least this many particle spacings, so that the
-      stream is resolved (the seed holds it near the smoothing length). [0, 10]
+      stream is resolved (the seed holds it near the smoothing length); a partial pour's final stage holds
+      cfs.final_head_fraction of it. [0, 10]
     sim: slosh induction (seed Fig. 7).
     approach: tilt toward the crest without SIM.
     cfs: constant-flow stage (seed Sec. 3.2).

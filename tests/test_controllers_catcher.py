@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from controllers.catcher import CatcherFollower, fall_time, landing_x, weir_velocity
-from controllers.motion import RateLimitedTracker, stop_time
+from controllers.motion import RateLimitedTracker, fitted_delay, stop_time
 from controllers.slosh import GRAVITY
 
 EXACT = 1e-12  # m: closed-form identities in float64
@@ -81,3 +81,11 @@ def test_target_filter_keeps_vessel_b_calm_under_a_jittering_prediction() -> Non
     assert mean == pytest.approx(0.05, abs=0.002)
     assert abs(raw_mean - 0.05) > abs(mean - 0.05)
     assert calm_swing < 0.25 * raw_swing
+
+
+def test_fitted_delay_of_a_delayed_ramp_and_of_a_still_command() -> None:
+    t = np.arange(0.0, 0.5, 0.01)
+    command = np.where(t < 0.1, 0.0, 0.3 * (t - 0.1))  # rad: still, then a 0.3 rad/s ramp
+    response = np.interp(t - 0.08, t, command)
+    assert fitted_delay(t, command, response, 0.3, 0.005) == pytest.approx(0.08, abs=1e-9)
+    assert fitted_delay(t, np.full_like(t, 0.2), np.full_like(t, 0.2), 0.3, 0.005) == 0.0

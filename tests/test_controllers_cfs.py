@@ -94,3 +94,13 @@ def test_after_flow_of_a_return_that_first_brakes_a_forward_tilt() -> None:
     assert got == pytest.approx(q * expected, rel=QUADRATURE_RTOL)
     assert got > after_flow_volume(q, h_q, lever, 10.0, accel)  # braking first lets more out
 
+
+def test_after_flow_of_a_vessel_that_lags_its_command() -> None:
+    """A vessel ``lag`` s behind its command keeps pouring at the current rate for that long, then returns."""
+    q, h_q, accel, w0, lag = 6e-5, 0.005, 1.5, 0.3, 0.08
+    lever = crest_lever(SEED_VESSEL, 0.4, SEED_VESSEL.inner_width * 0.15)
+    prompt = after_flow_volume(q, h_q, lever, 1.0, accel, w0)
+    assert after_flow_volume(q, h_q, lever, 1.0, accel, w0, lag) == pytest.approx(prompt + q * lag, rel=1e-12)
+    assert after_flow_volume(q, -0.001, lever, 1.0, accel, w0, lag) == 0.0  # nothing over the crest
+
+

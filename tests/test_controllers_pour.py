@@ -31,6 +31,9 @@ PARTIAL_POUR_RTOL = 0.03
 # CFS holds h_q at its reference: on the model plant within 5 % of 5 mm once the approach transient is over.
 H_Q_TOL = 0.25e-3  # m
 CFS_TRANSIENT = 3.0  # s after entering CFS: ten time constants of the CFS law (0.3 s)
+# The final stage's step of the h_q reference settles within H_Q_TOL after three time constants of the CFS law
+# and a slosh half-period (the step excites the slosh a little): 1 s.
+FINAL_STAGE_SETTLE = 1.0
 # After SIM, the slosh left when CFS takes over (seed t3) decays under CFS: its amplitude CFS_TRANSIENT s into
 # CFS is a small fraction of the induced slosh's amplitude during t1.
 SLOSH_DECAY = 0.2
@@ -45,9 +48,10 @@ def _config(**kw: object) -> PourConfig:
     return PourConfig(catcher=CatcherConfig(home_x=HOME_X), **kw)
 
 
-def _run(config: PourConfig, duration: float = 120.0) -> tuple[PourController, ModelPlant, Trace]:
+def _run(config: PourConfig, duration: float = 120.0, arm_delay_steps: int = 0) -> tuple[PourController, ModelPlant, Trace]:
     controller = PourController(config)
-    plant = ModelPlant(ModelPlantConfig(vessel=config.vessel, fill_depth=config.fill_depth), config.dt)
+    plant_config = ModelPlantConfig(vessel=config.vessel, fill_depth=config.fill_depth, arm_delay_steps=arm_delay_steps)
+    plant = ModelPlant(plant_config, config.dt)
     return controller, plant, run_closed_loop(controller, plant, duration)
 
 
@@ -64,14 +68,16 @@ def test_sim_timeline_on_the_linear_plant() -> None:
         (Phase.SIM_EXCITE, Phase.SIM_HOLD),
         (Phase.SIM_HOLD, Phase.SIM_DAMP),
         (Phase.SIM_DAMP, Phase.CFS),
-        (Phase.CFS, Phase.RETURN),
+        (Phase.CFS, Phase.CFS_FINAL),
+        (Phase.CFS_FINAL, Phase.RETURN),
         (Phase.RETURN, Phase.DONE),
     ]
     reasons = [tr.reason for tr in controller.transitions]
     assert reasons[0].startswith("h_e = 31.9 mm <= (B/2) tan(20 deg) = 34.8 mm")
     assert "crossed zero toward the lip" in reasons[2]
     assert "found free exit over the crest" in reasons[3]  # seed Sec. 3.1: t3 starts when the slosh flows out
-    assert "target" in reasons[4]
+    assert "to go before the predicted after-flow" in reasons[4]
+    assert "target" in reasons[5]
     # t0 lasts a quarter period of the excitation and ends at phi = 0.9 x the static crest tilt
     t = trace.t
     assert controller.transitions[1].t - controller.transitions[0].t == pytest.approx(
@@ -105,6 +111,36 @@ def test_partial_pour_reaches_its_target_and_holds_h_q() -> None:
         t_cfs = next(tr.t for tr in controller.transitions if tr.target is Phase.CFS)
         steady = (phases == Phase.CFS) & (trace.t > t_cfs + CFS_TRANSIENT)
         assert np.all(np.abs(trace.series("h_q")[steady] - config.cfs.h_q_ref) <= H_Q_TOL)
+
+
+def test_final_stage_lowers_the_head_before_a_partial_pour_stops() -> None:
+    base = _config(target_volume=0.5 * _config().initial_volume)
+    _, _, trace = _run(base)
+    phases, h_q = _phases(trace), trace.series("h_q")
+    final = np.flatnonzero(phases == Phase.CFS_FINAL)
+    cfs = base.cfs
+    settled = final[trace.t[final] > trace.t[final[0]] + FINAL_STAGE_SETTLE]
+    assert len(settled) > 0
+    assert np.all(np.abs(h_q[settled] - cfs.final_head_fraction * cfs.h_q_ref) <= H_Q_TOL)
+    # without the stage, the same pour goes from CFS straight back upright, at the full head
+    off = dataclasses.replace(base, cfs=dataclasses.replace(cfs, final_head_fraction=1.0))
+    controller_off, plant_off, trace_off = _run(off)
+    assert Phase.CFS_FINAL not in set(_phases(trace_off))
+    assert [tr.target for tr in controller_off.transitions][-2:] == [Phase.RETURN, Phase.DONE]
+    assert plant_off.poured == pytest.approx(off.target_volume, rel=PARTIAL_POUR_RTOL)
+
+
+def test_partial_pour_with_a_slow_arm_counts_the_lag_in_the_after_flow() -> None:
+    """An arm 8 periods late (80 ms, like the coupled pour's smoothed arm): the stop measures that lag from the
+    command's lead over the measured tilt, and the pour still ends within the tolerance."""
+    base = _config(target_volume=0.5 * _config().initial_volume)
+    config = dataclasses.replace(base, cfs=dataclasses.replace(base.cfs, final_head_fraction=1.0))
+    controller, plant, trace = _run(config, arm_delay_steps=8)
+    assert trace.commands[-1].phase is Phase.DONE
+    assert plant.poured == pytest.approx(config.target_volume, rel=PARTIAL_POUR_RTOL)
+    reason = next(tr.reason for tr in controller.transitions if tr.target is Phase.RETURN)
+    lag_ms = float(reason.split("(vessel ")[1].split(" ms")[0])
+    assert lag_ms == pytest.approx(90.0, abs=15.0)  # 8 periods late + the plant's own one-period move
 
 
 def test_low_fill_goes_straight_to_cfs_through_the_approach() -> None:
@@ -212,6 +248,7 @@ def test_bad_measurements_raise_one_line_errors() -> None:
         (lambda: SimConfig(mode="sometimes"), r"^sim\.mode: must be one of 'auto', 'always', 'never', got 'sometimes'$"),
         (lambda: SimConfig(frequency_ratio=0.8), r"^sim\.frequency_ratio: must be in \(0, 0\.5\], got 0\.8$"),
         (lambda: CfsConfig(h_q_ref=0.1), r"^cfs\.h_q_ref: must be in \[0\.001, 0\.05\] m, got 0\.1$"),
+        (lambda: CfsConfig(final_head_fraction=0.0), r"^cfs\.final_head_fraction: must be in \(0, 1\], got 0$"),
         (lambda: CatcherConfig(home_x=0.2, travel_min=0.1, travel_max=0.0), r"^catcher\.travel_max: must be in \(0\.1, 2\]"),
         (lambda: PourConfig(catcher={"home_x": 0.2}), r"^pour\.catcher: must be a CatcherConfig, got dict$"),
         (lambda: _config(sim=SimConfig(mode=SimMode.ALWAYS), control_rate=20.0,

@@ -201,12 +201,13 @@ class CoupledPour:
         return self.summary()
 
     def landing_accuracy(self) -> dict:
-        """Predicted against measured landing x of the stream in CFS (:func:`cosim.coupling.landing.landing_accuracy`)."""
+        """Predicted against measured landing x of the stream in CFS, its final stage included
+        (:func:`cosim.coupling.landing.landing_accuracy`)."""
         rows = self.log.arrays()
         if "t" not in rows:
             return {"samples": 0}
         return landing_accuracy(rows["t"], rows["landing_x"], rows["landing_fall_time"], rows["landing_measured_x"],
-                                rows["phase"] == "cfs")
+                                np.isin(rows["phase"], ("cfs", "cfs_final")))
 
     def outflow_timing(self) -> dict:
         """First and steady outflow (s after the pour's start), :func:`cosim.coupling.outflow.outflow_timing`."""
