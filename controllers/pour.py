@@ -8,9 +8,9 @@ A partial pour ends with CFS_FINAL: CFS holding ``cfs.final_head_fraction`` of h
 still to pour before the predicted after-flow would leave within ``cfs.final_stage_time`` at the current rate. The
 stop has to predict the after-flow (what still leaves while the vessel turns back,
 :func:`controllers.cfs.after_flow_volume`, with the vessel's lag behind its command fitted over the last
-LAG_WINDOW s). In four coupled partial pours it came out 1-23 % above the actual after-flow; the smaller outflow
-at the stop makes that error a smaller share of the target (at the full head the after-flow was 19 % of a 50 %
-pour, from the final stage 4-5 %).
+LAG_WINDOW s). In seven coupled partial pours it came out -18 to +23 % off the actual after-flow; the smaller
+outflow at the stop makes that error a smaller share of the target (at the full head the after-flow was 19 % of a
+50 % pour, from the final stage 4-8 %).
 
 Call :meth:`PourController.step` once per control period (``config.dt``, 10 ms by default) with a
 :class:`controllers.measurement.LiquidMeasurement`; it returns a :class:`controllers.measurement.PourCommand`.
