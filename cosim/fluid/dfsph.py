@@ -23,7 +23,9 @@ A substep, after the neighbour search:
   integrate                x += dt v*, then the shared wall guard, deactivation and diagnostics.
 
 One Jacobi iteration, for stiffness increments k_i (m^2/s^2, a pressure over density p / rho):
-  k_i = max(e_i, 0) alpha_i / dt^2, with e_i = dt Drho_i/Dt (divergence) or rho_i - rho0 + dt Drho_i/Dt (density),
+  k_i = omega max(e_i, 0) alpha_i / dt^2, with e_i = dt Drho_i/Dt (divergence) or rho_i - rho0 + dt Drho_i/Dt (density),
+  omega = min(1, JACOBI_GAIN_LIMIT / gain) (``cosim.fluid.params``; the gain of the lattice's pressure system,
+  ``cosim.fluid.sph_kernels.lattice_jacobi_gain``: 1 for the 2-D default, 0.56 in 3-D, where plain Jacobi diverges),
   Drho_i/Dt = sum_j m (v_i - v_j) . grad W_ij + sum_b rho0 V_b (v_i - v_b) . grad W_ib   (wall velocity v_b: the
   moving vessel enters the divergence term),
   v_i -= dt [sum_j m (k_i / rho_i + k_j / rho_j) grad W_ij + sum_b rho0 V_b (k_i / rho_i) grad W_ib]
@@ -273,7 +275,9 @@ def compute_solve_error(
     solve_stats: wp.array(dtype=wp.int64),
 ):
     """Each particle's remaining error e_i (``mode`` SOLVE_DIVERGENCE: dt Drho/Dt; SOLVE_DENSITY: rho_i - rho0 +
-    dt Drho/Dt; only compression: e_i >= 0), its next stiffness increment e_i alpha_i / dt^2 and the error sum."""
+    dt Drho/Dt; only compression: e_i >= 0), its next stiffness increment omega e_i alpha_i / dt^2 (omega:
+    ``prm.jacobi_relaxation``, 1 unless the support holds so many neighbours that plain Jacobi would diverge) and the
+    error sum."""
     i = wp.tid()
     if active[i] == 0:
         increment[i] = 0.0
@@ -293,7 +297,7 @@ def compute_solve_error(
     if mode == SOLVE_DENSITY:
         e += rho[i] - prm.rest_density
     e = wp.max(e, 0.0)
-    increment[i] = e * alpha[i] / (h * h)
+    increment[i] = prm.jacobi_relaxation * e * alpha[i] / (h * h)
     rel = wp.min(e / prm.rest_density, MAX_PARTICLE_ERROR)
     wp.atomic_add(solve_stats, STAT_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
     wp.atomic_max(solve_stats, STAT_MAX_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))

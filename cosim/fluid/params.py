@@ -5,7 +5,15 @@ from __future__ import annotations
 import warp as wp
 
 from cosim.fluid.config import FluidConfig
-from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma, lattice_gradient_square_sum, lattice_kernel_sum
+from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma, lattice_gradient_square_sum, lattice_jacobi_gain, lattice_kernel_sum
+
+# DFSPH's Jacobi solves diverge once one step's gain (cosim.fluid.sph_kernels.lattice_jacobi_gain) exceeds about 4
+# (measured, 2-D Wendland C2 hydrostatic tank at 40 across: stable at h = 1.6 dx, gain 3.74; blown up within 1 s at
+# 1.7 dx, gain 4.17; 3-D at h = 1.5 dx, gain 6.25: blown up within 0.5 s at 12 across). Only compression is
+# corrected, which halves the gain of an oscillating mode: hence 4, not the 2 of a linear Jacobi iteration. The
+# increments are scaled down so that the scaled gain stays at this limit (a margin below 4); at or below it they are
+# not scaled, so the 2-D default (gain 3.34) is unchanged.
+JACOBI_GAIN_LIMIT = 3.5
 
 
 @wp.struct
@@ -17,7 +25,8 @@ class SPHParams:
     tolerances and the iteration cap of each solve) and ``lattice_density``, the summation density of a resting
     lattice over rho0 (DFSPH and WCSPH's free liquid divide their summation density by it, so the liquid as seeded
     is at rest density) and ``lattice_factor_denominator``, sum_j |m grad W|^2 of a particle inside that lattice
-    (kg^2/m^(2 dim + 2)), the scale below which DFSPH does not let a factor's denominator fall."""
+    (kg^2/m^(2 dim + 2)), the scale below which DFSPH does not let a factor's denominator fall; ``jacobi_relaxation``
+    the factor (<= 1) DFSPH's Jacobi increments are scaled by (:data:`JACOBI_GAIN_LIMIT`)."""
 
     dim: int
     kernel: int
@@ -45,6 +54,7 @@ class SPHParams:
     max_iterations: int
     lattice_density: float
     lattice_factor_denominator: float
+    jacobi_relaxation: float
 
 
 def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
@@ -77,4 +87,5 @@ def make_params(cfg: FluidConfig, n_vessels: int) -> SPHParams:
     p.max_iterations = cfg.max_solver_iterations
     p.lattice_density = lattice_kernel_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim)
     p.lattice_factor_denominator = lattice_gradient_square_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim) * (cfg.particle_mass / cfg.spacing ** (cfg.dim + 1)) ** 2
+    p.jacobi_relaxation = min(1.0, JACOBI_GAIN_LIMIT / lattice_jacobi_gain(cfg.kernel, cfg.smoothing_ratio, cfg.dim))
     return p
