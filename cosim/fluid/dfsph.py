@@ -49,7 +49,6 @@ that of the non-pressure forces; the solves' final errors and iteration counts h
 
 from __future__ import annotations
 
-import math
 
 import warp as wp
 
@@ -66,7 +65,7 @@ from cosim.fluid.diagnostics import (
 )
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
-from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair
+from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair, wall_pair
 from cosim.fluid.sph_kernels import kernel_w
 
 # Warm starts (Bender & Koschier 2017, Sec. 4.3): each solve starts from a fraction of the stiffness it applied in
@@ -97,30 +96,12 @@ MIN_FACTOR_DENOMINATOR = wp.constant(0.25)
 SOLVE_DIVERGENCE = 0
 SOLVE_DENSITY = 1
 
-# Pair-list room per particle, in units of the lattice neighbours a full kernel support holds (liquid and wall
-# together fill one support; the rest is margin for compression and disorder)
-PAIR_CAPACITY_FACTOR = 2.5
-
-
-def pair_capacity(dim: int, smoothing_ratio: float) -> int:
-    """Pair-list entries per particle: PAIR_CAPACITY_FACTOR x the lattice points in a support of radius 2h."""
-    radius = 2.0 * smoothing_ratio  # in particle spacings
-    lattice = math.pi * radius**2 if dim == 2 else 4.0 / 3.0 * math.pi * radius**3
-    return math.ceil(PAIR_CAPACITY_FACTOR * lattice)
-
-
 # solve_stats (int64): error sum (quanta), active particle count, iterations of the current solve, largest error
 STAT_ERROR = wp.constant(0)
 STAT_COUNT = wp.constant(1)
 STAT_ITERATIONS = wp.constant(2)
 STAT_MAX_ERROR = wp.constant(3)
 N_STATS = 4
-
-
-@wp.func
-def wall_pair(b: int) -> int:
-    """Pair-list code of wall particle b (fluid neighbours are stored as their index j >= 0)."""
-    return -1 - b
 
 
 @wp.kernel

@@ -30,7 +30,7 @@ DIAG_CORRECTIONS = wp.constant(2)  # shallow wall contacts corrected by the guar
 DIAG_ACTIVE = wp.constant(3)  # active particles after the substep
 DIAG_DIVERGENCE_ITERATIONS = wp.constant(4)  # DFSPH: iterations of the divergence solve
 DIAG_DENSITY_ITERATIONS = wp.constant(5)  # DFSPH: iterations of the density solve
-DIAG_PAIR_OVERFLOW = wp.constant(6)  # DFSPH: particles with more neighbours than its pair list holds (instability)
+DIAG_PAIR_OVERFLOW = wp.constant(6)  # particles with more neighbours than the pair list holds (instability)
 DIAG_INSIDE0 = wp.constant(7)  # particles inside vessel k at DIAG_INSIDE0 + k
 N_DIAG_INT_BASE = 7
 

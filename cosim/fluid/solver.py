@@ -33,7 +33,7 @@ from cosim.errors import InputError, SimulationError
 from cosim.fluid import boundary as bd
 from cosim.fluid import dfsph, wcsph
 from cosim.fluid.config import FluidConfig, PressureSolver
-from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, sum_wall_wrench_chunks
+from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, pair_capacity, sum_wall_wrench_chunks
 from cosim.fluid.diagnostics import (
     DIAG_INTERNAL_ENERGY, DIAG_KINETIC_ENERGY, DIAG_POTENTIAL_ENERGY, DIAG_REMOVED_ENERGY, N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, rows_to_records,
 )
@@ -140,7 +140,7 @@ class FluidSolver:
         self._alpha = wp.zeros(n, dtype=float, device=d)
         self._increment = wp.zeros(n, dtype=float, device=d)
         self._solve_stats = wp.zeros(dfsph.N_STATS, dtype=wp.int64, device=d)
-        capacity = dfsph.pair_capacity(self.config.dim, self.config.smoothing_ratio) if self.config.pressure_solver is PressureSolver.DFSPH else 0
+        capacity = pair_capacity(self.config.dim, self.config.smoothing_ratio)
         self._pair_count = wp.zeros(n, dtype=wp.int32, device=d)
         self._pair_index = wp.zeros((n, capacity), dtype=wp.int32, device=d)
         self._pair_grad = wp.zeros((n, capacity), dtype=wp.vec3, device=d)
@@ -325,6 +325,7 @@ class FluidSolver:
         integrate (``cosim.fluid.wcsph``)."""
         m, prm, n, nb = self.model, self.model.params, self.n_particles, self.model.n_boundary
         rec = self._rec
+        pairs = [self._pair_count, self._pair_index, self._pair_grad]
         ops = []
         if self.config.free_liquid:
             ops.append(rec(
@@ -345,16 +346,13 @@ class FluidSolver:
                 prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel,
                 self._motions, st.x, st.v, st.rho, st.p, st.active, st.free, m.grid.cell_start, m.grid.cell_end,
                 self._bx, self._bv, self._b_p, self._b_rho, self._b_v_noslip,
-                m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, self._row,
+                m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, self._row, self._pair_index.shape[1],
             ],
-            [self._acc, self._rho_grad, self._wall_force, self._wall_torque, self._diag_f],
+            [self._acc, self._rho_grad, self._wall_force, self._wall_torque, *pairs, self._diag_f, self._diag_i],
         ))
         ops.append(rec(
             wcsph.compute_density_rate, n,
-            [
-                prm, m.grid.spec, m.b_volume, st.x, st.v, self._acc, st.rho, self._rho_grad, st.active, self._dt,
-                m.grid.cell_start, m.grid.cell_end, self._bx, self._bv, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end,
-            ],
+            [prm, m.b_volume, st.x, st.v, self._acc, st.rho, self._rho_grad, st.active, self._dt, self._bv, *pairs],
             [self._drho],
         ))
         ops.append(rec(
@@ -422,7 +420,7 @@ class FluidSolver:
         checks = [
             (rows_i[:, 0] > 0, lambda s: f"{rows_i[s, 0]} particles with a non-finite position, velocity or density"),
             (rows_i[:, 1] > 0, lambda s: f"{rows_i[s, 1]} particles inside a vessel wall (deeper than {cfg.max_wall_penetration:g} dx)"),
-            (rows_i[:, 6] > 0, lambda s: f"{rows_i[s, 6]} particles with more neighbours than the DFSPH pair list holds (over-compressed)"),
+            (rows_i[:, 6] > 0, lambda s: f"{rows_i[s, 6]} particles with more neighbours than the pair list holds (over-compressed)"),
             (
                 rows_f[:, 4] > cfg.max_density_error,
                 lambda s: f"compression {rows_f[s, 4]:.3f} exceeds fluid.max_density_error = {cfg.max_density_error:g}",

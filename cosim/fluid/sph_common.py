@@ -4,6 +4,8 @@ reorder of the particle state into cell order and the fixed-order reduction of t
 
 from __future__ import annotations
 
+import math
+
 import warp as wp
 
 from cosim.fluid.boundary import VesselGeometry, VesselMotion, guard_vessel, inside_vessel
@@ -20,6 +22,24 @@ from cosim.fluid.diagnostics import (
 )
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_dw
+
+
+# Pair-list room per particle, in units of the lattice neighbours a full kernel support holds (liquid and wall
+# together fill one support; the rest is margin for compression and disorder)
+PAIR_CAPACITY_FACTOR = 2.5
+
+
+def pair_capacity(dim: int, smoothing_ratio: float) -> int:
+    """Pair-list entries per particle: PAIR_CAPACITY_FACTOR x the lattice points in a support of radius 2h."""
+    radius = 2.0 * smoothing_ratio  # in particle spacings
+    lattice = math.pi * radius**2 if dim == 2 else 4.0 / 3.0 * math.pi * radius**3
+    return math.ceil(PAIR_CAPACITY_FACTOR * lattice)
+
+
+@wp.func
+def wall_pair(b: int) -> int:
+    """Pair-list code of wall particle b (fluid neighbours are stored as their index j >= 0)."""
+    return -1 - b
 
 
 @wp.func

@@ -13,7 +13,9 @@ compute_forces: per particle, over fluid and wall neighbours,
     mass rho0 V_w with their extrapolated pressure (Adami et al. 2012, see ``cosim.fluid.boundary``); Monaghan
     (1992) artificial viscosity and Morris et al. (1997) laminar viscosity (no-slip against the walls); gravity;
   - the reaction on each vessel: -m a_ib summed per particle, and its moment about the vessel's centre of mass,
-    stored per particle so they can be reduced in a fixed order (deterministic on every device).
+    stored per particle so they can be reduced in a fixed order (deterministic on every device);
+  - the substep's pair list (each neighbour and its kernel gradient, in loop order), which the density rate sums
+    over instead of searching the cells a second time (the same sums in the same order: identical results).
 compute_density_rate: continuity equation (liquid and wall particles) evaluated with the kicked velocities, plus
   delta-SPH diffusion with the renormalised density gradient of Antuono et al. (2010), so a resting column keeps
   its hydrostatic density profile and loose liquid exchanges nothing.
@@ -29,10 +31,10 @@ from __future__ import annotations
 import warp as wp
 
 from cosim.fluid.boundary import VesselGeometry, VesselMotion, inside_vessel
-from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR
+from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
-from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair
+from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair, wall_pair
 from cosim.fluid.sph_kernels import kernel_w
 
 # The renormalisation matrix L^-1 (identity for a full kernel support) is used only where det L exceeds this:
@@ -178,24 +180,34 @@ def compute_forces(
     b_cell_start: wp.array(dtype=wp.int32),
     b_cell_end: wp.array(dtype=wp.int32),
     row: wp.array(dtype=wp.int32),
+    capacity: int,
     # Out
     acc: wp.array(dtype=wp.vec3),
     rho_grad: wp.array(dtype=wp.vec3),
     wall_force: wp.array2d(dtype=wp.vec3),
     wall_torque: wp.array2d(dtype=wp.vec3),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_grad: wp.array2d(dtype=wp.vec3),
     diag_f: wp.array2d(dtype=float),
+    diag_i: wp.array2d(dtype=wp.int32),
 ):
     """Acceleration of each particle, the reaction it exerts on each vessel (per particle, reduced later) and its
     renormalised density gradient <grad rho>^L = L^-1 sum_j V_j (rho_j - rho_i) grad W, L = sum_j V_j (x_j - x_i)
-    (x) grad W (Antuono et al. 2010; liquid neighbours only; zero where L is too ill-conditioned to invert)."""
+    (x) grad W (Antuono et al. 2010; liquid neighbours only; zero where L is too ill-conditioned to invert). Also
+    the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``:
+    grad_i W), in the order of the neighbour loop, which compute_density_rate sums over instead of searching the
+    cells again; more than ``capacity`` neighbours count as an overflow, an instability."""
     i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
+    pair_count[i] = 0
     if active[i] == 0:
         acc[i] = wp.vec3(0.0)
         rho_grad[i] = wp.vec3(0.0)
         return
+    count = int(0)
     xi = x[i]
     vi = v[i]
     rhoi = rho[i]
@@ -220,6 +232,10 @@ def compute_forces(
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
                     gw = kernel_gradient(prm, r, r2)
+                    if count < capacity:
+                        pair_index[i, count] = j
+                        pair_grad[i, count] = gw
+                    count += 1
                     vij = vi - v[j]
                     rhoj = rho[j]
                     vol = prm.mass / rhoj
@@ -236,6 +252,10 @@ def compute_forces(
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
                     gw = kernel_gradient(prm, r, r2)
+                    if count < capacity:
+                        pair_index[i, count] = wall_pair(b)
+                        pair_grad[i, count] = gw
+                    count += 1
                     mw = prm.rest_density * b_volume[b]
                     rhob = b_rho[b]
                     ab = -(mw * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
@@ -247,6 +267,9 @@ def compute_forces(
                     f_vessel = -prm.mass_out * ab
                     wall_force[kv, i] = wall_force[kv, i] + f_vessel
                     wall_torque[kv, i] = wall_torque[kv, i] + wp.cross(xb - com, f_vessel)
+    if count > capacity:
+        wp.atomic_add(diag_i, row[0], DIAG_PAIR_OVERFLOW, 1)
+    pair_count[i] = wp.min(count, capacity)
     a += prm.gravity
     acc[i] = a
     if prm.dim == 2:
@@ -262,7 +285,6 @@ def compute_forces(
 def compute_density_rate(
     # Model
     prm: SPHParams,
-    g: GridSpec,
     b_volume: wp.array(dtype=float),
     # State in
     x: wp.array(dtype=wp.vec3),
@@ -272,20 +294,18 @@ def compute_density_rate(
     rho_grad: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
     dt: wp.array(dtype=float),
-    cell_start: wp.array(dtype=wp.int32),
-    cell_end: wp.array(dtype=wp.int32),
-    bx: wp.array(dtype=wp.vec3),
     bv: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    b_cell_start: wp.array(dtype=wp.int32),
-    b_cell_end: wp.array(dtype=wp.int32),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_grad: wp.array2d(dtype=wp.vec3),
     # Out
     drho: wp.array(dtype=float),
 ):
     """Density rate from the continuity equation with the KICKED velocities v + dt a (symplectic: the density
     sees the velocity it is integrated with), plus delta-SPH diffusion (Antuono et al. 2010):
     delta h c0 sum_j V_j [2 (rho_i - rho_j) r_ij . grad W / (r^2 + eta^2) - (<grad rho>_i + <grad rho>_j) . grad W],
-    which vanishes for any linear density field (a resting column) and conserves mass between pairs."""
+    which vanishes for any linear density field (a resting column) and conserves mass between pairs. Sums over
+    compute_forces' pair list, in its order (the neighbours have not moved since)."""
     i = wp.tid()
     if active[i] == 0:
         drho[i] = 0.0
@@ -294,34 +314,23 @@ def compute_density_rate(
     xi = x[i]
     vi = v[i] + h * acc[i]
     rhoi = rho[i]
-    support2 = prm.support * prm.support
     grad_i = rho_grad[i]
     diffusion = prm.delta * prm.h * prm.sound_speed
     dr = float(0.0)
-    c = grid_cell(g, xi)
-    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
-        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
-            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
-                cell = grid_index(g, cx, cy, cz)
-                for j in range(cell_start[cell], cell_end[cell]):
-                    r = xi - x[j]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    gw = kernel_gradient(prm, r, r2)
-                    vij = vi - (v[j] + h * acc[j])
-                    rhoj = rho[j]
-                    dr += prm.mass * wp.dot(vij, gw)
-                    psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + rho_grad[j], gw)
-                    dr += diffusion * (prm.mass / rhoj) * psi
-                for kk in range(b_cell_start[cell], b_cell_end[cell]):
-                    b = b_order[kk]
-                    r = xi - bx[b]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    gw = kernel_gradient(prm, r, r2)
-                    dr += prm.rest_density * b_volume[b] * wp.dot(vi - bv[b], gw)
+    for k in range(pair_count[i]):
+        j = pair_index[i, k]
+        gw = pair_grad[i, k]
+        if j >= 0:
+            r = xi - x[j]
+            r2 = wp.dot(r, r)
+            vij = vi - (v[j] + h * acc[j])
+            rhoj = rho[j]
+            dr += prm.mass * wp.dot(vij, gw)
+            psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + rho_grad[j], gw)
+            dr += diffusion * (prm.mass / rhoj) * psi
+        else:
+            b = -1 - j
+            dr += prm.rest_density * b_volume[b] * wp.dot(vi - bv[b], gw)
     drho[i] = dr
 
 
