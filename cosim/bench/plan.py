@@ -1,8 +1,8 @@
 """Which configurations the benchmark runs: axes around the default scene's settings, not hand-written rows.
 
 Per case: a resolution sweep at the default numerics, then one axis at a time at the case's default resolution
-(the pour: at 24 across) (every other kernel, the CFL levels, every other pressure solver); on every device
-present. The pour adds a
+(the pour: at 24 across) (every other kernel, the CFL levels), and every other pressure solver over the whole
+resolution sweep (to compare the solvers at equal error); on every device present. The pour adds a
 fine reference (:data:`REFERENCE_ACROSS`) that its resolution and numerics rows are compared with, and the skip
 options: pairs of runs that differ only in what a scene may skip, the second doing the full work.
 
@@ -99,7 +99,8 @@ def _axis_rows(case: BenchCase, axes: CaseAxes, device: str) -> list[BenchConfig
     rows = [replace(base, particles_across=n) for n in axes.resolutions]
     rows += [replace(base, kernel=k) for k in KernelType if k is not base.kernel]
     rows += [replace(base, cfl=c) for c in axes.cfl_levels if c != base.cfl]
-    rows += [replace(base, pressure_solver=s) for s in PressureSolver if s is not base.pressure_solver]
+    # every other pressure solver over the whole resolution sweep, so the two can be compared at equal error
+    rows += [replace(base, particles_across=n, pressure_solver=s) for s in PressureSolver if s is not base.pressure_solver for n in axes.resolutions]
     return rows
 
 
