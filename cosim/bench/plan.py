@@ -7,7 +7,7 @@ fine reference (:data:`REFERENCE_ACROSS`) that its resolution and numerics rows 
 options: pairs of runs that differ only in what a scene may skip, the second doing the full work.
 
 Cost: the full plan is sized to finish cold in about half an hour on a 2-core CPU; the pour runs
-:data:`POUR_SECONDS` of simulated time (the slosh induction and the first outflow, 7 to 16 % of the liquid), not
+:data:`POUR_SECONDS` of simulated time (the slosh induction and the first outflow, 9 to 20 % of the liquid), not
 the whole ~19 s pour.
 """
 
