@@ -9,7 +9,7 @@ import pytest
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig, KernelType
 from cosim.fluid.runtime import cuda_available
-from cosim.fluid.seeding import fill_vessel, liquid_block
+from cosim.fluid.seeding import ParticleSet, fill_vessel, liquid_block
 from cosim.fluid.solver import FluidInstabilityError, FluidSolver
 from cosim.frames import Pose, rotation_y
 from cosim.validation import hydrostatic, moving_vessel, slosh
@@ -152,3 +152,20 @@ def test_cpu_and_cuda_agree():
         results.append((solver.positions(), solver.vessel_wrenches()))
     np.testing.assert_allclose(results[0][0], results[1][0], atol=1e-5)
     np.testing.assert_allclose(results[0][1], results[1][1], rtol=1e-3, atol=1e-4)
+
+
+@pytest.mark.parametrize("solver_name", ["wcsph", "dfsph"])
+def test_more_neighbours_than_the_pair_list_holds_is_an_instability(solver_name):
+    # Liquid at a third of its spacing holds 9 x the neighbours of a resting lattice, more than the pair list's
+    # room (cosim.fluid.sph_common.PAIR_CAPACITY_FACTOR = 2.5 x): the solver must stop with its clear error instead of
+    # summing a truncated neighbourhood.
+    # (a wide, tall tank: the packed liquid bursts apart in its first substep and must not reach a wall within it)
+    tank = VesselSpec(name="tank", inner_width=0.6, inner_height=0.6)
+    cfg = FluidConfig(dim=2, spacing=0.1 / 16, pressure_solver=solver_name, domain_min=(-0.5, -0.15, -0.1), domain_max=(0.5, 0.15, 0.8))
+    side = np.arange(12) * cfg.spacing / 3.0
+    xs, zs = np.meshgrid(side - side.mean(), side + 0.3)
+    n = xs.size
+    packed = ParticleSet(np.stack([xs.ravel(), np.zeros(n), zs.ravel()], axis=1), np.zeros((n, 3)), np.full(n, cfg.rest_density))
+    fluid = FluidSolver(cfg, [tank], [Pose()], packed)
+    with pytest.raises(FluidInstabilityError, match="more neighbours than the pair list holds"):
+        fluid.advance(0.002)
