@@ -108,20 +108,18 @@ def _periodic_jacobi_gain(kernel: KernelType, smoothing_ratio: float, n: int = 4
     change -sum_j (dv_i - dv_j) . grad W_ij; D its diagonal part sum_j |grad W_ij|^2."""
     reach = math.ceil(2.0 * smoothing_ratio)
     offsets = [(a, b) for a in range(-reach, reach + 1) for b in range(-reach, reach + 1) if 0 < math.hypot(a, b) < 2.0 * smoothing_ratio]
-    grads = []
-    for a, b in offsets:
-        q = math.hypot(a, b) / smoothing_ratio
-        if kernel is KernelType.CUBIC_SPLINE:
-            slope = (-3.0 * q + 2.25 * q * q) if q < 1.0 else -0.75 * (2.0 - q) ** 2
-        else:
-            slope = -5.0 * q * (1.0 - 0.5 * q) ** 3
-        grads.append(slope * np.array([a, b]) / math.hypot(a, b))
+    distance = np.array([math.hypot(a, b) for a, b in offsets])
+    # dW/dr from the solver's own warp kernel (the gain's numpy slope is then checked against it too)
+    slope = wp.zeros(len(offsets), dtype=float)
+    sigma = kernel_sigma(kernel, smoothing_ratio, 2)
+    wp.launch(evaluate_kernel, len(offsets), inputs=[wp.array(distance.astype(np.float32), dtype=float), 1.0 / smoothing_ratio, sigma, KERNEL_IDS[kernel], wp.zeros(len(offsets), dtype=float), slope])
+    grads = [dw * np.array(o) / r for o, r, dw in zip(offsets, distance, slope.numpy().astype(float))]
     size = n * n
     index = np.arange(size).reshape(n, n)
+    rows = np.arange(size)
     velocity = np.zeros((size, 2, size))  # d(dv_i)/d(kappa)
     for (a, b), g in zip(offsets, grads):
         j = np.roll(index, (-a, -b), axis=(0, 1)).ravel()
-        rows = np.arange(size)
         velocity[rows, :, rows] -= g
         np.subtract.at(velocity, (rows, slice(None), j), g)
     density = np.zeros((size, size))
