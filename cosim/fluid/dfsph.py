@@ -4,8 +4,9 @@ Incompressibility is enforced by two iterative solves per substep instead of a s
 time step follows the flow speed (CFL on particle and wall speed) rather than an artificial speed of sound.
 A substep, after the neighbour search:
 
-  compute_density_factor   the substep's pair list (liquid and wall neighbours with their mass-weighted kernel
-                           gradients, which every solve iteration loops over instead of the cell grid);
+  compute_density_factor   the substep's pair list (liquid and wall neighbours with their kernel gradients, which
+                           every later stage loops over instead of searching the cell grid again: one search per
+                           substep);
                            rho_i = (sum_j m W_ij + sum_b rho0 V_b W_ib) / s (summation density, wall particles
                            included; s = the sum over a resting lattice / rho0, 1.005 for Wendland C2 at h = 1.5 dx
                            in 2-D, so the liquid as seeded is at rest instead of 0.5 % compressed) and the DFSPH
@@ -48,7 +49,6 @@ that of the non-pressure forces; the solves' final errors and iteration counts h
 """
 
 from __future__ import annotations
-
 
 import warp as wp
 
@@ -136,8 +136,8 @@ def compute_density_factor(
     diag_i: wp.array2d(dtype=wp.int32),
 ):
     """Summation density, DFSPH factor and the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall
-    code :func:`wall_pair`; ``pair_grad[i, k]``: its mass times grad_i W, kg/m^(dim+1)), which the solve
-    iterations loop over instead of the cell grid; the divergence solve's warm start (increment = a fraction of the
+    code :func:`wall_pair`; ``pair_grad[i, k]``: grad_i W, 1/m^(dim+1), weighted by the pair's mass where used:
+    :func:`pair_mass`), which the later stages loop over instead of the cell grid; the divergence solve's warm start (increment = a fraction of the
     last substep's stiffness, applied by the first iteration) and its counters. More than ``capacity`` neighbours
     (impossible below ~2x compression) count as an overflow, an instability."""
     i = wp.tid()
@@ -170,12 +170,13 @@ def compute_density_factor(
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
                     density += prm.mass * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                    gm = prm.mass * kernel_gradient(prm, r, r2)
+                    gw = kernel_gradient(prm, r, r2)
+                    gm = prm.mass * gw
                     grad_sum += gm
                     grad_sq += wp.dot(gm, gm)
                     if count < capacity:
                         pair_index[i, count] = j
-                        pair_grad[i, count] = gm
+                        pair_grad[i, count] = gw
                     count += 1
                 for kk in range(b_cell_start[cell], b_cell_end[cell]):
                     b = b_order[kk]
@@ -185,11 +186,11 @@ def compute_density_factor(
                         continue
                     mw = prm.rest_density * b_volume[b]
                     density += mw * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                    gm = mw * kernel_gradient(prm, r, r2)
-                    grad_sum += gm
+                    gw = kernel_gradient(prm, r, r2)
+                    grad_sum += mw * gw
                     if count < capacity:
                         pair_index[i, count] = wall_pair(b)
-                        pair_grad[i, count] = gm
+                        pair_grad[i, count] = gw
                     count += 1
     if count > capacity:
         wp.atomic_add(diag_i, row[0], DIAG_PAIR_OVERFLOW, 1)
@@ -204,8 +205,20 @@ def compute_density_factor(
     wp.atomic_max(diag_f, row[0], DIAG_MAX_COMPRESSION, compression)
 
 
+@wp.func
+def pair_mass(prm: SPHParams, b_volume: wp.array(dtype=float), j: int) -> float:
+    """Mass (kg, or kg/m in 2-D) of pair-list entry ``j``: the particle mass, or rho0 V_b of wall particle
+    b = -1 - j (:func:`wall_pair`)."""
+    if j >= 0:
+        return prm.mass
+    return prm.rest_density * b_volume[-1 - j]
+
+
 @wp.kernel
 def apply_stiffness(
+    # Model
+    prm: SPHParams,
+    b_volume: wp.array(dtype=float),
     # State in
     rho: wp.array(dtype=float),
     increment: wp.array(dtype=float),
@@ -231,7 +244,7 @@ def apply_stiffness(
         kj = float(0.0)
         if j >= 0:
             kj = increment[j] / rho[j]
-        dv += (ki + kj) * pair_grad[i, k]
+        dv += (ki + kj) * (pair_mass(prm, b_volume, j) * pair_grad[i, k])
     v[i] = v[i] - dt[0] * dv
     kappa[i] = kappa[i] + increment[i]
 
@@ -240,6 +253,7 @@ def apply_stiffness(
 def compute_solve_error(
     # Model
     prm: SPHParams,
+    b_volume: wp.array(dtype=float),
     mode: int,
     # State in
     v: wp.array(dtype=wp.vec3),
@@ -273,7 +287,7 @@ def compute_solve_error(
             vj = v[j]
         else:
             vj = bv[-1 - j]
-        rate += wp.dot(vi - vj, pair_grad[i, k])
+        rate += wp.dot(vi - vj, pair_mass(prm, b_volume, j) * pair_grad[i, k])
     e = h * rate
     if mode == SOLVE_DENSITY:
         e += rho[i] - prm.rest_density
@@ -320,18 +334,17 @@ def check_convergence(
 
 
 @wp.func
-def wall_pair_viscosity(prm: SPHParams, volume: float, r: wp.vec3, r2: float, v_rel: wp.vec3, rho_i: float) -> wp.vec3:
-    """Viscous acceleration of a particle from one wall particle (of rest density, ``volume``, relative velocity
-    ``v_rel`` against the wall's own): the same call in compute_nonpressure and compute_wall_reaction, so the
-    vessel receives exactly the opposite force."""
-    return viscous_pair(prm, prm.alpha, prm.rest_density * volume, r, r2, kernel_gradient(prm, r, r2), v_rel, v_rel, rho_i, prm.rest_density)
+def wall_pair_viscosity(prm: SPHParams, volume: float, r: wp.vec3, r2: float, gw: wp.vec3, v_rel: wp.vec3, rho_i: float) -> wp.vec3:
+    """Viscous acceleration of a particle from one wall particle (of rest density, ``volume``, kernel gradient
+    ``gw``, relative velocity ``v_rel`` against the wall's own): the same call in compute_nonpressure and
+    compute_wall_reaction, so the vessel receives exactly the opposite force."""
+    return viscous_pair(prm, prm.alpha, prm.rest_density * volume, r, r2, gw, v_rel, v_rel, rho_i, prm.rest_density)
 
 
 @wp.kernel
 def compute_nonpressure(
     # Model
     prm: SPHParams,
-    g: GridSpec,
     b_volume: wp.array(dtype=float),
     # State in
     x: wp.array(dtype=wp.vec3),
@@ -339,13 +352,11 @@ def compute_nonpressure(
     rho: wp.array(dtype=float),
     active: wp.array(dtype=wp.int32),
     dt: wp.array(dtype=float),
-    cell_start: wp.array(dtype=wp.int32),
-    cell_end: wp.array(dtype=wp.int32),
     bx: wp.array(dtype=wp.vec3),
     bv: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    b_cell_start: wp.array(dtype=wp.int32),
-    b_cell_end: wp.array(dtype=wp.int32),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_grad: wp.array2d(dtype=wp.vec3),
     row: wp.array(dtype=wp.int32),
     # State in/out
     kappa_density: wp.array(dtype=float),
@@ -356,8 +367,8 @@ def compute_nonpressure(
     keep_going: wp.array(dtype=wp.int32),
     diag_f: wp.array2d(dtype=float),
 ):
-    """v* = v + dt (g + viscosity) (walls: their own velocity, rest density; :func:`wall_pair_viscosity`); the
-    density solve's warm start and counters."""
+    """v* = v + dt (g + viscosity) over the substep's pair list (walls: their own velocity, rest density;
+    :func:`wall_pair_viscosity`); the density solve's warm start and counters."""
     i = wp.tid()
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)
@@ -371,27 +382,17 @@ def compute_nonpressure(
     xi = x[i]
     vi = v[i]
     rhoi = rho[i]
-    support2 = prm.support * prm.support
     a = wp.vec3(0.0)
-    c = grid_cell(g, xi)
-    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
-        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
-            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
-                cell = grid_index(g, cx, cy, cz)
-                for j in range(cell_start[cell], cell_end[cell]):
-                    r = xi - x[j]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    vij = vi - v[j]
-                    a += viscous_pair(prm, prm.alpha, prm.mass, r, r2, kernel_gradient(prm, r, r2), vij, vij, rhoi, rho[j])
-                for kk in range(b_cell_start[cell], b_cell_end[cell]):
-                    b = b_order[kk]
-                    r = xi - bx[b]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    a += wall_pair_viscosity(prm, b_volume[b], r, r2, vi - bv[b], rhoi)
+    for k in range(pair_count[i]):
+        j = pair_index[i, k]
+        if j >= 0:
+            r = xi - x[j]
+            vij = vi - v[j]
+            a += viscous_pair(prm, prm.alpha, prm.mass, r, wp.dot(r, r), pair_grad[i, k], vij, vij, rhoi, rho[j])
+        else:
+            b = -1 - j
+            r = xi - bx[b]
+            a += wall_pair_viscosity(prm, b_volume[b], r, wp.dot(r, r), pair_grad[i, k], vi - bv[b], rhoi)
     a += prm.gravity
     v_star[i] = vi + dt[0] * a
     increment[i] = warm
@@ -402,7 +403,6 @@ def compute_nonpressure(
 def compute_wall_reaction(
     # Model
     prm: SPHParams,
-    g: GridSpec,
     vessels: wp.array(dtype=VesselGeometry),
     b_volume: wp.array(dtype=float),
     b_vessel: wp.array(dtype=wp.int32),
@@ -416,9 +416,9 @@ def compute_wall_reaction(
     active: wp.array(dtype=wp.int32),
     bx: wp.array(dtype=wp.vec3),
     bv: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    b_cell_start: wp.array(dtype=wp.int32),
-    b_cell_end: wp.array(dtype=wp.int32),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_grad: wp.array2d(dtype=wp.vec3),
     substep_weight: wp.array(dtype=float),
     # Out
     wall_force: wp.array2d(dtype=wp.vec3),
@@ -426,13 +426,13 @@ def compute_wall_reaction(
     # State in/out
     p: wp.array(dtype=float),
 ):
-    """The force each particle exerted on each vessel this substep, the opposite of what its wall neighbours gave
-    it: per wall particle the pressure m (kappa_i / rho_i) rho0 V_b grad W_ib over both solves (kappa_i enters
-    linearly, so the sum over the iterations is exact) and the viscous term with the velocity the non-pressure
-    stage saw (``v``, before the density solve), and its moment about the vessel's centre of mass. Also adds this
-    substep's share (``substep_weight`` = 1 / substeps of the interval) of the reported pressure p_i = rho_i kappa_i
-    (Pa): the pressure is the interval's average, as the wrenches are (one substep's stiffness is the multiplier of
-    that substep's residual, noisy from substep to substep)."""
+    """The force each particle exerted on each vessel this substep, the opposite of what its wall neighbours (the
+    wall entries of the pair list) gave it: per wall particle the pressure m (kappa_i / rho_i) rho0 V_b grad W_ib
+    over both solves (kappa_i enters linearly, so the sum over the iterations is exact) and the viscous term with
+    the velocity the non-pressure stage saw (``v``, before the density solve), and its moment about the vessel's
+    centre of mass. Also adds this substep's share (``substep_weight`` = 1 / substeps of the interval) of the
+    reported pressure p_i = rho_i kappa_i (Pa): the pressure is the interval's average, as the wrenches are (one
+    substep's stiffness is the multiplier of that substep's residual, noisy from substep to substep)."""
     i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
@@ -445,27 +445,22 @@ def compute_wall_reaction(
     xi = x[i]
     vi = v[i]
     ki = kappa / rhoi
-    support2 = prm.support * prm.support
-    c = grid_cell(g, xi)
-    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
-        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
-            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
-                cell = grid_index(g, cx, cy, cz)
-                for kk in range(b_cell_start[cell], b_cell_end[cell]):
-                    b = b_order[kk]
-                    xb = bx[b]
-                    r = xi - xb
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    ab = wall_pair_viscosity(prm, b_volume[b], r, r2, vi - bv[b], rhoi)
-                    ab -= (prm.rest_density * b_volume[b] * ki) * kernel_gradient(prm, r, r2)
-                    kv = b_vessel[b]
-                    m = motions[kv]
-                    com = m.p_now + m.r_now @ vessels[kv].com
-                    f_vessel = -prm.mass_out * ab
-                    wall_force[kv, i] = wall_force[kv, i] + f_vessel
-                    wall_torque[kv, i] = wall_torque[kv, i] + wp.cross(xb - com, f_vessel)
+    for k in range(pair_count[i]):
+        j = pair_index[i, k]
+        if j >= 0:
+            continue
+        b = -1 - j
+        xb = bx[b]
+        r = xi - xb
+        gw = pair_grad[i, k]
+        ab = wall_pair_viscosity(prm, b_volume[b], r, wp.dot(r, r), gw, vi - bv[b], rhoi)
+        ab -= (prm.rest_density * b_volume[b] * ki) * gw
+        kv = b_vessel[b]
+        m = motions[kv]
+        com = m.p_now + m.r_now @ vessels[kv].com
+        f_vessel = -prm.mass_out * ab
+        wall_force[kv, i] = wall_force[kv, i] + f_vessel
+        wall_torque[kv, i] = wall_torque[kv, i] + wp.cross(xb - com, f_vessel)
 
 
 @wp.kernel

@@ -368,14 +368,12 @@ class FluidSolver:
         rec = self._rec
         grid = [m.grid.cell_start, m.grid.cell_end]
         walls = [self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end]
-        walls_v = [self._bx, self._bv, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end]
-
         pairs = [self._pair_count, self._pair_index, self._pair_grad]
 
         def solve(mode: int, v: wp.array, kappa: wp.array):
             body = [
-                rec(dfsph.apply_stiffness, n, [st.rho, self._increment, st.active, self._dt, *pairs], [v, kappa]),
-                rec(dfsph.compute_solve_error, n, [prm, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [self._increment, self._solve_stats]),
+                rec(dfsph.apply_stiffness, n, [prm, m.b_volume, st.rho, self._increment, st.active, self._dt, *pairs], [v, kappa]),
+                rec(dfsph.compute_solve_error, n, [prm, m.b_volume, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [self._increment, self._solve_stats]),
                 rec(dfsph.check_convergence, 1, [prm, mode, self._row], [self._solve_stats, self._keep_going, self._diag_f, self._diag_i]),
             ]
 
@@ -392,15 +390,15 @@ class FluidSolver:
             ),
             solve(dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence),
             rec(
-                dfsph.compute_nonpressure, n, [prm, m.grid.spec, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, *grid, *walls_v, self._row, st.kappa_density],
+                dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.kappa_density],
                 [self._v_star, self._increment, self._solve_stats, self._keep_going, self._diag_f],
             ),
             solve(dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density),
             rec(
                 dfsph.compute_wall_reaction, n,
                 [
-                    prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel, self._motions, st.x, st.v, st.rho, st.kappa_density,
-                    st.kappa_divergence, st.active, *walls_v, self._substep_weight,
+                    prm, m.vessels, m.b_volume, m.b_vessel, self._motions, st.x, st.v, st.rho, st.kappa_density,
+                    st.kappa_divergence, st.active, self._bx, self._bv, *pairs, self._substep_weight,
                 ],
                 [self._wall_force, self._wall_torque, st.p],
             ),
