@@ -15,7 +15,9 @@ or DFSPH (``cosim.fluid.dfsph``)
     compute_nonpressure; density solve; compute_wall_reaction; integrate (+ wall guard); reduce_wrenches
 
 entirely on the device (no host copies inside; only the interval's plan and its diagnostics cross; DFSPH's
-convergence loops read a device flag through ``wp.capture_while``, see ``cosim.fluid.dfsph``). After the
+convergence loops read a device flag through ``wp.capture_while``, see ``cosim.fluid.dfsph``). On a CUDA device
+each substep is replayed as one captured CUDA graph from the second interval on (written without a GPU at hand:
+``python -m cosim.bench.device_check`` is the check to run where one is). After the
 interval the per-substep diagnostics are checked and an instability raises :class:`FluidInstabilityError`
 naming the step and what broke. Results come back as numpy arrays in the particles' original order.
 """
@@ -78,6 +80,9 @@ class FluidSolver:
       poses: initial world pose of each vessel frame.
       particles: the initial liquid (e.g. from :func:`cosim.fluid.seeding.fill_vessel`).
       device: "cpu" or "cuda[:N]".
+      cuda_graphs: on a CUDA device, replay each substep as one captured CUDA graph (captured after the first
+        interval, which runs the operations one by one and so sizes the sort's scratch memory); the operations
+        one by one where capture fails (:attr:`graph_capture_error` says why) or when False. No effect on the CPU.
     In 2-D, vessel poses are projected onto the pour plane (rotation about y, translation in x-z, y = 0).
     """
 
@@ -88,6 +93,7 @@ class FluidSolver:
         poses: Sequence[Pose],
         particles: ParticleSet,
         device: str = "cpu",
+        cuda_graphs: bool = True,
     ):
         if len(vessels) != len(poses):
             raise InputError(f"fluid: {len(vessels)} vessels but {len(poses)} poses")
@@ -107,6 +113,9 @@ class FluidSolver:
         self._last_max_accel = config.gravity_magnitude
         self._history: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         self._last_report: IntervalReport | None = None
+        self._capture_graphs = cuda_graphs and self.device.is_cuda
+        self.graph_capture_error: str | None = None
+        self._graphs: tuple | None = None
         self._allocate(particles)
         self.energy_account = EnergyAccount(config, vessels, particles.positions, particles.velocities, self._internal_energy())
 
@@ -186,6 +195,7 @@ class FluidSolver:
         self._diag_f = wp.zeros((self._rows_capacity, N_DIAG_FLOAT), dtype=float, device=self.device)
         self._diag_i = wp.zeros((self._rows_capacity, N_DIAG_INT_BASE + self.model.n_vessels), dtype=wp.int32, device=self.device)
         self._ops = None
+        self._graphs = None
 
     def _upload_motions(self, lin_vel: np.ndarray, ang_vel: np.ndarray, lin_acc: np.ndarray, ang_acc: np.ndarray) -> None:
         motions = []
@@ -262,6 +272,8 @@ class FluidSolver:
         self._torque_sum.zero_()
         for _ in range(n_sub):
             self._substep()
+        if self._capture_graphs and self._graphs is None:
+            self._graphs = self._capture()
         rows_f = self._diag_f.numpy()[:n_sub].copy()
         rows_i = self._diag_i.numpy()[:n_sub].copy()
         first = self.step_count
@@ -406,10 +418,30 @@ class FluidSolver:
             self._solve_stats.zero_,
         ]
 
+    def _capture(self) -> tuple | None:
+        """Both parities' substeps as CUDA graphs (DFSPH's solve loops become conditional nodes), or None, with
+        the reason in :attr:`graph_capture_error`, where warp or the driver cannot capture them."""
+        graphs = []
+        try:
+            for ops in self._ops:
+                with wp.ScopedCapture(device=self.device) as capture:
+                    for op in ops:
+                        op()
+                graphs.append(capture.graph)
+        except Exception as exc:  # warp raises RuntimeError and others (e.g. no conditional nodes before CUDA 12.4)
+            self._capture_graphs = False
+            self.graph_capture_error = f"{type(exc).__name__}: {exc}"
+            return None
+        return tuple(graphs)
+
     def _substep(self) -> None:
-        """One substep: run the recorded operations of the current parity, then swap the particle buffers."""
-        for op in self._ops[self._parity]:
-            op()
+        """One substep: replay the current parity's graph (CUDA) or run its recorded operations, then swap the
+        particle buffers."""
+        if self._graphs is not None:
+            wp.capture_launch(self._graphs[self._parity])
+        else:
+            for op in self._ops[self._parity]:
+                op()
         self._parity ^= 1
         self.state, self._spare = self._spare, self.state
 
