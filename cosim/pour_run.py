@@ -19,10 +19,10 @@ from dataclasses import asdict, replace
 from datetime import datetime, timezone
 from importlib import metadata
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
-from tqdm import tqdm
 
 from controllers.config import CatcherConfig, PourConfig
 from controllers.geometry import VesselGeometry
@@ -31,12 +31,14 @@ from cosim.coupling.loop import CoupledPour, build_pour
 from cosim.errors import InputError
 from cosim.frames import tilt_about_y
 from cosim.io.pour_series import write_series_csv
-from cosim.io.recording import PourRecorder
 from cosim.pour_scene import PourScene
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.limits import scene_limits
+
+if TYPE_CHECKING:
+    from cosim.io.recording import PourRecorder
 
 DEFAULT_RECORDINGS = Path("recordings")
 VERSIONED_PACKAGES = ("cosim", "warp-lang", "mujoco", "numpy", "control", "ruckig", "rerun-sdk")
@@ -178,6 +180,12 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
     os.chmod(work, 0o777 & ~umask)  # mkdtemp makes it private; the run folder gets the usual permissions
     recorder = None
     try:
+        # imported here: prepare() and a pour without its recording need neither rerun-sdk nor tqdm (the GPU
+        # machine's staged packages hold neither, cosim.bench.device_check)
+        from tqdm import tqdm
+
+        from cosim.io.recording import PourRecorder
+
         callbacks = []
         if scene.logging.enabled:
             recorder = PourRecorder(work / "pour.rrd", pour.scene.model, scene.logging.recording, particle_radius=0.5 * pour.fluid.config.spacing)

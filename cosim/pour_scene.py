@@ -20,7 +20,7 @@ from cosim.coupling.pose_filter import PoseFilterLimits
 from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig, GridReset, KernelType, PressureSolver
-from cosim.io.recording import RecordingConfig
+from cosim.io.recording_config import RecordingConfig
 from cosim.trajectory.limits import JointLimitOverride
 
 

@@ -28,7 +28,6 @@ import math
 import os
 import uuid
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
@@ -36,10 +35,11 @@ import numpy as np
 import rerun as rr
 from matplotlib import colormaps
 
-from cosim.checks import check_int, check_positive, check_range
+from cosim.checks import check_positive
 from cosim.errors import InputError
 from cosim.io import rerun_paths
 from cosim.io.rerun_blueprint import build_blueprint, series_label
+from cosim.io.recording_config import RecordingConfig
 from cosim.io.rerun_geometry import body_name, geom_visuals, log_static_geometry, xyzw_from_wxyz
 
 # Buffered rows per entity before they are sent as one column batch (bounds memory; 1000 rows of 30 signals
@@ -50,29 +50,6 @@ SPEED_COLORMAP = "viridis"
 # Fraction of a logging period by which a state may come early and still count for its slot (absorbs the
 # rounding of sim_time = step * dt).
 _SLOT_TOLERANCE = 1e-6
-
-
-@dataclass(frozen=True)
-class RecordingConfig:
-    """What goes into the recording.
-
-    particle_stride: log every k-th liquid particle (by particle index, so the same particles are shown in every
-        frame). [1, 1000]
-    particle_rate_hz: Hz of simulated time, at most how often body poses and particles are logged; scalars are
-        logged at every call. (0, 1000]
-    speed_color_max: m/s, particle speed at the top of the colour map (faster particles share its top colour).
-        (0, 100]
-    """
-
-    particle_stride: int = 1
-    particle_rate_hz: float = 50.0
-    speed_color_max: float = 2.0
-
-    def __post_init__(self) -> None:
-        s = object.__setattr__
-        s(self, "particle_stride", check_int("recording.particle_stride", self.particle_stride, 1, 1000))
-        s(self, "particle_rate_hz", check_range("recording.particle_rate_hz", self.particle_rate_hz, 0.0, 1000.0, "Hz", lo_open=True))
-        s(self, "speed_color_max", check_positive("recording.speed_color_max", self.speed_color_max, "m/s", 100.0))
 
 
 class _Columns:
