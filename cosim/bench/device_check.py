@@ -1,0 +1,277 @@
+"""The checks that need a CUDA device, as one short prepared run for a session that has one (issue 7).
+
+    python -m cosim.bench.device_check [--device cuda] [--out DIR] [--quick]
+
+Each check runs in its own process under its own time limit (a crash or a hang costs that check only), and the
+report, DIR/device_check.md, is printed at the end:
+
+1. agreement: the same short runs on the CPU and on the device: a tank tilted and shaken for 40 ms
+   (:data:`AGREEMENT_INTERVALS` intervals of 4 ms), WCSPH and DFSPH, 2-D and 3-D; the largest particle position
+   difference in particle spacings and the largest wrench difference over the liquid's weight; the device run
+   with its substeps replayed as CUDA graphs against launched one by one (and why capture failed, if it did).
+2. validation: the hydrostatic tank (0.5 s) and the slosh case (2 periods) on both: every metric side by side.
+3. throughput: ``cosim.fluid.benchmark`` on the device (issue 7's sizes: 2-D 10k, 3-D 100k and 1M particles,
+   both solvers, warp's ``example_sph`` beside the 3-D rows), and the 2-D row again without graph replay.
+4. pour: the coupled pour (robots, controllers, trajectory generation, no recording) on the device: the default
+   2-D scene and the 3-D one at 64 across (~112k particles), :data:`POUR_SECONDS` simulated after a warm-up that
+   compiles the kernels and captures the graphs; real-time factor.
+
+Sized to finish within one 600 s call of the device tool (:data:`TIME_LIMITS`); the warp install the GPU machine
+needs first is in ``../shared/gpu/README.md``. Written without a GPU at hand: never run on one yet.
+
+``--quick`` runs every check at small sizes (on the CPU too): a dry run of the machinery, numbers meaningless.
+Needs warp, mujoco, ruckig and control; not rerun-sdk or tqdm (the GPU machine's staged packages,
+``../shared/gpu/README.md``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from cosim.atomic_files import write_text_atomic
+
+AGREEMENT_INTERVALS = 10  # of 4 ms: long enough for the graph replay (from the second interval on) to matter
+AGREEMENT_INTERVAL = 0.004  # s
+# s simulated and timed per pour, by dimension (after the warm-up): the 3-D pour at 112k particles takes ~60,000
+# substeps per simulated second, a minute or more even at 1 ms a substep
+POUR_SECONDS = {2: 2.0, 3: 0.5}
+POUR_WARM_UP = 0.05  # s simulated before timing: compiles the kernels, captures the graphs
+POUR_3D_ACROSS = 64  # particles across the pourer of the 3-D pour: 111,936 particles
+# seconds each check may take on the device machine: together within one 600 s call of the device tool
+TIME_LIMITS = {"agreement": 90, "validation": 120, "throughput": 180, "pour": 150}
+CHECKS = tuple(TIME_LIMITS)
+
+
+def _capture_status(fluid) -> str:
+    """How the solver ran its substeps: replayed graphs, launches one by one (and why), or the CPU's launches."""
+    if not fluid.device.is_cuda:
+        return "- (CPU)"
+    return fluid.graph_capture_error or "captured"
+
+
+# ---- agreement --------------------------------------------------------------------------------------------
+def _tank_run(device: str, solver: str, dim: int, across: int, cuda_graphs: bool) -> dict:
+    """A tank of liquid tilted and shaken for AGREEMENT_INTERVALS intervals: positions, wrenches, substeps."""
+    from cosim.fluid.config import FluidConfig
+    from cosim.fluid.seeding import fill_vessel
+    from cosim.fluid.solver import FluidSolver
+    from cosim.frames import Pose, rotation_y
+    from cosim.vessel import VesselSpec
+
+    width, fill = 0.1, 0.06
+    tank = VesselSpec(name="tank", inner_width=width, inner_depth=width, inner_height=0.15)
+    cfg = FluidConfig(
+        dim=dim, spacing=width / across, pressure_solver=solver, max_expected_speed=2 * math.sqrt(9.81 * fill),
+        domain_min=(-0.15, -0.15, -0.05), domain_max=(0.15, 0.15, 0.25),
+    )
+    fluid = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, fill, cfg), device=device, cuda_graphs=cuda_graphs)
+    for k in range(1, AGREEMENT_INTERVALS + 1):
+        phase = k / AGREEMENT_INTERVALS
+        fluid.set_vessel_poses([Pose((0.005 * math.sin(2 * math.pi * phase), 0.0, 0.0), rotation_y(0.1 * phase))])
+        fluid.advance(AGREEMENT_INTERVAL)
+    weight = fluid.n_particles * cfg.particle_mass * cfg.out_of_plane_scale * 9.81
+    return {
+        "x": fluid.positions(), "wrench": fluid.vessel_wrenches(), "steps": fluid.step_count, "spacing": cfg.spacing,
+        "weight": weight, "particles": fluid.n_particles, "graphs": _capture_status(fluid),
+    }
+
+
+def _difference(a: dict, b: dict) -> dict:
+    return {
+        "max_dx_over_spacing": float(np.abs(a["x"] - b["x"]).max() / a["spacing"]),
+        "max_wrench_over_weight": float(np.abs(a["wrench"] - b["wrench"]).max() / a["weight"]),
+        "substeps": f"{a['steps']} / {b['steps']}",
+    }
+
+
+def check_agreement(device: str, quick: bool) -> list[dict]:
+    rows = []
+    for dim, across in ((2, 12 if quick else 24), (3, 6 if quick else 12)):
+        for solver in ("wcsph", "dfsph"):
+            cpu = _tank_run("cpu", solver, dim, across, False)
+            graphs = _tank_run(device, solver, dim, across, True)
+            launches = _tank_run(device, solver, dim, across, False)
+            rows.append({
+                "dim": dim, "solver": solver, "particles": cpu["particles"],
+                "cpu_vs_device": _difference(cpu, graphs), "graphs_vs_launches": _difference(graphs, launches),
+                "graphs": graphs["graphs"],
+            })
+    return rows
+
+
+def _agreement_table(rows: list[dict]) -> list[str]:
+    out = [
+        "| case | particles | CPU vs device: max dx / spacing | max wrench / weight | substeps | graphs vs launches: max dx / spacing | graph capture |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        c, g = r["cpu_vs_device"], r["graphs_vs_launches"]
+        out.append(f"| {r['dim']}-D {r['solver']} | {r['particles']} | {c['max_dx_over_spacing']:.2e} | {c['max_wrench_over_weight']:.2e} | "
+                   f"{c['substeps']} | {g['max_dx_over_spacing']:.2e} | {r['graphs']} |")
+    return out
+
+
+# ---- validation -------------------------------------------------------------------------------------------
+def check_validation(device: str, quick: bool) -> list[dict]:
+    from cosim.validation import hydrostatic, slosh
+
+    runs = (
+        ("hydrostatic", hydrostatic.run, lambda d: hydrostatic.Params(device=d, duration=0.05 if quick else 0.5, spacing=0.191 / 16 if quick else None)),
+        ("slosh", slosh.run, lambda d: slosh.Params(device=d, periods=0.5 if quick else 2.0, spacing=0.191 / 16 if quick else None)),
+    )
+    rows = []
+    for name, run, params in runs:
+        cpu, dev = run(params("cpu")), run(params(device))
+        for a, b in zip(cpu.metrics, dev.metrics):
+            rows.append({"case": name, "metric": a.name, "unit": a.unit, "cpu": a.measured, "device": b.measured,
+                         "cpu_wall_s": cpu.wall_time, "device_wall_s": dev.wall_time})
+    return rows
+
+
+def _validation_table(rows: list[dict]) -> list[str]:
+    out = ["| case | metric | CPU | device | difference |", "|---|---|---|---|---|"]
+    for r in rows:
+        diff = r["device"] - r["cpu"]
+        out.append(f"| {r['case']} | {r['metric']} ({r['unit'] or '-'}) | {r['cpu']:.6g} | {r['device']:.6g} | {diff:+.3g} |")
+    walls = {r["case"]: (r["cpu_wall_s"], r["device_wall_s"]) for r in rows}
+    out.append("")
+    out += [f"{case}: wall time {c:.1f} s on the CPU, {d:.1f} s on the device." for case, (c, d) in walls.items()]
+    return out
+
+
+# ---- throughput -------------------------------------------------------------------------------------------
+def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
+    from cosim.fluid import benchmark
+
+    counts2d, counts3d = (["500"], ["2000"]) if quick else (["10000"], ["100000", "1000000"])
+    table = out / "throughput.md"
+    table.unlink(missing_ok=True)  # the benchmark appends: start this run's table afresh
+    common = ["--device", device, "--solvers", "wcsph", "dfsph", "--out", str(table)]
+    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *common])
+    benchmark.main(["--counts2d", *counts2d, "--counts3d", "--no-cuda-graphs", *common])
+    return [{"table": table.read_text()}]
+
+
+# ---- pour -------------------------------------------------------------------------------------------------
+def _pour(device: str, dim: int, across: int, seconds: float) -> dict:
+    from cosim.coupling.settings import CouplingSettings
+    from cosim.pour_run import prepare
+    from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene
+
+    scene = PourScene(
+        device=device, fluid=replace(FluidSettings(), dim=dim, particles_across=across),
+        coupling=CouplingSettings(max_duration=POUR_WARM_UP + seconds), logging=LoggingSettings(enabled=False),
+    )
+    pour = prepare(scene)
+    while pour.time < POUR_WARM_UP - 1e-9:
+        pour.step()
+    steps0, start = pour.fluid.step_count, time.perf_counter()
+    while pour.time < POUR_WARM_UP + seconds - 1e-9:
+        pour.step()
+    wall = time.perf_counter() - start
+    return {
+        "dim": dim, "across": across, "particles": pour.fluid.n_particles, "simulated_s": seconds, "wall_s": wall,
+        "real_time_factor": seconds / wall, "sph_substeps": pour.fluid.step_count - steps0,
+        "graphs": _capture_status(pour.fluid),
+    }
+
+
+def check_pour(device: str, quick: bool) -> list[dict]:
+    if quick:
+        return [_pour(device, 2, 32, 0.05), _pour(device, 3, 12, 0.05)]
+    return [_pour(device, 2, 32, POUR_SECONDS[2]), _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3])]
+
+
+def _pour_table(rows: list[dict]) -> list[str]:
+    out = ["| pour | particles | simulated s | wall s | real-time factor | SPH substeps | graph capture |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        out.append(f"| {r['dim']}-D, {r['across']} across | {r['particles']} | {r['simulated_s']:g} | {r['wall_s']:.1f} | "
+                   f"{r['real_time_factor']:.3f} | {r['sph_substeps']} | {r['graphs']} |")
+    return out
+
+
+# ---- driver -----------------------------------------------------------------------------------------------
+def _run_one(check: str, device: str, quick: bool, out: Path) -> list[dict]:
+    if check == "agreement":
+        return check_agreement(device, quick)
+    if check == "validation":
+        return check_validation(device, quick)
+    if check == "throughput":
+        return check_throughput(device, quick, out)
+    return check_pour(device, quick)
+
+
+def _to_json(value):
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return str(value)
+
+
+def _report(results: dict[str, dict], device: str, quick: bool) -> str:
+    tables = {"agreement": _agreement_table, "validation": _validation_table, "pour": _pour_table}
+    lines = [f"# Device check ({device}{', quick: numbers meaningless' if quick else ''})", ""]
+    for check in CHECKS:
+        r = results.get(check)
+        lines.append(f"## {check}")
+        lines.append("")
+        if r is None:
+            lines.append("not run")
+        elif r["status"] != "ok":
+            lines.append(f"{r['status']} after {r['wall_s']:.0f} s: {r.get('error', '')}")
+        elif check == "throughput":
+            lines.append(r["rows"][0]["table"].strip())
+        else:
+            lines += tables[check](r["rows"])
+        if r is not None:
+            lines += ["", f"({r['wall_s']:.0f} s)"]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--device", default="cuda", help="the device to check against the CPU (default cuda)")
+    p.add_argument("--out", type=Path, default=Path("recordings") / "device_check", help="folder for the report and raw results")
+    p.add_argument("--quick", action="store_true", help="small sizes: a dry run of the machinery (numbers meaningless)")
+    p.add_argument("--only", choices=CHECKS, nargs="*", default=list(CHECKS), help="run these checks only")
+    p.add_argument("--child", choices=CHECKS, help=argparse.SUPPRESS)  # one check, in the process the driver started
+    args = p.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    if args.child:
+        rows = _run_one(args.child, args.device, args.quick, args.out)
+        write_text_atomic(args.out / f"{args.child}.json", json.dumps(rows, default=_to_json, indent=1))
+        return 0
+    results = {}
+    for check in args.only:
+        cmd = [sys.executable, "-m", "cosim.bench.device_check", "--child", check, "--device", args.device, "--out", str(args.out)]
+        cmd += ["--quick"] if args.quick else []
+        start = time.perf_counter()
+        print(f"device check: {check} ...", flush=True)
+        try:
+            done = subprocess.run(cmd, capture_output=True, text=True, timeout=TIME_LIMITS[check])
+            status = "ok" if done.returncode == 0 else f"failed (exit {done.returncode})"
+            error = done.stderr.strip().splitlines()[-1] if done.returncode and done.stderr.strip() else ""
+            write_text_atomic(args.out / f"{check}.log", done.stdout + done.stderr)
+        except subprocess.TimeoutExpired:
+            status, error = "timed out", f"the {TIME_LIMITS[check]} s limit"
+        result = {"status": status, "wall_s": time.perf_counter() - start, "error": error}
+        if status == "ok":
+            result["rows"] = json.loads((args.out / f"{check}.json").read_text())
+        results[check] = result
+    report = _report(results, args.device, args.quick)
+    write_text_atomic(args.out / "device_check.md", report + "\n")
+    print(report)
+    return 0 if all(r["status"] == "ok" for r in results.values()) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
