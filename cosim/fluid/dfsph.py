@@ -65,7 +65,7 @@ from cosim.fluid.diagnostics import (
 )
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
-from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair, wall_pair
+from cosim.fluid.sph_common import add_wall_reaction, finish_particle, kernel_gradient, pair_wall, viscous_pair, wall_pair
 from cosim.fluid.sph_kernels import kernel_w
 
 # Warm starts (Bender & Koschier 2017, Sec. 4.3): each solve starts from a fraction of the stiffness it applied in
@@ -208,10 +208,10 @@ def compute_density_factor(
 @wp.func
 def pair_mass(prm: SPHParams, b_volume: wp.array(dtype=float), j: int) -> float:
     """Mass (kg, or kg/m in 2-D) of pair-list entry ``j``: the particle mass, or rho0 V_b of wall particle
-    b = -1 - j (:func:`wall_pair`)."""
+    :func:`pair_wall` of j."""
     if j >= 0:
         return prm.mass
-    return prm.rest_density * b_volume[-1 - j]
+    return prm.rest_density * b_volume[pair_wall(j)]
 
 
 @wp.kernel
@@ -286,7 +286,7 @@ def compute_solve_error(
         if j >= 0:
             vj = v[j]
         else:
-            vj = bv[-1 - j]
+            vj = bv[pair_wall(j)]
         rate += wp.dot(vi - vj, pair_mass(prm, b_volume, j) * pair_grad[i, k])
     e = h * rate
     if mode == SOLVE_DENSITY:
@@ -390,7 +390,7 @@ def compute_nonpressure(
             vij = vi - v[j]
             a += viscous_pair(prm, prm.alpha, prm.mass, r, wp.dot(r, r), pair_grad[i, k], vij, vij, rhoi, rho[j])
         else:
-            b = -1 - j
+            b = pair_wall(j)
             r = xi - bx[b]
             a += wall_pair_viscosity(prm, b_volume[b], r, wp.dot(r, r), pair_grad[i, k], vi - bv[b], rhoi)
     a += prm.gravity
@@ -449,18 +449,13 @@ def compute_wall_reaction(
         j = pair_index[i, k]
         if j >= 0:
             continue
-        b = -1 - j
+        b = pair_wall(j)
         xb = bx[b]
         r = xi - xb
         gw = pair_grad[i, k]
         ab = wall_pair_viscosity(prm, b_volume[b], r, wp.dot(r, r), gw, vi - bv[b], rhoi)
         ab -= (prm.rest_density * b_volume[b] * ki) * gw
-        kv = b_vessel[b]
-        m = motions[kv]
-        com = m.p_now + m.r_now @ vessels[kv].com
-        f_vessel = -prm.mass_out * ab
-        wall_force[kv, i] = wall_force[kv, i] + f_vessel
-        wall_torque[kv, i] = wall_torque[kv, i] + wp.cross(xb - com, f_vessel)
+        add_wall_reaction(prm, vessels, motions, b_vessel[b], i, xb, ab, wall_force, wall_torque)
 
 
 @wp.kernel

@@ -43,6 +43,12 @@ def wall_pair(b: int) -> int:
 
 
 @wp.func
+def pair_wall(j: int) -> int:
+    """The wall particle of pair-list code j < 0 (the inverse of :func:`wall_pair`)."""
+    return -1 - j
+
+
+@wp.func
 def kernel_gradient(prm: SPHParams, r: wp.vec3, r2: float) -> wp.vec3:
     """grad_i W(x_i - x_j) for r = x_i - x_j, |r|^2 = r2 > 0 (1/m^(dim+1))."""
     rl = wp.sqrt(r2)
@@ -65,6 +71,28 @@ def viscous_pair(
         a += (mass_j * alpha * prm.sound_speed * mu / (0.5 * (rho_i + rho_j))) * gw
     a += (mass_j * prm.nu * (1.0 / rho_i + 1.0 / rho_j) * wp.dot(r, gw) / (r2 + prm.eta2)) * v_rel_laminar
     return a
+
+
+@wp.func
+def add_wall_reaction(
+    prm: SPHParams,
+    vessels: wp.array(dtype=VesselGeometry),
+    motions: wp.array(dtype=VesselMotion),
+    kv: int,
+    i: int,
+    xb: wp.vec3,
+    a_wall: wp.vec3,
+    wall_force: wp.array2d(dtype=wp.vec3),
+    wall_torque: wp.array2d(dtype=wp.vec3),
+):
+    """Add to particle i's reaction on vessel kv the opposite of the acceleration ``a_wall`` (m/s^2) one of that
+    vessel's wall particles, at ``xb``, gave it: the force -m a_wall (N, the 3-D mass the particle stands for) and
+    its moment about the vessel's centre of mass at the substep's start (N m)."""
+    m = motions[kv]
+    com = m.p_now + m.r_now @ vessels[kv].com
+    f_vessel = -prm.mass_out * a_wall
+    wall_force[kv, i] = wall_force[kv, i] + f_vessel
+    wall_torque[kv, i] = wall_torque[kv, i] + wp.cross(xb - com, f_vessel)
 
 
 @wp.func

@@ -34,7 +34,7 @@ from cosim.fluid.boundary import VesselGeometry, VesselMotion, inside_vessel
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
-from cosim.fluid.sph_common import finish_particle, kernel_gradient, viscous_pair, wall_pair
+from cosim.fluid.sph_common import add_wall_reaction, finish_particle, kernel_gradient, pair_wall, viscous_pair, wall_pair
 from cosim.fluid.sph_kernels import kernel_w
 
 # The renormalisation matrix L^-1 (identity for a full kernel support) is used only where det L exceeds this:
@@ -261,12 +261,7 @@ def compute_forces(
                     ab = -(mw * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
                     ab += viscous_pair(prm, alpha_wall, mw, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
                     a += ab
-                    kv = b_vessel[b]
-                    m = motions[kv]
-                    com = m.p_now + m.r_now @ vessels[kv].com
-                    f_vessel = -prm.mass_out * ab
-                    wall_force[kv, i] = wall_force[kv, i] + f_vessel
-                    wall_torque[kv, i] = wall_torque[kv, i] + wp.cross(xb - com, f_vessel)
+                    add_wall_reaction(prm, vessels, motions, b_vessel[b], i, xb, ab, wall_force, wall_torque)
     if count > capacity:
         wp.atomic_add(diag_i, row[0], DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
@@ -329,7 +324,7 @@ def compute_density_rate(
             psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + rho_grad[j], gw)
             dr += diffusion * (prm.mass / rhoj) * psi
         else:
-            b = -1 - j
+            b = pair_wall(j)
             dr += prm.rest_density * b_volume[b] * wp.dot(vi - bv[b], gw)
     drho[i] = dr
 
