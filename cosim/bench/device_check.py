@@ -210,12 +210,6 @@ def _run_one(check: str, device: str, quick: bool, out: Path) -> list[dict]:
     return check_pour(device, quick)
 
 
-def _to_json(value):
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    return str(value)
-
-
 def _report(results: dict[str, dict], device: str, quick: bool) -> str:
     tables = {"agreement": _agreement_table, "validation": _validation_table, "pour": _pour_table}
     lines = [f"# Device check ({device}{', quick: numbers meaningless' if quick else ''})", ""]
@@ -248,7 +242,7 @@ def main(argv: list[str] | None = None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     if args.child:
         rows = _run_one(args.child, args.device, args.quick, args.out)
-        write_text_atomic(args.out / f"{args.child}.json", json.dumps(rows, default=_to_json, indent=1))
+        write_text_atomic(args.out / f"{args.child}.json", json.dumps(rows, indent=1))
         return 0
     results = {}
     for check in args.only:
