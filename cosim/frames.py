@@ -83,6 +83,14 @@ def rotation_from_vector(w: np.ndarray) -> np.ndarray:
     return np.eye(3) + math.sin(angle) * kx + (1.0 - math.cos(angle)) * (kx @ kx)
 
 
+def cross3(a, b) -> np.ndarray:
+    """a x b of two 3-vectors (same arithmetic, and result, as ``np.cross``, without its dispatch cost, which
+    dominates for a single pair in the step loop)."""
+    a0, a1, a2 = float(a[0]), float(a[1]), float(a[2])
+    b0, b1, b2 = float(b[0]), float(b[1]), float(b[2])
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 class Pose:
     """A rigid pose: ``position`` (3,) m and ``rotation`` (3, 3), mapping frame vectors to world vectors."""
 

@@ -11,6 +11,7 @@ the liquid leaves the vessel (the seed's pivot during CFS).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from enum import Enum
@@ -138,11 +139,14 @@ class VesselSpec:
         """kg, empty vessel."""
         return self.wall_volume * self.wall_density
 
-    @property
+    @functools.cached_property
     def com_local(self) -> np.ndarray:
-        """Centre of mass of the empty vessel in the vessel frame (m)."""
+        """Centre of mass of the empty vessel in the vessel frame (m); read-only (computed once: the coupling reads
+        it every step)."""
         parts = self._wall_parts()
-        return sum(v * c for v, c in parts) / sum(v for v, _ in parts)
+        com = sum(v * c for v, c in parts) / sum(v for v, _ in parts)
+        com.flags.writeable = False
+        return com
 
     @property
     def outer_half_extents(self) -> np.ndarray:

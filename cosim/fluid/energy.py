@@ -24,7 +24,7 @@ from typing import Sequence
 import numpy as np
 
 from cosim.fluid.config import FluidConfig
-from cosim.frames import Pose, rotation_from_vector
+from cosim.frames import Pose, cross3, rotation_from_vector
 from cosim.vessel import VesselSpec
 
 
@@ -68,7 +68,7 @@ class EnergyAccount:
         linear (V, 3, m/s) and angular (V, 3, rad/s) velocities over ``duration`` (s)."""
         for k, pose in enumerate(before):
             rotation_mid = rotation_from_vector(0.5 * duration * ang_vel[k]) @ pose.rotation
-            v_com = lin_vel[k] + np.cross(ang_vel[k], rotation_mid @ self.com_local[k])
+            v_com = lin_vel[k] + cross3(ang_vel[k], rotation_mid @ self.com_local[k])
             self.wall_work -= float(wrenches[k, :3] @ v_com + wrenches[k, 3:] @ ang_vel[k]) * duration
         self.removed += removed
         self.energy = kinetic + potential + self.removed

@@ -25,6 +25,7 @@ naming the step and what broke. Results come back as numpy arrays in the particl
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -107,6 +108,7 @@ class FluidSolver:
         self.model: FluidModel = build_model(config, tuple(vessels), self.n_particles, self.device)
         self.time = 0.0
         self.step_count = 0
+        self.substep_wall_time = 0.0  # s of wall clock spent in the substeps (device work included), for benchmarks
         self._poses = [self._planar(p) for p in poses]
         self._targets = list(self._poses)
         self._last_max_speed = 0.0
@@ -168,6 +170,10 @@ class FluidSolver:
         self._b_v_noslip = wp.zeros(nb, dtype=wp.vec3, device=d)
         self._b_active = wp.ones(nb, dtype=wp.int32, device=d)
         self._motions = wp.zeros(m.n_vessels, dtype=bd.VesselMotion, device=d)
+        # the motions are written on the host through a structured numpy view (the CPU device's array itself, else a
+        # pinned staging copy): no per-field warp struct assignment in the step loop
+        self._motions_host = self._motions if not d.is_cuda else wp.zeros(m.n_vessels, dtype=bd.VesselMotion, device="cpu", pinned=True)
+        self._motions_view = self._motions_host.numpy()
         self._dt = wp.zeros(1, dtype=float, device=d)
         self._substep_weight = wp.zeros(1, dtype=float, device=d)
         self._row = wp.zeros(1, dtype=wp.int32, device=d)
@@ -198,20 +204,16 @@ class FluidSolver:
         self._graphs = None
 
     def _upload_motions(self, lin_vel: np.ndarray, ang_vel: np.ndarray, lin_acc: np.ndarray, ang_acc: np.ndarray) -> None:
-        motions = []
-        for k, pose in enumerate(self._poses):
-            mo = bd.VesselMotion()
-            mo.p0 = wp.vec3(*pose.position)
-            mo.r0 = wp.mat33(*pose.rotation.ravel())
-            mo.lin_vel = wp.vec3(*lin_vel[k])
-            mo.ang_vel = wp.vec3(*ang_vel[k])
-            mo.lin_acc = wp.vec3(*lin_acc[k])
-            mo.ang_acc = wp.vec3(*ang_acc[k])
-            mo.p_now = mo.p_next = mo.p0
-            mo.r_now = mo.r_next = mo.r0
-            motions.append(mo)
-        if motions:  # copied into the existing array: the recorded launches hold it
-            wp.copy(self._motions, wp.array(motions, dtype=bd.VesselMotion, device="cpu"))
+        """The vessels' motion over the next interval (world frame; (V, 3) m/s, rad/s, m/s^2, rad/s^2), from their
+        current poses; the substeps' own poses start there."""
+        if not self._poses:
+            return
+        mo = self._motions_view
+        mo["p0"] = mo["p_now"] = mo["p_next"] = [pose.position for pose in self._poses]
+        mo["r0"] = mo["r_now"] = mo["r_next"] = [pose.rotation for pose in self._poses]
+        mo["lin_vel"], mo["ang_vel"], mo["lin_acc"], mo["ang_acc"] = lin_vel, ang_vel, lin_acc, ang_acc
+        if self._motions_host is not self._motions:  # copied into the existing array: the recorded launches hold it
+            wp.copy(self._motions, self._motions_host)
 
     # ---- driving ---------------------------------------------------------------------------------------------
     def set_vessel_poses(self, poses: Sequence[Pose]) -> None:
@@ -270,8 +272,12 @@ class FluidSolver:
         self._diag_i.zero_()
         self._force_sum.zero_()
         self._torque_sum.zero_()
+        start = time.perf_counter()
         for _ in range(n_sub):
             self._substep()
+        if self.device.is_cuda:
+            wp.synchronize_device(self.device)  # the diagnostics copy below waits for the device anyway
+        self.substep_wall_time += time.perf_counter() - start
         if self._capture_graphs and self._graphs is None:
             self._graphs = self._capture()
         rows_f = self._diag_f.numpy()[:n_sub].copy()

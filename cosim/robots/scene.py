@@ -33,6 +33,7 @@ from cosim.robots.planar import PlanarPose, planar_to_world
 from cosim.robots.scene_builder import CUSTOM_PREFIX, HOME_KEY, build_scene_spec
 from cosim.robots.scene_config import ArmRole, SceneConfig
 from cosim.robots.vessel_mjcf import frame_site, lip_site
+from cosim.frames import cross3
 from cosim.vessel import VesselShape, VesselSpec
 
 
@@ -53,7 +54,7 @@ class VesselState:
 
     def velocity_at(self, point: np.ndarray) -> np.ndarray:
         """Velocity (3,) m/s of the rigid vessel at world ``point`` (3,) m: ``v + w x (p - pos)``."""
-        return self.lin_vel + np.cross(self.ang_vel, np.asarray(point, dtype=float) - self.pos)
+        return self.lin_vel + cross3(self.ang_vel, np.asarray(point, dtype=float) - self.pos)
 
 
 @dataclass(frozen=True)
@@ -82,9 +83,7 @@ def shift_wrench(force: np.ndarray, torque: np.ndarray, from_point: np.ndarray, 
     """Torque (3,) N m about ``to_point`` of a wrench given as ``force`` (3,) N and ``torque`` (3,) N m about
     ``from_point``; all world frame: ``tau_to = tau_from + (from_point - to_point) x force``. Use it to move a wrench
     to the vessel's centre of mass (``VesselState.com``) before :meth:`RobotScene.apply_vessel_wrench`."""
-    return np.asarray(torque, dtype=float) + np.cross(
-        np.asarray(from_point, dtype=float) - np.asarray(to_point, dtype=float), np.asarray(force, dtype=float)
-    )
+    return np.asarray(torque, dtype=float) + cross3(np.asarray(from_point, dtype=float) - np.asarray(to_point, dtype=float), force)
 
 
 def _text(model: mujoco.MjModel, name: str, source: str) -> str:
