@@ -8,7 +8,7 @@ report, DIR/device_check.md, is printed at the end:
 1. agreement: the same short runs on the CPU and on the device: a tank tilted and shaken for 40 ms
    (:data:`AGREEMENT_INTERVALS` intervals of 4 ms), WCSPH and DFSPH, 2-D and 3-D; the largest particle position
    difference in particle spacings and the largest wrench difference over the liquid's weight; the device run
-   with its substeps replayed as CUDA graphs against launched one by one (and why capture failed, if it did).
+   with its substeps replayed as captured graphs against launched one by one (and why capture failed, if it did).
 2. validation: the hydrostatic tank (0.5 s) and the slosh case (2 periods) on both: every metric side by side.
 3. throughput: ``cosim.fluid.benchmark`` on the device (issue 7's sizes: 2-D 10k, 3-D 100k and 1M particles,
    both solvers, warp's ``example_sph`` beside the 3-D rows), and the 2-D row again without graph replay.
@@ -52,14 +52,13 @@ CHECKS = tuple(TIME_LIMITS)
 
 
 def _capture_status(fluid) -> str:
-    """How the solver ran its substeps: replayed graphs, launches one by one (and why), or the CPU's launches."""
-    if not fluid.device.is_cuda:
-        return "- (CPU)"
+    """How the solver ran its substeps: replayed graphs (CUDA graphs, or warp's CPU operation stream), or
+    launches one by one because capture failed (and why)."""
     return fluid.graph_capture_error or "captured"
 
 
 # ---- agreement --------------------------------------------------------------------------------------------
-def _tank_run(device: str, solver: str, dim: int, across: int, cuda_graphs: bool) -> dict:
+def _tank_run(device: str, solver: str, dim: int, across: int, graphs: bool) -> dict:
     """A tank of liquid tilted and shaken for AGREEMENT_INTERVALS intervals: positions, wrenches, substeps."""
     from cosim.fluid.config import FluidConfig
     from cosim.fluid.seeding import fill_vessel
@@ -73,7 +72,7 @@ def _tank_run(device: str, solver: str, dim: int, across: int, cuda_graphs: bool
         dim=dim, spacing=width / across, pressure_solver=solver, max_expected_speed=2 * math.sqrt(9.81 * fill),
         domain_min=(-0.15, -0.15, -0.05), domain_max=(0.15, 0.15, 0.25),
     )
-    fluid = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, fill, cfg), device=device, cuda_graphs=cuda_graphs)
+    fluid = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, fill, cfg), device=device, graphs=graphs)
     for k in range(1, AGREEMENT_INTERVALS + 1):
         phase = k / AGREEMENT_INTERVALS
         fluid.set_vessel_poses([Pose((0.005 * math.sin(2 * math.pi * phase), 0.0, 0.0), rotation_y(0.1 * phase))])
@@ -157,7 +156,7 @@ def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
     table.unlink(missing_ok=True)  # the benchmark appends: start this run's table afresh
     common = ["--device", device, "--solvers", "wcsph", "dfsph", "--out", str(table)]
     benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *common])
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", "--no-cuda-graphs", *common])
+    benchmark.main(["--counts2d", *counts2d, "--counts3d", "--no-graphs", *common])
     return [{"table": table.read_text()}]
 
 

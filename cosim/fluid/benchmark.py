@@ -2,7 +2,7 @@
 ``example_sph`` at the same particle count (a benchmark, not a test).
 
     python -m cosim.fluid.benchmark [--device cpu|cuda] [--counts2d 1000 4000 16000] [--counts3d 4000 16000 62500]
-                                    [--solvers wcsph dfsph] [--repeats 3] [--no-cuda-graphs] [--out docs/benchmarks.md]
+                                    [--solvers wcsph dfsph] [--repeats 3] [--no-graphs] [--out docs/benchmarks.md]
 
 Ours: a resting box of liquid in a tank (the hydrostatic case), every stage of a substep (walls, neighbour sort,
 reorder, then the pressure solver's stages, integration, wrench reduction), for each pressure solver. Besides
@@ -38,7 +38,7 @@ from cosim.vessel import VesselSpec
 TANK_ASPECT = 1.0  # the liquid block is as tall as it is wide
 
 
-def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, cuda_graphs: bool = True) -> tuple[float, float, int, float]:
+def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, graphs: bool = True) -> tuple[float, float, int, float]:
     """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s) of our
     solver on a resting liquid block of ~n particles, timed over intervals of ``steps`` WCSPH substeps after a
     settling interval of the same length (kernel compilation, DFSPH's cold start and the CUDA graph capture
@@ -54,7 +54,7 @@ def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: Press
         domain_min=(-0.5 * width - m, -0.5 * depth - m, -m), domain_max=(0.5 * width + m, 0.5 * depth + m, 1.5 * width + m),
     )
     block = liquid_block((-0.5 * width, -0.5 * depth, 0.0), (0.5 * width, 0.5 * depth, width * TANK_ASPECT), cfg)
-    fluid = FluidSolver(cfg, [tank], [Pose()], block, device=device, cuda_graphs=cuda_graphs)
+    fluid = FluidSolver(cfg, [tank], [Pose()], block, device=device, graphs=graphs)
     interval = steps * cfg.cfl * cfg.smoothing_length / cfg.sound_speed * 0.999
     fluid.advance(interval)  # warm-up: compiles, records, settles
     rates, speeds, dts = [], [], []
@@ -124,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--steps", type=int, default=20, help="WCSPH substeps per timed interval (the same simulated interval for every solver)")
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--solvers", nargs="*", choices=[s.value for s in PressureSolver], default=[s.value for s in PressureSolver])
-    p.add_argument("--no-cuda-graphs", action="store_true", help="run a substep's launches one by one on CUDA instead of replaying its graph")
+    p.add_argument("--no-graphs", action="store_true", help="run a substep's launches one by one instead of replaying its captured graph")
     p.add_argument("--out", type=Path, default=None, help="append the table to this Markdown file")
     args = p.parse_args(argv)
     device = resolve_device(args.device)
@@ -133,7 +133,7 @@ def main(argv: list[str] | None = None) -> int:
         for n in counts:
             theirs = float("nan")
             for k, name in enumerate(args.solvers):
-                ours, sim_rate, actual, dt = _ours(n, dim, str(device), args.steps, args.repeats, PressureSolver(name), not args.no_cuda_graphs)
+                ours, sim_rate, actual, dt = _ours(n, dim, str(device), args.steps, args.repeats, PressureSolver(name), not args.no_graphs)
                 if dim == 3 and k == 0:
                     theirs = _example_sph(actual, str(device), args.steps, args.repeats)
                 rows.append((dim, actual, name, ours, sim_rate, dt, theirs))
@@ -149,7 +149,7 @@ def main(argv: list[str] | None = None) -> int:
         f"Machine: {_machine()}. Versions: Python {platform.python_version()}, warp {wp.__version__}, numpy {np.__version__}.\n"
         f"Command: `python -m cosim.fluid.benchmark --device {args.device} --counts2d {' '.join(map(str, args.counts2d))} "
         f"--counts3d {' '.join(map(str, args.counts3d))} --solvers {' '.join(args.solvers)} --steps {args.steps} --repeats {args.repeats}"
-        f"{' --no-cuda-graphs' if args.no_cuda_graphs else ''}`. "
+        f"{' --no-graphs' if args.no_graphs else ''}`. "
         f"Median of {args.repeats} intervals of {args.steps} WCSPH substeps' simulated time after a settling interval; one step "
         "is the full substep (walls, neighbour sort and reorder, the pressure solver's stages, integration, wrench "
         "reduction; DFSPH's includes its iterations); simulated s / wall s compares the solvers at equal simulated time; "

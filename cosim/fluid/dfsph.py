@@ -37,9 +37,10 @@ acted over dt; reported as its average over the interval), the wall reaction, an
 substep.
 
 The stopping test reads one int32 flag that ``check_convergence`` writes on the device, driven by
-``wp.capture_while``: on the CPU it reads the flag from memory each iteration; on CUDA it becomes a conditional
-graph node when captured (otherwise warp copies the flag to the host each iteration). Verified on the CPU only:
-no GPU was available when this was written, so neither the CUDA run nor its graph capture has been executed.
+``wp.capture_while``: captured, it becomes a conditional graph node on CUDA and a while operation of warp's
+operation stream on the CPU; launched one by one, warp reads the flag each iteration (on CUDA through a copy to
+the host). Verified on the CPU only: no GPU was available when this was written, so neither the CUDA run nor its
+graph capture has been executed.
 The average error is summed as integers (quanta of ``ERROR_QUANTUM``) so it does not depend on the order of the atomic adds: the
 iteration count, and with it the trajectory, is deterministic on every device.
 

@@ -15,9 +15,11 @@ or DFSPH (``cosim.fluid.dfsph``)
     compute_nonpressure; density solve; compute_wall_reaction; integrate (+ wall guard); reduce_wrenches
 
 entirely on the device (no host copies inside; only the interval's plan and its diagnostics cross; DFSPH's
-convergence loops read a device flag through ``wp.capture_while``, see ``cosim.fluid.dfsph``). On a CUDA device
-each substep is replayed as one captured CUDA graph from the second interval on (written without a GPU at hand:
-``python -m cosim.bench.device_check`` is the check to run where one is). After the
+convergence loops read a device flag through ``wp.capture_while``, see ``cosim.fluid.dfsph``). From the second
+interval on each substep is replayed as one captured graph: a CUDA graph on a CUDA device (written without a GPU at
+hand: ``python -m cosim.bench.device_check`` is the check to run where one is), on the CPU warp's operation stream
+(APIC), which replays the launches in C++ without Python's per-launch argument handling (same results to the bit,
+tests/test_fluid_graphs.py). After the
 interval the per-substep diagnostics are checked and an instability raises :class:`FluidInstabilityError`
 naming the step and what broke. Results come back as numpy arrays in the particles' original order.
 """
@@ -81,9 +83,10 @@ class FluidSolver:
       poses: initial world pose of each vessel frame.
       particles: the initial liquid (e.g. from :func:`cosim.fluid.seeding.fill_vessel`).
       device: "cpu" or "cuda[:N]".
-      cuda_graphs: on a CUDA device, replay each substep as one captured CUDA graph (captured after the first
-        interval, which runs the operations one by one and so sizes the sort's scratch memory); the operations
-        one by one where capture fails (:attr:`graph_capture_error` says why) or when False. No effect on the CPU.
+      graphs: replay each substep as one captured graph (CUDA graph, or on the CPU warp's APIC operation stream;
+        captured after the first interval, which runs the operations one by one and so compiles the kernels and
+        sizes the sort's scratch memory); the operations one by one where capture fails
+        (:attr:`graph_capture_error` says why) or when False.
     In 2-D, vessel poses are projected onto the pour plane (rotation about y, translation in x-z, y = 0).
     """
 
@@ -94,7 +97,7 @@ class FluidSolver:
         poses: Sequence[Pose],
         particles: ParticleSet,
         device: str = "cpu",
-        cuda_graphs: bool = True,
+        graphs: bool = True,
     ):
         if len(vessels) != len(poses):
             raise InputError(f"fluid: {len(vessels)} vessels but {len(poses)} poses")
@@ -115,7 +118,7 @@ class FluidSolver:
         self._last_max_accel = config.gravity_magnitude
         self._history: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         self._last_report: IntervalReport | None = None
-        self._capture_graphs = cuda_graphs and self.device.is_cuda
+        self._capture_graphs = graphs
         self.graph_capture_error: str | None = None
         self._graphs: tuple | None = None
         self._allocate(particles)
@@ -425,8 +428,9 @@ class FluidSolver:
         ]
 
     def _capture(self) -> tuple | None:
-        """Both parities' substeps as CUDA graphs (DFSPH's solve loops become conditional nodes), or None, with
-        the reason in :attr:`graph_capture_error`, where warp or the driver cannot capture them."""
+        """Both parities' substeps as graphs (DFSPH's solve loops become conditional nodes on CUDA, while
+        operations on the CPU), or None, with the reason in :attr:`graph_capture_error`, where warp or the driver
+        cannot capture them."""
         graphs = []
         try:
             for ops in self._ops:
@@ -441,8 +445,8 @@ class FluidSolver:
         return tuple(graphs)
 
     def _substep(self) -> None:
-        """One substep: replay the current parity's graph (CUDA) or run its recorded operations, then swap the
-        particle buffers."""
+        """One substep: replay the current parity's graph or run its recorded operations, then swap the particle
+        buffers."""
         if self._graphs is not None:
             wp.capture_launch(self._graphs[self._parity])
         else:
