@@ -23,3 +23,13 @@ def test_a_failing_check_is_reported_and_sets_the_exit_status(tmp_path):
     assert device_check.main(["--device", "cuda:7", "--quick", "--only", "agreement", "--out", str(tmp_path)]) == 1
     report = (tmp_path / "device_check.md").read_text()
     assert "failed (exit" in report and "cuda:7" in report
+
+
+def test_pour_rows_split_the_wall_time_into_substeps_and_the_rest():
+    row = device_check._pour("cpu", 2, 12, 0.02)
+    assert row["particles"] > 0 and row["sph_substeps"] > 0 and row["graphs"] == "captured"
+    steps = round(row["simulated_s"] / 0.002)  # 2 ms MuJoCo steps
+    assert 0.0 < row["substeps_ms_per_step"] and 0.0 < row["host_ms_per_step"]
+    assert abs((row["substeps_ms_per_step"] + row["host_ms_per_step"]) * steps - 1e3 * row["wall_s"]) < 1e-6
+    table = "\n".join(device_check._pour_table([row]))
+    assert "| 2-D, 12 across |" in table and "the rest (host) ms per step" in table

@@ -14,7 +14,8 @@ report, DIR/device_check.md, is printed at the end:
    both solvers, warp's ``example_sph`` beside the 3-D rows), and the 2-D row again without graph replay.
 4. pour: the coupled pour (robots, controllers, trajectory generation, no recording) on the device: the default
    2-D scene and the 3-D one at 64 across (~112k particles), :data:`POUR_SECONDS` simulated after a warm-up that
-   compiles the kernels and captures the graphs; real-time factor.
+   compiles the kernels and captures the graphs; real-time factor, and the wall time per 2 ms MuJoCo step split
+   into the substeps and the rest (``cosim.bench.host_overhead``: the rest bounds the real-time factor).
 
 Sized to finish within one 600 s call of the device tool (:data:`TIME_LIMITS`); the warp install the GPU machine
 needs first is in ``../shared/gpu/README.md``. Written without a GPU at hand: never run on one yet.
@@ -173,13 +174,16 @@ def _pour(device: str, dim: int, across: int, seconds: float) -> dict:
     pour = prepare(scene)
     while pour.time < POUR_WARM_UP - 1e-9:
         pour.step()
-    steps0, start = pour.fluid.step_count, time.perf_counter()
+    steps0, mj0, substep0, start = pour.fluid.step_count, pour.steps, pour.fluid.substep_wall_time, time.perf_counter()
     while pour.time < POUR_WARM_UP + seconds - 1e-9:
         pour.step()
     wall = time.perf_counter() - start
+    substeps_s = pour.fluid.substep_wall_time - substep0
+    mj_steps = pour.steps - mj0
     return {
         "dim": dim, "across": across, "particles": pour.fluid.n_particles, "simulated_s": seconds, "wall_s": wall,
         "real_time_factor": seconds / wall, "sph_substeps": pour.fluid.step_count - steps0,
+        "substeps_ms_per_step": 1e3 * substeps_s / mj_steps, "host_ms_per_step": 1e3 * (wall - substeps_s) / mj_steps,
         "graphs": _capture_status(pour.fluid),
     }
 
@@ -191,10 +195,15 @@ def check_pour(device: str, quick: bool) -> list[dict]:
 
 
 def _pour_table(rows: list[dict]) -> list[str]:
-    out = ["| pour | particles | simulated s | wall s | real-time factor | SPH substeps | graph capture |", "|---|---|---|---|---|---|---|"]
+    out = [
+        "| pour | particles | simulated s | wall s | real-time factor | SPH substeps | substeps ms per MuJoCo step | "
+        "the rest (host) ms per step | graph capture |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         out.append(f"| {r['dim']}-D, {r['across']} across | {r['particles']} | {r['simulated_s']:g} | {r['wall_s']:.1f} | "
-                   f"{r['real_time_factor']:.3f} | {r['sph_substeps']} | {r['graphs']} |")
+                   f"{r['real_time_factor']:.3f} | {r['sph_substeps']} | {r['substeps_ms_per_step']:.3f} | "
+                   f"{r['host_ms_per_step']:.3f} | {r['graphs']} |")
     return out
 
 
