@@ -163,6 +163,7 @@ def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
 
 # ---- pour -------------------------------------------------------------------------------------------------
 def _pour(device: str, dim: int, across: int, seconds: float) -> dict:
+    from cosim.bench.host_overhead import time_steps
     from cosim.coupling.settings import CouplingSettings
     from cosim.pour_run import prepare
     from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene
@@ -172,18 +173,13 @@ def _pour(device: str, dim: int, across: int, seconds: float) -> dict:
         coupling=CouplingSettings(max_duration=POUR_WARM_UP + seconds), logging=LoggingSettings(enabled=False),
     )
     pour = prepare(scene)
-    while pour.time < POUR_WARM_UP - 1e-9:
-        pour.step()
-    steps0, mj0, substep0, start = pour.fluid.step_count, pour.steps, pour.fluid.substep_wall_time, time.perf_counter()
-    while pour.time < POUR_WARM_UP + seconds - 1e-9:
-        pour.step()
-    wall = time.perf_counter() - start
-    substeps_s = pour.fluid.substep_wall_time - substep0
-    mj_steps = pour.steps - mj0
+    time_steps(pour, POUR_WARM_UP)
+    substeps0 = pour.fluid.step_count
+    split = time_steps(pour, seconds)
     return {
-        "dim": dim, "across": across, "particles": pour.fluid.n_particles, "simulated_s": seconds, "wall_s": wall,
-        "real_time_factor": seconds / wall, "sph_substeps": pour.fluid.step_count - steps0,
-        "substeps_ms_per_step": 1e3 * substeps_s / mj_steps, "host_ms_per_step": 1e3 * (wall - substeps_s) / mj_steps,
+        "dim": dim, "across": across, "particles": split.particles, "simulated_s": seconds, "wall_s": split.wall_s,
+        "real_time_factor": seconds / split.wall_s, "sph_substeps": pour.fluid.step_count - substeps0,
+        "substeps_ms_per_step": split.substep_ms_per_step, "host_ms_per_step": split.host_ms_per_step,
         "graphs": _capture_status(pour.fluid),
     }
 
