@@ -89,3 +89,18 @@ def test_wrench_feedforward_cancels_a_known_liquid_load(scene):
     without, with_ff = sag(False), sag(True)
     assert without > 1e-3  # millimetres of sag from the servo stiffness alone
     assert with_ff < 1e-6
+
+
+def test_vessel_pose_and_com_are_those_of_the_full_state(scene):
+    """The every-step exchange reads pose and centre of mass without the velocity: the same values, copies."""
+    scene.set_joint_positions(ArmRole.POUR, scene.arms[ArmRole.POUR].home_q + 0.1)
+    mujoco.mj_forward(scene.model, scene.data)
+    for role in (ArmRole.POUR, ArmRole.CATCH):
+        state = scene.vessel_state(role)
+        pos, quat = scene.vessel_pose(role)
+        com = scene.vessel_com(role)
+        np.testing.assert_array_equal(pos, state.pos)
+        np.testing.assert_array_equal(quat, state.quat)
+        np.testing.assert_array_equal(com, state.com)
+        pos[:] = com[:] = 0.0
+        assert np.any(scene.vessel_pose(role)[0] != 0.0) and np.any(scene.vessel_com(role) != 0.0)

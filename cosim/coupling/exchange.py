@@ -20,13 +20,13 @@ ROLES = (ArmRole.POUR, ArmRole.CATCH)  # fluid vessel index k <-> ROLES[k]
 
 def vessel_poses(scene: RobotScene) -> list[Pose]:
     """World poses of the pourer and the catcher frames, in the fluid's vessel order."""
-    return [Pose.from_quat_wxyz(s.pos, s.quat) for s in (scene.vessel_state(role) for role in ROLES)]
+    return [Pose.from_quat_wxyz(*scene.vessel_pose(role)) for role in ROLES]
 
 
 def wrench_at_body_com(scene: RobotScene, role: ArmRole, pose: Pose, wrench: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(force, torque) of a fluid wrench (6,) about the vessel spec's centre of mass, re-expressed about the MuJoCo
     body's centre of mass (world frame)."""
     spec_com = pose.transform(scene.arms[role].vessel.com_local[None, :])[0]
-    body_com = scene.vessel_state(role).com
+    body_com = scene.vessel_com(role)
     force = wrench[:3]
     return force, shift_wrench(force, wrench[3:], spec_com, body_com)

@@ -251,19 +251,21 @@ class LiquidProbe:
         self._sums = wp.zeros((CHUNKS, _SUMS), dtype=float, device=device)
         self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
         self._crossing_x = wp.zeros(max(n_particles, 1), dtype=float, device=device)
+        spec = geo.pourer
+        self._pourer_frame = PourerFrame()  # the fixed fields once; :meth:`_frame` sets the pose (warp struct fields are costly to set)
+        self._pourer_frame.half_width = 0.5 * spec.inner_width
+        self._pourer_frame.half_depth = 0.5 * spec.section_depth
+        self._pourer_frame.height = spec.inner_height
+        self._pourer_frame.dim = geo.dim
+        self._pourer_frame.column_start = geo.column_start
+        self._pourer_frame.column_width = geo.smoothing_length
+        self._pourer_frame.columns = geo.columns
 
     def _frame(self, pose: Pose) -> PourerFrame:
-        geo, spec = self.geo, self.geo.pourer
-        f = PourerFrame()
+        """The pourer's frame at ``pose`` (the one struct, updated: launches copy their arguments)."""
+        f = self._pourer_frame
         f.origin = wp.vec3(*pose.position)
         f.rotation = wp.mat33(*pose.rotation.ravel())
-        f.half_width = 0.5 * spec.inner_width
-        f.half_depth = 0.5 * spec.section_depth
-        f.height = spec.inner_height
-        f.dim = geo.dim
-        f.column_start = geo.column_start
-        f.column_width = geo.smoothing_length
-        f.columns = geo.columns
         return f
 
     def measure(

@@ -65,6 +65,15 @@ class FluidInstabilityError(SimulationError):
         self.reason = reason
 
 
+# diagnostics columns whose non-zero count stops the run (``_check``): non-finite, wall breaches, pair overflow
+_CHECKED_COUNTS = [0, 1, 6]
+
+
+def _norm(v: np.ndarray) -> float:
+    """|v| of a 3-vector: ``np.linalg.norm``'s own arithmetic (sqrt of ``v.dot(v)``) without its dispatch cost."""
+    return math.sqrt(v.dot(v))
+
+
 @dataclass(frozen=True)
 class IntervalReport:
     """What one :meth:`FluidSolver.advance` did: substeps taken, their dt (s), and the last substep's record."""
@@ -179,6 +188,7 @@ class FluidSolver:
         self._motions_view = self._motions_host.numpy()
         self._dt = wp.zeros(1, dtype=float, device=d)
         self._substep_weight = wp.zeros(1, dtype=float, device=d)
+        self._dt_written = self._weight_written = None  # the values last written to _dt and _substep_weight
         self._row = wp.zeros(1, dtype=wp.int32, device=d)
         self._rows_capacity = 0
         self._ensure_rows(64)
@@ -224,7 +234,9 @@ class FluidSolver:
         if len(poses) != self.model.n_vessels:
             raise InputError(f"fluid: {self.model.n_vessels} vessels but {len(poses)} poses given")
         for k, pose in enumerate(poses):
-            if not (np.all(np.isfinite(pose.position)) and np.all(np.isfinite(pose.rotation))):
+            if not (math.isfinite(pose.position.sum()) and math.isfinite(pose.rotation.sum())) and not (
+                np.all(np.isfinite(pose.position)) and np.all(np.isfinite(pose.rotation))
+            ):  # a finite sum is the cheap proof (a NaN or inf propagates); an overflowing one is looked at closely
                 raise InputError(f"fluid: vessel {self.model.vessel_specs[k].name} pose is not finite")
         self._targets = [self._planar(p) for p in poses]
 
@@ -258,7 +270,7 @@ class FluidSolver:
         m = self.model
         lin = np.array([(t.position - p.position) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
         ang = np.array([rotation_vector(t.rotation @ p.rotation.T) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
-        wall_speed = max((np.linalg.norm(lin[k]) + np.linalg.norm(ang[k]) * m.b_reach[k] for k in range(m.n_vessels)), default=0.0)
+        wall_speed = max((_norm(lin[k]) + _norm(ang[k]) * m.b_reach[k] for k in range(m.n_vessels)), default=0.0)
         n_sub, dt = self.plan_time_step(duration, wall_speed)
         self._upload_motions(lin, ang, (lin - self._lin_vel) / duration, (ang - self._ang_vel) / duration)
         self._lin_vel, self._ang_vel = lin, ang
@@ -266,9 +278,13 @@ class FluidSolver:
         if self._ops is None:
             even, odd = (self.state, self._spare) if self._parity == 0 else (self._spare, self.state)
             self._ops = (self._substep_commands(even, odd), self._substep_commands(odd, even))
-        self._dt.fill_(dt)
+        if dt != self._dt_written:  # the substeps read it on the device; most intervals keep the last one
+            self._dt.fill_(dt)
+            self._dt_written = dt
         if self.config.pressure_solver is PressureSolver.DFSPH:  # its pressure is averaged over the interval
-            self._substep_weight.fill_(1.0 / n_sub)
+            if n_sub != self._weight_written:
+                self._substep_weight.fill_(1.0 / n_sub)
+                self._weight_written = n_sub
             self.state.p.zero_()
         self._row.zero_()
         self._diag_f.zero_()
@@ -457,6 +473,11 @@ class FluidSolver:
 
     def _check(self, first: int, t0: float, dt: float, rows_f: np.ndarray, rows_i: np.ndarray) -> None:
         cfg = self.config
+        if not (
+            rows_i[:, _CHECKED_COUNTS].any() or rows_f[:, 4].max() > cfg.max_density_error
+            or self.energy_account.created > cfg.max_energy_creation
+        ):  # the usual interval, found in one pass
+            return
         checks = [
             (rows_i[:, 0] > 0, lambda s: f"{rows_i[s, 0]} particles with a non-finite position, velocity or density"),
             (rows_i[:, 1] > 0, lambda s: f"{rows_i[s, 1]} particles inside a vessel wall (deeper than {cfg.max_wall_penetration:g} dx)"),

@@ -312,13 +312,18 @@ class RobotScene:
         arm, m, d = self.arms[role], self.model, self.data
         vel = np.empty(6)
         mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_XBODY, arm.vessel_body, vel, 0)
-        return VesselState(
-            pos=d.xpos[arm.vessel_body].copy(),
-            quat=d.xquat[arm.vessel_body].copy(),
-            lin_vel=vel[3:].copy(),
-            ang_vel=vel[:3].copy(),
-            com=d.xipos[arm.vessel_body].copy(),
-        )
+        pos, quat = self.vessel_pose(role)
+        return VesselState(pos=pos, quat=quat, lin_vel=vel[3:].copy(), ang_vel=vel[:3].copy(), com=self.vessel_com(role))
+
+    def vessel_pose(self, role: ArmRole) -> tuple[np.ndarray, np.ndarray]:
+        """The held vessel frame's world position (3,) m and orientation quaternion (4,) [w, x, y, z] (copies; valid
+        after mj_forward/mj_step): :meth:`vessel_state` without the velocity, for the every-step exchange."""
+        body, d = self.arms[role].vessel_body, self.data
+        return d.xpos[body].copy(), d.xquat[body].copy()
+
+    def vessel_com(self, role: ArmRole) -> np.ndarray:
+        """(3,) m, world position of the held vessel body's centre of mass (the point ``xfrc_applied`` acts at)."""
+        return self.data.xipos[self.arms[role].vessel_body].copy()
 
     def lip_position(self, role: ArmRole) -> np.ndarray:
         """(3,) m, world position of the held vessel's pour lip."""

@@ -105,6 +105,13 @@ def _quadratic_derivatives(times: list[float], points: list[np.ndarray]) -> tupl
     return qd, qdd
 
 
+def _clip(x: float, lo: float, hi: float) -> float:
+    """``min(max(x, lo), hi)`` with numpy ``clip``'s tie-breaking (the second argument when neither is larger),
+    so a signed zero comes out as numpy's does."""
+    x = x if x > lo else lo
+    return x if x < hi else hi
+
+
 def _vector(name: str, value: object, n: int) -> np.ndarray:
     try:
         array = np.asarray(value, dtype=float)
@@ -130,6 +137,7 @@ class TrajectoryGenerator:
         n = len(limits.joints)
         self._lo, self._hi = limits.array("min_position"), limits.array("max_position")
         self._vmax, self._amax = limits.array("max_velocity"), limits.array("max_acceleration")
+        self._lo_floats, self._hi_floats, self._vmax_floats = self._lo.tolist(), self._hi.tolist(), self._vmax.tolist()
         q0 = _vector(f"{limits.arm}: start position", q0, n)
         outside = np.flatnonzero((q0 < self._lo) | (q0 > self._hi))
         if outside.size:
@@ -163,6 +171,7 @@ class TrajectoryGenerator:
         self._steps = 0
         self._state = (q0.copy(), np.zeros(n), np.zeros(n))
         self._path = self._state  # the latest target path state (q, qd, qdd) at its time
+        self._path_floats = tuple(a.tolist() for a in self._path)  # the same as lists of floats, for _predict
         self._history_steps: list[int] = []  # step index of each recent target (at most three)
         self._history_q: list[np.ndarray] = []
         self._new_target = False
@@ -200,12 +209,13 @@ class TrajectoryGenerator:
         qd = np.where(clamped, 0.0, np.clip(qd, -self._vmax, self._vmax))
         qdd = np.where(clamped, 0.0, np.clip(qdd, -self._amax, self._amax))
         self._path = self._stop_at_range(q, qd, qdd, interval)
+        self._path_floats = tuple(a.tolist() for a in self._path)
         horizon = self._intercept_horizon(interval)
         self._late_targets += horizon > interval + TIME_EPSILON
         inp = self._input
         inp.control_interface = ruckig.ControlInterface.Position
         inp.minimum_duration = horizon
-        inp.target_position, inp.target_velocity, inp.target_acceleration = (list(v) for v in self._predict(horizon))
+        inp.target_position, inp.target_velocity, inp.target_acceleration = self._predict(horizon)
         self._new_target = True
 
     def _stop_at_range(
@@ -229,14 +239,25 @@ class TrajectoryGenerator:
         target = np.where(upper, self._hi, np.where(lower, self._lo, q))
         return target, np.where(braking, 0.0, qd), np.where(braking, 0.0, qdd)
 
-    def _predict(self, tau: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _predict(self, tau: float) -> tuple[list[float], list[float], list[float]]:
         """The target path's state ``tau`` s ahead, extrapolated at constant acceleration, made admissible: velocity
-        and acceleration clamped to the limits, positions clamped to the joint range (those joints then at rest)."""
-        q, qd, qdd = self._path
-        vel = np.clip(qd + qdd * tau, -self._vmax, self._vmax)
-        pos = q + qd * tau + 0.5 * qdd * tau * tau
-        outside = (pos < self._lo) | (pos > self._hi)
-        return np.clip(pos, self._lo, self._hi), np.where(outside, 0.0, vel), np.where(outside, 0.0, qdd)
+        and acceleration clamped to the limits, positions clamped to the joint range (those joints then at rest).
+
+        Plain Python floats, one joint at a time (the interception search calls this up to a dozen times per target;
+        numpy's per-call cost on six numbers was most of it), with the operations, their order and the clamps'
+        tie-breaking of numpy's ``clip`` (``_clip``): the same bits as the array expressions."""
+        pos, vel, acc = [], [], []
+        for q, qd, qdd, lo, hi, vmax in zip(*self._path_floats, self._lo_floats, self._hi_floats, self._vmax_floats):
+            p = q + qd * tau + 0.5 * qdd * tau * tau
+            if p < lo or p > hi:
+                pos.append(_clip(p, lo, hi))
+                vel.append(0.0)
+                acc.append(0.0)
+            else:
+                pos.append(p)
+                vel.append(_clip(qd + qdd * tau, -vmax, vmax))
+                acc.append(qdd)
+        return pos, vel, acc
 
     def _reachable(self, tau: float) -> bool:
         """Whether the arm can be on the predicted path state ``tau`` s from now: ruckig, asked for a motion of at
@@ -244,7 +265,7 @@ class TrajectoryGenerator:
         probe, src = self._probe_input, self._input
         probe.current_position, probe.current_velocity = src.current_position, src.current_velocity
         probe.current_acceleration = src.current_acceleration
-        probe.target_position, probe.target_velocity, probe.target_acceleration = (list(v) for v in self._predict(tau))
+        probe.target_position, probe.target_velocity, probe.target_acceleration = self._predict(tau)
         probe.minimum_duration = tau
         try:
             result = self._probe.calculate(probe, self._probe_trajectory)
