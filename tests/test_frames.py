@@ -1,8 +1,9 @@
-"""cosim.frames: the scalar cross product the step loop uses in place of np.cross."""
+"""cosim.frames: the scalar cross product and the vector norm the step loop uses in place of np.cross and
+np.linalg.norm."""
 
 import numpy as np
 
-from cosim.frames import cross3
+from cosim.frames import cross3, vector_norm
 
 
 def test_cross3_is_np_cross_to_the_bit():
@@ -13,3 +14,17 @@ def test_cross3_is_np_cross_to_the_bit():
     got = np.array([cross3(x, y) for x, y in zip(a, b)])
     np.testing.assert_array_equal(got, np.cross(a, b))
     assert cross3([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]).tolist() == [0.0, 0.0, 1.0]
+
+
+def test_vector_norm_is_np_linalg_norm_to_the_bit():
+    # the IK, the quaternion conversion, the energy account and the solver's wall speed switched on that promise
+    rng = np.random.default_rng(11)
+    for size in (3, 4, 6):
+        vectors = rng.normal(size=(300, size)) * 10.0 ** rng.integers(-8, 8, size=(300, 1))
+        for v in vectors:
+            got, expected = vector_norm(v), np.linalg.norm(v)
+            assert type(got) is type(expected) and got.tobytes() == expected.tobytes()
+    matrix = rng.normal(size=(6, 6))
+    for v in (matrix[:, 2], matrix[1, ::2], matrix[2:4, 1:3], [3, 4], [1.0, 2.0, 2.0], np.array([0.1, 0.2, 0.3], dtype=np.float32)):
+        got, expected = vector_norm(v), np.linalg.norm(v)  # strided, 2-D, integers, a list, float32
+        assert type(got) is type(expected) and got.tobytes() == expected.tobytes()

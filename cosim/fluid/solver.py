@@ -46,7 +46,7 @@ from cosim.fluid.energy import EnergyAccount
 from cosim.fluid.model import FluidModel, FluidState, build_model
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
-from cosim.frames import Pose, rotation_vector, rotation_y, tilt_about_y
+from cosim.frames import Pose, rotation_vector, rotation_y, tilt_about_y, vector_norm
 from cosim.vessel import VesselSpec
 
 WRENCH_CHUNKS = 64  # first-level chunks of the fixed-order wrench reduction
@@ -67,11 +67,6 @@ class FluidInstabilityError(SimulationError):
 
 # diagnostics columns whose non-zero count stops the run (``_check``): non-finite, wall breaches, pair overflow
 _CHECKED_COUNTS = [0, 1, 6]
-
-
-def _norm(v: np.ndarray) -> float:
-    """|v| of a 3-vector: ``np.linalg.norm``'s own arithmetic (sqrt of ``v.dot(v)``) without its dispatch cost."""
-    return math.sqrt(v.dot(v))
 
 
 @dataclass(frozen=True)
@@ -270,7 +265,7 @@ class FluidSolver:
         m = self.model
         lin = np.array([(t.position - p.position) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
         ang = np.array([rotation_vector(t.rotation @ p.rotation.T) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
-        wall_speed = max((_norm(lin[k]) + _norm(ang[k]) * m.b_reach[k] for k in range(m.n_vessels)), default=0.0)
+        wall_speed = max((vector_norm(lin[k]) + vector_norm(ang[k]) * m.b_reach[k] for k in range(m.n_vessels)), default=0.0)
         n_sub, dt = self.plan_time_step(duration, wall_speed)
         self._upload_motions(lin, ang, (lin - self._lin_vel) / duration, (ang - self._ang_vel) / duration)
         self._lin_vel, self._ang_vel = lin, ang

@@ -26,6 +26,7 @@ import numpy as np
 
 from cosim.checks import check_int, check_positive, check_range
 from cosim.errors import InputError
+from cosim.frames import vector_norm
 
 # Regularisation of J J^T in the nullspace projector (full-rank rows assumed; only guards exact singularity).
 _NULLSPACE_REG = 1e-12
@@ -88,7 +89,7 @@ def rotation_error(target_mat: np.ndarray, current_mat: np.ndarray) -> np.ndarra
     if quat[0] < 0.0:
         quat = -quat
     vec = quat[1:]
-    sin_half = float(np.linalg.norm(vec))
+    sin_half = float(vector_norm(vec))
     if sin_half < 1e-12:
         return 2.0 * vec
     return (2.0 * math.atan2(sin_half, quat[0]) / sin_half) * vec
@@ -133,7 +134,7 @@ class ArmIK:
         model, data = self.model, self._data
         target_pos = np.asarray(target_pos, dtype=float)
         target_mat = np.empty(9)
-        mujoco.mju_quat2Mat(target_mat, np.asarray(target_quat, dtype=float) / np.linalg.norm(target_quat))
+        mujoco.mju_quat2Mat(target_mat, np.asarray(target_quat, dtype=float) / vector_norm(target_quat))
         target_mat = target_mat.reshape(3, 3)
         q = np.clip(np.asarray(seed_q, dtype=float).copy(), self.lower, self.upper)
         n = q.size
@@ -148,7 +149,7 @@ class ArmIK:
             mujoco.mj_kinematics(model, data)
             e_pos = target_pos - data.site_xpos[self.site_id]
             e_rot = rotation_error(target_mat, data.site_xmat[self.site_id].reshape(3, 3))
-            err_p, err_r = float(np.linalg.norm(e_pos)), float(np.linalg.norm(e_rot))
+            err_p, err_r = float(vector_norm(e_pos)), float(vector_norm(e_rot))
             task_ok = err_p <= s.position_tolerance and err_r <= s.rotation_tolerance
             if task_ok and not redundant:
                 return IKResult(q, err_p, err_r, iteration, True)
