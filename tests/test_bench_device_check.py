@@ -32,4 +32,6 @@ def test_pour_rows_split_the_wall_time_into_substeps_and_the_rest():
     assert 0.0 < row["substeps_ms_per_step"] and 0.0 < row["host_ms_per_step"]
     assert abs((row["substeps_ms_per_step"] + row["host_ms_per_step"]) * steps - 1e3 * row["wall_s"]) < 1e-6
     table = "\n".join(device_check._pour_table([row]))
-    assert "| 2-D, 12 across |" in table and "the rest (host) ms per step" in table
+    assert "| 2-D, 12 across, wcsph |" in table and "the rest (host) ms per step" in table
+    needed = row["particles"] * row["sph_substeps"] / row["simulated_s"] / 1e9  # G particle-substeps per second
+    assert f"| {needed:.3f} |" in table
