@@ -28,8 +28,9 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
-from typing import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Callable, Sequence
 
 import numpy as np
 import warp as wp
@@ -71,11 +72,16 @@ _CHECKED_COUNTS = [0, 1, 6]
 
 @dataclass(frozen=True)
 class IntervalReport:
-    """What one :meth:`FluidSolver.advance` did: substeps taken, their dt (s), and the last substep's record."""
+    """What one :meth:`FluidSolver.advance` did: substeps taken, their dt (s), and the last substep's record
+    (:attr:`last`, built from ``_record`` when first asked for: most intervals never are)."""
 
     substeps: int
     dt: float
-    last: StepDiagnostics
+    _record: Callable[[], StepDiagnostics] = field(repr=False)
+
+    @cached_property
+    def last(self) -> StepDiagnostics:
+        return self._record()
 
 
 class FluidSolver:
@@ -312,8 +318,10 @@ class FluidSolver:
         self._check(first, t0, dt, rows_f, rows_i)
         self._last_max_speed = float(rows_f[:, 0].max())
         self._last_max_accel = float(rows_f[:, 1].max())
-        last = rows_to_records(first + n_sub - 1, t0 + (n_sub - 1) * dt, dt, rows_f[-1:], rows_i[-1:], self.n_particles, self.config.particle_volume)[0]
-        self._last_report = IntervalReport(n_sub, dt, last)
+        n, volume = self.n_particles, self.config.particle_volume
+        self._last_report = IntervalReport(
+            n_sub, dt, lambda: rows_to_records(first + n_sub - 1, t0 + (n_sub - 1) * dt, dt, rows_f[-1:], rows_i[-1:], n, volume)[0],
+        )
         return self._last_report
 
     def _substep_commands(self, src: FluidState, dst: FluidState) -> list:
