@@ -98,3 +98,40 @@ def test_default_support_is_not_relaxed():
     # the 2-D default (Wendland C2, h = 1.5 dx) is within the Jacobi gain limit: its increments are not scaled
     fluid, _ = _tank()
     assert fluid.model.params.jacobi_relaxation == 1.0
+
+
+# The rows next to the floor and the surface rows keep the spacing they were seeded with (pressure-carrying wall
+# layer and seeded surface offsets, cosim.fluid.dfsph): without them the bottom row sank from dx/2 to 0.23 dx above
+# the floor and the two surface rows merged 0.47 dx low (40 across, 2 s; in this test's tank -0.157 dx for the bottom
+# row); with them every row of the 40-across tank stayed within 0.015 dx.
+ROW_DRIFT_LIMIT = 0.1  # spacings, mean displacement of a row of particles after REST_SETTLE
+
+
+def test_rows_at_the_floor_and_the_surface_keep_their_seeded_heights():
+    fluid, cfg = _tank(across=16)
+    seeded = fluid.positions()[:, 2].copy()
+    while fluid.time < REST_SETTLE - 1e-9:
+        fluid.advance(0.02)
+    z = fluid.positions()[:, 2]
+    rows = np.round(seeded / cfg.spacing - 0.5).astype(int)
+    for row in (rows.min(), rows.max()):
+        drift = (z[rows == row] - seeded[rows == row]).mean() / cfg.spacing
+        assert abs(drift) <= ROW_DRIFT_LIMIT, f"row {row}: {drift:+.3f} dx"
+
+
+def test_the_wetted_wall_layer_is_the_one_facing_the_liquid():
+    from cosim.fluid.wall_sampling import sample_vessel_walls, wetted_layer
+
+    spec = VesselSpec(name="tank", inner_width=B, inner_depth=0.1, inner_height=0.2)
+    dx = B / 16
+    points, _ = sample_vessel_walls(spec, dx, 3 * dx, 2)
+    wetted = wetted_layer(spec, points, dx, 2)
+    x, z = points[:, 0], points[:, 2]
+    inside_x = np.abs(x) < 0.5 * B
+    floor = wetted & inside_x
+    sides = wetted & (z > 0.0)
+    assert np.allclose(z[floor], -0.5 * dx)  # the floor's top layer, its whole width
+    assert floor.sum() == 16
+    assert np.allclose(np.abs(x[sides]), 0.5 * B + 0.5 * dx)  # the side walls' inner layers
+    assert (wetted & ~inside_x & (z < 0.0)).sum() == 2  # the two inner corners' diagonal particles
+    assert not (wetted & (np.abs(x) > 0.5 * B + dx)).any()

@@ -11,7 +11,7 @@ from cosim.fluid.boundary import SHAPE_BOX, SHAPE_CYLINDER, VesselGeometry
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.neighbors import CellGrid
 from cosim.fluid.params import SPHParams, make_params
-from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls
+from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls, wetted_layer
 from cosim.vessel import VesselSpec
 
 
@@ -25,6 +25,8 @@ class FluidModel:
     b_local: (Nb,) vec3, dummy wall particles in their vessel's frame (m).
     b_vessel: (Nb,) int32, index of the vessel each wall particle belongs to.
     b_volume: (Nb,) float, volume of each wall particle (m^dim; its mass is rho0 times this).
+    b_wetted: (Nb,) int32, 1 for the wall particles of the layer facing the liquid
+    (:func:`cosim.fluid.wall_sampling.wetted_layer`; DFSPH holds them to rest density too).
     b_reach: (V,) numpy, largest distance of a vessel's wall particles from its frame origin (m): wall speed bound.
     wall_thickness: (V,) numpy, wall thickness the liquid sees (m), >= the vessel's own.
     grid, b_grid: neighbour grids for liquid and wall particles (identical cell layout).
@@ -38,6 +40,7 @@ class FluidModel:
     b_local: wp.array
     b_vessel: wp.array
     b_volume: wp.array
+    b_wetted: wp.array
     b_reach: np.ndarray
     wall_thickness: np.ndarray
     grid: CellGrid
@@ -69,6 +72,7 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
     samples = [w[0] for w in walls]
     b_local = np.concatenate(samples) if samples else np.zeros((0, 3))
     b_volume = np.concatenate([w[1] for w in walls]) if walls else np.zeros(0)
+    b_wetted = np.concatenate([wetted_layer(s, w[0], cfg.spacing, cfg.dim) for s, w in zip(specs, walls)]) if walls else np.zeros(0, bool)
     b_vessel = np.concatenate([np.full(len(s), k, dtype=np.int32) for k, s in enumerate(samples)]) if samples else np.zeros(0, np.int32)
     reach = np.array([np.linalg.norm(s, axis=1).max() for s in samples]) if samples else np.zeros(0)
     thickness = np.array([numerical_wall_thickness(s, cfg.spacing, cfg.support_radius) for s in specs])
@@ -82,6 +86,7 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
         b_local=wp.array(b_local.astype(np.float32), dtype=wp.vec3, device=device),
         b_vessel=wp.array(b_vessel, dtype=wp.int32, device=device),
         b_volume=wp.array(b_volume.astype(np.float32), dtype=float, device=device),
+        b_wetted=wp.array(b_wetted.astype(np.int32), dtype=wp.int32, device=device),
         b_reach=reach,
         wall_thickness=thickness,
         grid=make_grid(n_particles),
@@ -96,9 +101,10 @@ class FluidState:
     x: m; v: m/s; rho: kg/m^3; p: Pa; active: 1 while simulated, 0 once spilled or broken; pid: the particle's
     original index (to return results in the order the particles were given); kappa_density, kappa_divergence:
     DFSPH only, m^2/s^2, the stiffness (p / rho) each of its two solves applied in the last substep (the warm start
-    of the next; zero under WCSPH); free: WCSPH only, 1 while the particle is free liquid (memoryless summation
-    density, no tension: :func:`cosim.fluid.wcsph.update_free_liquid`), 0 while its density follows the continuity
-    equation.
+    of the next; zero under WCSPH); free: 1 while the particle is free liquid (WCSPH: memoryless summation density,
+    no tension, :func:`cosim.fluid.wcsph.update_free_liquid`; DFSPH: no seeded offset), 0 while it is bound (its
+    density follows the continuity equation under WCSPH); rest_offset: DFSPH only, kg/m^3, the kernel deficiency a
+    bound particle was seeded with (:func:`cosim.fluid.dfsph.bound_or_free_density`).
     """
 
     x: wp.array
@@ -110,6 +116,7 @@ class FluidState:
     kappa_density: wp.array
     kappa_divergence: wp.array
     free: wp.array
+    rest_offset: wp.array
 
     @staticmethod
     def allocate(n: int, device) -> "FluidState":
@@ -123,7 +130,8 @@ class FluidState:
             kappa_density=wp.zeros(n, dtype=float, device=device),
             kappa_divergence=wp.zeros(n, dtype=float, device=device),
             free=wp.zeros(n, dtype=wp.int32, device=device),
+            rest_offset=wp.zeros(n, dtype=float, device=device),
         )
 
     def arrays(self) -> list[wp.array]:
-        return [self.x, self.v, self.rho, self.p, self.active, self.pid, self.kappa_density, self.kappa_divergence, self.free]
+        return [self.x, self.v, self.rho, self.p, self.active, self.pid, self.kappa_density, self.kappa_divergence, self.free, self.rest_offset]

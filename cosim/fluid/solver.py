@@ -157,6 +157,7 @@ class FluidSolver:
             # the seeded pressure (hydrostatic for a filled vessel) as the stiffness the liquid was already under:
             # the first density solve warm-starts from it as from any previous substep's
             self.state.kappa_density.assign((self.state.p.numpy() / self.state.rho.numpy()).astype(np.float32))
+            self.state.rest_offset.fill_(float(dfsph.UNSEEDED_OFFSET))
         self._drho = wp.zeros(n, dtype=float, device=d)
         self._acc = wp.zeros(n, dtype=wp.vec3, device=d)
         self._rho_grad = wp.zeros(n, dtype=wp.vec3, device=d)
@@ -181,6 +182,14 @@ class FluidSolver:
         self._b_p = wp.zeros(nb, dtype=float, device=d)
         self._b_rho = wp.zeros(nb, dtype=float, device=d)
         self._b_v_noslip = wp.zeros(nb, dtype=wp.vec3, device=d)
+        if self.config.pressure_solver is PressureSolver.DFSPH:
+            self._b_alpha = wp.zeros(nb, dtype=float, device=d)
+            self._b_increment = wp.zeros(nb, dtype=float, device=d)
+            self._b_kappa_density = wp.zeros(nb, dtype=float, device=d)
+            self._b_kappa_divergence = wp.zeros(nb, dtype=float, device=d)
+            self._b_pair_count = wp.zeros(nb, dtype=wp.int32, device=d)
+            self._b_pair_index = wp.zeros((nb, capacity), dtype=wp.int32, device=d)
+            self._b_pair_grad = wp.zeros((nb, capacity), dtype=wp.vec3, device=d)
         self._b_active = wp.ones(nb, dtype=wp.int32, device=d)
         self._motions = wp.zeros(m.n_vessels, dtype=bd.VesselMotion, device=d)
         # the motions are written on the host through a structured numpy view (the CPU device's array itself, else a
@@ -410,10 +419,17 @@ class FluidSolver:
         walls = [self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end]
         pairs = [self._pair_count, self._pair_index, self._pair_grad]
 
-        def solve(mode: int, v: wp.array, kappa: wp.array):
+        nb = m.n_boundary
+        b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_grad]
+
+        def solve(mode: int, v: wp.array, kappa: wp.array, b_kappa: wp.array):
             body = [
-                rec(dfsph.apply_stiffness, n, [prm, m.b_volume, st.rho, self._increment, st.active, self._dt, *pairs], [v, kappa]),
+                rec(dfsph.apply_stiffness, n, [prm, m.b_volume, st.rho, self._increment, st.active, self._dt, *pairs, self._b_rho, self._b_increment], [v, kappa]),
                 rec(dfsph.compute_solve_error, n, [prm, m.b_volume, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [self._increment, self._solve_stats]),
+                rec(
+                    dfsph.compute_wall_solve_error, nb, [prm, mode, v, self._dt, self._bv, self._b_rho, self._b_alpha, *b_pairs],
+                    [b_kappa, self._b_increment, self._solve_stats],
+                ),
                 rec(dfsph.check_convergence, 1, [prm, mode, self._row], [self._solve_stats, self._keep_going, self._diag_f, self._diag_i]),
             ]
 
@@ -425,20 +441,32 @@ class FluidSolver:
 
         return [
             rec(
-                dfsph.compute_density_factor, n, [prm, m.grid.spec, m.b_volume, self._pair_index.shape[1], st.x, st.active, *grid, *walls, self._row, st.kappa_divergence],
+                dfsph.compute_density_factor, n,
+                [
+                    prm, m.grid.spec, m.vessels, m.b_volume, self._pair_index.shape[1], int(self.config.free_liquid), self._motions, st.x, st.active,
+                    *grid, *walls, self._row, st.kappa_divergence, st.free, st.rest_offset,
+                ],
                 [st.rho, self._alpha, self._increment, *pairs, self._solve_stats, self._keep_going, self._diag_f, self._diag_i],
             ),
-            solve(dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence),
             rec(
-                dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.kappa_density],
+                dfsph.compute_wall_density_factor, nb,
+                [prm, m.grid.spec, m.b_volume, m.b_wetted, self._b_pair_index.shape[1], st.x, *grid, *walls, self._row],
+                [self._b_rho, self._b_alpha, *b_pairs, self._solve_stats, self._diag_i],
+            ),
+            rec(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE)], [self._b_kappa_divergence, self._b_increment]),
+            solve(dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence, self._b_kappa_divergence),
+            rec(
+                dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.free, st.kappa_density],
                 [self._v_star, self._increment, self._solve_stats, self._keep_going, self._diag_f],
             ),
-            solve(dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density),
+            rec(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY)], [self._b_kappa_density, self._b_increment]),
+            solve(dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density, self._b_kappa_density),
             rec(
                 dfsph.compute_wall_reaction, n,
                 [
                     prm, m.vessels, m.b_volume, m.b_vessel, self._motions, st.x, st.v, st.rho, st.kappa_density,
-                    st.kappa_divergence, st.active, self._bx, self._bv, *pairs, self._substep_weight,
+                    st.kappa_divergence, st.active, self._bx, self._bv, *pairs, self._b_rho, self._b_kappa_density, self._b_kappa_divergence,
+                    self._substep_weight, st.free,
                 ],
                 [self._wall_force, self._wall_torque, st.p],
             ),
@@ -533,7 +561,7 @@ class FluidSolver:
 
     def free_mask(self) -> np.ndarray:
         """(N,) bool: free liquid (outside every vessel, or back inside but not yet packed: summation density, no
-        tension; ``FluidConfig.free_liquid``). Always False under DFSPH, whose density is the summation density."""
+        tension; ``FluidConfig.free_liquid``), under both solvers."""
         return self._in_id_order(self.state.free).astype(bool)
 
     def vessel_poses(self) -> list[Pose]:

@@ -37,6 +37,16 @@ def pair_capacity(dim: int, smoothing_ratio: float) -> int:
 
 
 @wp.func
+def inside_any_vessel(prm: SPHParams, vessels: wp.array(dtype=VesselGeometry), motions: wp.array(dtype=VesselMotion), x: wp.vec3) -> bool:
+    """Whether x is in some vessel's inner volume (below its rim) at the substep's start pose."""
+    for k in range(prm.n_vessels):
+        m = motions[k]
+        if inside_vessel(wp.transpose(m.r_now) @ (x - m.p_now), vessels[k], prm.dim) != 0:
+            return True
+    return False
+
+
+@wp.func
 def wall_pair(b: int) -> int:
     """Pair-list code of wall particle b (fluid neighbours are stored as their index j >= 0)."""
     return -1 - b
@@ -189,6 +199,7 @@ def gather_particles(
     kappa_density: wp.array(dtype=float),
     kappa_divergence: wp.array(dtype=float),
     free: wp.array(dtype=wp.int32),
+    rest_offset: wp.array(dtype=float),
     x_out: wp.array(dtype=wp.vec3),
     v_out: wp.array(dtype=wp.vec3),
     rho_out: wp.array(dtype=float),
@@ -198,6 +209,7 @@ def gather_particles(
     kappa_density_out: wp.array(dtype=float),
     kappa_divergence_out: wp.array(dtype=float),
     free_out: wp.array(dtype=wp.int32),
+    rest_offset_out: wp.array(dtype=float),
 ):
     """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
     i = wp.tid()
@@ -211,6 +223,7 @@ def gather_particles(
     kappa_density_out[i] = kappa_density[src]
     kappa_divergence_out[i] = kappa_divergence[src]
     free_out[i] = free[src]
+    rest_offset_out[i] = rest_offset[src]
 
 
 @wp.kernel

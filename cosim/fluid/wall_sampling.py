@@ -98,3 +98,20 @@ def sample_vessel_walls(spec: VesselSpec, spacing: float, support: float, dim: i
         r = 0.5 * spec.inner_width
         parts = [_fill_disc(r + t, -t, 0.0, spacing), _fill_cylinder_shells(r, r + t, 0.0, h, spacing)]
     return np.concatenate([p for p, _ in parts]), np.concatenate([v for _, v in parts])
+
+
+def wetted_layer(spec: VesselSpec, points: np.ndarray, spacing: float, dim: int) -> np.ndarray:
+    """(n,) bool: the wall particles ``points`` (vessel frame) of the layer that faces the liquid, those less than
+    one ``spacing`` from the vessel's inner volume (the inner corners' diagonal ones included). Only this layer has
+    a full kernel support of liquid and wall in a resting, filled vessel (the deeper ones lack the layers beyond
+    the last), so only it can be held to rest density (DFSPH's pressure-carrying wall, ``cosim.fluid.dfsph``)."""
+    x, y, z = points[:, 0], points[:, 1], points[:, 2]
+    below = np.maximum(-z, 0.0)
+    if dim == 2 or spec.is_box:
+        out_x = np.maximum(np.abs(x) - 0.5 * spec.inner_width, 0.0)
+        out_y = np.maximum(np.abs(y) - 0.5 * spec.section_depth, 0.0) if dim == 3 else np.zeros_like(y)
+        distance = np.sqrt(out_x**2 + out_y**2 + below**2)
+    else:
+        out_r = np.maximum(np.hypot(x, y) - 0.5 * spec.inner_width, 0.0)
+        distance = np.hypot(out_r, below)
+    return distance < spacing

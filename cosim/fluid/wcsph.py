@@ -30,11 +30,19 @@ from __future__ import annotations
 
 import warp as wp
 
-from cosim.fluid.boundary import VesselGeometry, VesselMotion, inside_vessel
+from cosim.fluid.boundary import VesselGeometry, VesselMotion
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
-from cosim.fluid.sph_common import add_wall_reaction, finish_particle, kernel_gradient, pair_wall, viscous_pair, wall_pair
+from cosim.fluid.sph_common import (
+    add_wall_reaction,
+    finish_particle,
+    inside_any_vessel,
+    kernel_gradient,
+    pair_wall,
+    viscous_pair,
+    wall_pair,
+)
 from cosim.fluid.sph_kernels import kernel_w
 
 # The renormalisation matrix L^-1 (identity for a full kernel support) is used only where det L exceeds this:
@@ -68,16 +76,6 @@ def tait_internal_energy(prm: SPHParams, rho: float) -> float:
         return tait_elastic_energy(prm, rho)
     rt = prm.tension_density
     return tait_elastic_energy(prm, rt) + prm.max_tension * (1.0 / rho - 1.0 / rt)
-
-
-@wp.func
-def inside_any_vessel(prm: SPHParams, vessels: wp.array(dtype=VesselGeometry), motions: wp.array(dtype=VesselMotion), x: wp.vec3) -> bool:
-    """Whether x is in some vessel's inner volume (below its rim) at the substep's start pose."""
-    for k in range(prm.n_vessels):
-        m = motions[k]
-        if inside_vessel(wp.transpose(m.r_now) @ (x - m.p_now), vessels[k], prm.dim) != 0:
-            return True
-    return False
 
 
 @wp.kernel
