@@ -58,8 +58,8 @@ graph capture has been executed.
 The average error is summed as integers (quanta of ``ERROR_QUANTUM``) so it does not depend on the order of the atomic adds: the
 iteration count, and with it the trajectory, is deterministic on every device.
 
-Diagnostics: ``max_density_error`` and ``max_compression`` are the summation density's compression
-max(rho - rho0, 0) / rho0 at the substep's start (the state the previous substep left), ``max_acceleration`` is
+Diagnostics: ``max_density_error`` and ``max_compression`` are the compression max(rho - rho0, 0) / rho0 of the
+density the solves hold the particle to (:func:`bound_or_free_density`) at the substep's start (the state the previous substep left), ``max_acceleration`` is
 that of the non-pressure forces; the solves' final errors and iteration counts have their own fields.
 """
 
