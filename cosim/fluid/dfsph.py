@@ -85,6 +85,7 @@ from cosim.fluid.sph_common import (
     finish_particle,
     inside_any_vessel,
     kernel_gradient,
+    next_free_state,
     pair_wall,
     viscous_pair,
     wall_pair,
@@ -161,14 +162,11 @@ def bound_or_free_density(
         offset = wp.max(prm.rest_density - summation, 0.0)
         rest_offset[i] = offset
     if free_liquid != 0:
-        inside = inside_any_vessel(prm, vessels, motions, xi)
-        if free[i] == 0:
-            if not inside and summation < prm.rest_density:
-                free[i] = 1
-        elif inside and summation >= prm.rest_density:
-            free[i] = 0
+        state = next_free_state(free[i], inside_any_vessel(prm, vessels, motions, xi), summation, prm.rest_density)
+        if free[i] != 0 and state == 0:
             offset = 0.0
             rest_offset[i] = 0.0
+        free[i] = state
     if free[i] != 0:
         return summation
     return summation + offset

@@ -39,6 +39,7 @@ from cosim.fluid.sph_common import (
     finish_particle,
     inside_any_vessel,
     kernel_gradient,
+    next_free_state,
     pair_wall,
     viscous_pair,
     wall_pair,
@@ -138,14 +139,12 @@ def update_free_liquid(
                         continue
                     density += prm.rest_density * b_volume[b] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
     density = density / prm.lattice_density
-    if free[i] == 0:
+    state = next_free_state(free[i], inside, density, prm.rest_density)
+    if free[i] == 0 and state == 0:
         # bound liquid outside every vessel (leaving over a lip) stays bound while it is packed: its summation
         # density then still carries the particle disorder's +-2-5 %, whose Tait pressure would kick it off the lip
-        if density >= prm.rest_density:
-            return
-        free[i] = 1
-    else:
-        free[i] = wp.where(inside and density >= prm.rest_density, 0, 1)
+        return
+    free[i] = state
     rhoi = wp.max(density, prm.rest_density)
     rho[i] = rhoi
     p[i] = tait_pressure(prm, rhoi)
