@@ -43,8 +43,9 @@ class FluidSettings:
     """dim: 2 (liquid in the pour plane, times the pourer's depth) or 3. [2, 3]
     particles_across: particles across the pourer's inner width; sets the spacing dx = B / n. [8, 400]
     kernel: 'wendland_c2' or 'cubic_spline' (the seed's).
-    pressure_solver: 'wcsph' (weakly compressible, time step set by an artificial sound speed) or 'dfsph'
-      (divergence-free SPH, time step set by the flow speed).
+    pressure_solver: 'dfsph' (divergence-free SPH, time step set by the flow speed; the default: it passes the
+      validations WCSPH passes and pours the default scene about 3.5 x faster) or 'wcsph' (weakly compressible, time
+      step set by an artificial sound speed).
     smoothing_ratio: h / dx. [1.0, 2.5]
     cfl: Courant number of the time step (on the sound speed for WCSPH, on the flow speed for DFSPH). (0, 0.6]
     grid_reset: 'occupied' resets only the neighbour-grid cells the liquid and walls occupied (work restricted to
@@ -65,7 +66,7 @@ class FluidSettings:
     dim: int = 2
     particles_across: int = 32
     kernel: KernelType = KernelType.WENDLAND_C2
-    pressure_solver: PressureSolver = PressureSolver.WCSPH
+    pressure_solver: PressureSolver = PressureSolver.DFSPH
     smoothing_ratio: float = 1.5
     cfl: float = 0.25
     adaptive_time_step: bool = True

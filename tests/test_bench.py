@@ -18,7 +18,9 @@ from cosim.bench.runners import pour_scene, run_config
 from cosim.cli.main import main
 from cosim.coupling.settings import Coupling
 from cosim.errors import InputError
+from cosim.fluid.config import PressureSolver
 from cosim.fluid.solver import FluidInstabilityError
+from cosim.pour_scene import FluidSettings
 from cosim.validation import CASES
 
 
@@ -80,8 +82,17 @@ def test_real_smoke_rows_csv_and_markdown(tmp_path):
     assert hydro and all(0 <= float(t["pressure_error"]) < math.inf and t["front_error"] == "" for t in hydro)
     text = markdown(plan, outcome.results, rows, [], {}, "## header")
     assert "### hydrostatic" in text and "### dam-break" in text and "**default**" in text
-    assert text.count("| cfl 0.4 |") == 2 and "pressure_solver dfsph" in text  # one row per CFL level and solver per case
+    other = next(s for s in PressureSolver if s is not FluidSettings().pressure_solver)
+    assert text.count("| cfl 0.4 |") == 2 and f"pressure_solver {other.value}" in text  # one row per CFL level and solver per case
     assert "load average" in text
+
+
+def test_the_pour_reference_is_wcsph_and_every_solver_sweeps_the_pour_resolutions():
+    plan = build_plan("full")
+    assert plan.reference.pressure_solver is PressureSolver.WCSPH and plan.reference.particles_across == 48
+    pours = [c for c in plan.compared_pours() if c.kernel is plan.reference.kernel and c.cfl == plan.reference.cfl and not c.options]
+    for solver in PressureSolver:  # both solvers at 16, 24 and 32 across, compared with the one reference
+        assert {c.particles_across for c in pours if c.pressure_solver is solver} == {16, 24, 32}
 
 
 def test_update_document_keeps_the_text_around_the_generated_block(tmp_path):

@@ -76,8 +76,8 @@ def test_runs_are_deterministic():
 
 
 def test_scene_selects_the_solver():
-    assert FluidSettings(pressure_solver="dfsph").fluid_config(B).pressure_solver is PressureSolver.DFSPH
-    assert FluidSettings().fluid_config(B).pressure_solver is PressureSolver.WCSPH
+    assert FluidSettings(pressure_solver="wcsph").fluid_config(B).pressure_solver is PressureSolver.WCSPH
+    assert FluidSettings().fluid_config(B).pressure_solver is PressureSolver.DFSPH  # the default scene's solver
 
 
 @pytest.mark.parametrize(("dim", "smoothing_ratio", "across"), [(2, 2.0, 12), (3, 1.5, 8)])

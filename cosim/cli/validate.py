@@ -18,6 +18,7 @@ from pathlib import Path
 from cosim.atomic_files import atomic_path
 from cosim.errors import InputError
 from cosim.fluid.config import PressureSolver
+from cosim.pour_scene import FluidSettings
 from cosim.validation import CASES, DEFAULT_CASES, slosh
 from cosim.validation.common import CaseResult
 DEFAULT_OUT = Path("recordings") / "validate"
@@ -35,8 +36,9 @@ def register(subparsers) -> None:
     p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
     p.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2-D (pour plane) or 3-D (default 2)")
     p.add_argument("--device", default="cpu", help="cpu or cuda[:N] (default cpu)")
-    p.add_argument("--solver", choices=[s.value for s in PressureSolver], default=PressureSolver.WCSPH.value,
-                   help="pressure solver: wcsph (weakly compressible) or dfsph (divergence-free) (default wcsph)")
+    default_solver = FluidSettings().pressure_solver.value
+    p.add_argument("--solver", choices=[s.value for s in PressureSolver], default=default_solver,
+                   help=f"pressure solver: wcsph (weakly compressible) or dfsph (divergence-free) (default: the default scene's, {default_solver})")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
