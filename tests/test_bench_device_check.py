@@ -1,6 +1,7 @@
 """The prepared device check (cosim.bench.device_check): its machinery, run on the CPU at its quick sizes."""
 
 from cosim.bench import device_check
+from cosim.pour_scene import FluidSettings
 
 
 def test_quick_agreement_on_the_cpu_reports_identical_runs(tmp_path):
@@ -32,6 +33,6 @@ def test_pour_rows_split_the_wall_time_into_substeps_and_the_rest():
     assert 0.0 < row["substeps_ms_per_step"] and 0.0 < row["host_ms_per_step"]
     assert abs((row["substeps_ms_per_step"] + row["host_ms_per_step"]) * steps - 1e3 * row["wall_s"]) < 1e-6
     table = "\n".join(device_check._pour_table([row]))
-    assert "| 2-D, 12 across, wcsph |" in table and "the rest (host) ms per step" in table
+    assert f"| 2-D, 12 across, {FluidSettings().pressure_solver.value} |" in table and "the rest (host) ms per step" in table
     needed = row["particles"] * row["sph_substeps"] / row["simulated_s"] / 1e9  # G particle-substeps per second
     assert f"| {needed:.3f} |" in table
