@@ -81,6 +81,7 @@ from cosim.fluid.diagnostics import (
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
+    add_wall_density,
     add_wall_reaction,
     finish_particle,
     inside_any_vessel,
@@ -471,13 +472,7 @@ def compute_wall_density_factor(
                         b_pair_index[b, count] = j
                         b_pair_grad[b, count] = gw
                     count += 1
-                for kk in range(b_cell_start[cell], b_cell_end[cell]):
-                    o = b_order[kk]
-                    r = xb - bx[o]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    density += prm.rest_density * b_volume[o] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xb, density)
     if count == 0:
         return
     if count > capacity:

@@ -21,7 +21,7 @@ from cosim.fluid.diagnostics import (
     DIAG_NONFINITE,
 )
 from cosim.fluid.params import SPHParams
-from cosim.fluid.sph_kernels import kernel_dw
+from cosim.fluid.sph_kernels import kernel_dw, kernel_w
 
 
 # Pair-list room per particle, in units of the lattice neighbours a full kernel support holds (liquid and wall
@@ -54,6 +54,30 @@ def next_free_state(free_now: int, inside: bool, summation: float, rest_density:
     if free_now == 0:
         return wp.where(not inside and summation < rest_density, 1, 0)
     return wp.where(inside and summation >= rest_density, 0, 1)
+
+
+@wp.func
+def add_wall_density(
+    prm: SPHParams,
+    b_volume: wp.array(dtype=float),
+    bx: wp.array(dtype=wp.vec3),
+    b_order: wp.array(dtype=wp.int32),
+    start: int,
+    end: int,
+    x: wp.vec3,
+    density: float,
+) -> float:
+    """``density`` (kg/m^3) plus the summation density sum_b rho0 V_b W(x - x_b) of the wall particles of one grid
+    cell (``b_order[start:end]``; a wall particle at x itself excluded), added one by one in cell order."""
+    support2 = prm.support * prm.support
+    for kk in range(start, end):
+        b = b_order[kk]
+        r = x - bx[b]
+        r2 = wp.dot(r, r)
+        if r2 >= support2 or r2 < 1.0e-24:
+            continue
+        density += prm.rest_density * b_volume[b] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+    return density
 
 
 @wp.func

@@ -35,6 +35,7 @@ from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_M
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
+    add_wall_density,
     add_wall_reaction,
     finish_particle,
     inside_any_vessel,
@@ -131,13 +132,7 @@ def update_free_liquid(
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
                     density += prm.mass * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                for kk in range(b_cell_start[cell], b_cell_end[cell]):
-                    b = b_order[kk]
-                    r = xi - bx[b]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2:
-                        continue
-                    density += prm.rest_density * b_volume[b] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xi, density)
     density = density / prm.lattice_density
     state = next_free_state(free[i], inside, density, prm.rest_density)
     if free[i] == 0 and state == 0:
