@@ -61,6 +61,9 @@ class FluidSettings:
     density_diffusion: delta-SPH delta. [0, 1]
     kinematic_viscosity: m^2/s (water 1e-6). [0, 0.01]
     max_density_error: compression that counts as an instability (impacts reach about v / c0). (0, 1]
+    density_tolerance: DFSPH: the density solve stops when the average compression is below this fraction of rho0
+      (``cosim.fluid.config.FluidConfig``; the pour's time against its errors at three other tolerances is in
+      docs/benchmarks.md). (0, 0.05]
     """
 
     dim: int = 2
@@ -79,6 +82,7 @@ class FluidSettings:
     density_diffusion: float = 0.1
     kinematic_viscosity: float = 1.0e-6
     max_density_error: float = 0.3
+    density_tolerance: float = 0.00005
 
     def __post_init__(self) -> None:
         check_int("fluid.dim", self.dim, 2, 3)
@@ -107,6 +111,7 @@ class FluidSettings:
             density_diffusion=self.density_diffusion,
             kinematic_viscosity=self.kinematic_viscosity,
             max_density_error=self.max_density_error,
+            density_tolerance=self.density_tolerance,
         )
 
 

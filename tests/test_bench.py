@@ -14,7 +14,7 @@ from cosim.bench.plan import build_plan
 from cosim.bench.pour_compare import compare_pours
 from cosim.bench.report import CSV_COLUMNS, GENERATED_BEGIN, GENERATED_END, build_rows, markdown, rows_csv, update_document
 from cosim.bench.run import run_plan
-from cosim.bench.runners import pour_scene, run_config
+from cosim.bench.runners import numerics, pour_scene, run_config
 from cosim.cli.main import main
 from cosim.coupling.settings import Coupling
 from cosim.errors import InputError
@@ -65,7 +65,9 @@ def test_cache_key_covers_every_parameter_and_the_code_version():
     a = BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0)
     variants = [BenchConfig(BenchCase.HYDROSTATIC, 21, 1.0), BenchConfig(BenchCase.HYDROSTATIC, 20, 2.0),
                 BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, cfl=0.3), BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, kernel="cubic_spline"),
-                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, dim=3), BenchConfig(BenchCase.SLOSH, 20, 1.0)]
+                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, dim=3), BenchConfig(BenchCase.SLOSH, 20, 1.0),
+                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="dfsph"),
+                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="dfsph", density_tolerance=1e-4)]
     keys = {a.key("v1"), a.key("v2"), *(v.key("v1") for v in variants)}
     assert len(keys) == 2 + len(variants)
     assert a.key("v1") == BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0).key("v1")
@@ -93,6 +95,24 @@ def test_the_pour_reference_is_wcsph_and_every_solver_sweeps_the_pour_resolution
     pours = [c for c in plan.compared_pours() if c.kernel is plan.reference.kernel and c.cfl == plan.reference.cfl and not c.options]
     for solver in PressureSolver:  # both solvers at 16, 24 and 32 across, compared with the one reference
         assert {c.particles_across for c in pours if c.pressure_solver is solver} == {16, 24, 32}
+
+
+def test_every_case_has_dfsph_rows_at_other_density_tolerances_at_its_default_resolution():
+    plan = build_plan("full")
+    default_tolerance = FluidSettings().density_tolerance
+    for case, default in plan.defaults.items():
+        rows = [c for c in plan.rows if c.case is case and c.density_tolerance is not None]
+        assert len(rows) == 3 and default_tolerance not in {c.density_tolerance for c in rows}
+        assert all(c.pressure_solver is PressureSolver.DFSPH and c.particles_across == default.particles_across for c in rows)
+
+
+def test_a_density_tolerance_reaches_the_pour_scene_and_the_validation_numerics():
+    cfg = BenchConfig(BenchCase.POUR, 20, 2.0, pressure_solver="dfsph", density_tolerance=1e-4)
+    assert pour_scene(cfg).fluid.fluid_config(0.1).density_tolerance == 1e-4
+    assert "tol0.0001" in cfg.label
+    hydro = BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="dfsph", density_tolerance=1e-5)
+    assert dict(numerics(hydro))["density_tolerance"] == 1e-5
+    assert "density_tolerance" not in dict(numerics(replace(hydro, density_tolerance=None)))
 
 
 def test_update_document_keeps_the_text_around_the_generated_block(tmp_path):
@@ -157,6 +177,10 @@ def test_bad_config_is_one_input_error():
         BenchConfig(BenchCase.POUR, 4, 1.0)
     with pytest.raises(InputError, match="options"):
         BenchConfig(BenchCase.SLOSH, 20, 1.0, options=(("coupling.coupling", "one_way"),))
+    with pytest.raises(InputError, match="density_tolerance: applies to the dfsph solver only"):
+        BenchConfig(BenchCase.SLOSH, 20, 1.0, pressure_solver="wcsph", density_tolerance=1e-4)
+    with pytest.raises(InputError, match="density_tolerance"):
+        BenchConfig(BenchCase.SLOSH, 20, 1.0, pressure_solver="dfsph", density_tolerance=0.5)
 
 
 def test_code_version_is_per_case_sources():

@@ -45,6 +45,8 @@ class BenchConfig:
         (coupling.max_duration). (0, 600]
     options: pour scene options as (dotted scene key, value) pairs, e.g. (("coupling.coupling", "one_way"),),
         sorted by key; only for the pour.
+    density_tolerance: DFSPH's density-solve tolerance (``FluidConfig.density_tolerance``); None: the solver's
+        default. Only with DFSPH. (0, 0.05]
     """
 
     case: BenchCase
@@ -56,6 +58,7 @@ class BenchConfig:
     pressure_solver: PressureSolver = PressureSolver.WCSPH
     device: str = "cpu"
     options: tuple[tuple[str, OptionValue], ...] = ()
+    density_tolerance: float | None = None
 
     def __post_init__(self) -> None:
         s = object.__setattr__
@@ -70,13 +73,17 @@ class BenchConfig:
         if self.options and self.case is not BenchCase.POUR:
             raise InputError(f"options: scene options apply to the pour only, not to {self.case.value}")
         s(self, "options", tuple(sorted((str(k), v) for k, v in self.options)))
+        if self.density_tolerance is not None:
+            check_range("density_tolerance", self.density_tolerance, 0.0, 0.05, lo_open=True)
+            if self.pressure_solver is not PressureSolver.DFSPH:
+                raise InputError(f"density_tolerance: applies to the dfsph solver only, not to {self.pressure_solver.value}")
 
     def to_json(self) -> dict:
         """Plain JSON values (enums by value)."""
         return {
             "case": self.case.value, "particles_across": self.particles_across, "length": self.length, "dim": self.dim,
             "kernel": self.kernel.value, "cfl": self.cfl, "pressure_solver": self.pressure_solver.value,
-            "device": self.device, "options": [list(o) for o in self.options],
+            "device": self.device, "options": [list(o) for o in self.options], "density_tolerance": self.density_tolerance,
         }
 
     def key(self, code_version: str) -> str:
@@ -86,8 +93,11 @@ class BenchConfig:
 
     @property
     def label(self) -> str:
-        """Short human name, e.g. 'pour 2-D 32 wendland_c2 cfl0.25 wcsph cpu one_way'."""
+        """Short human name, e.g. 'pour 2-D 32 wendland_c2 cfl0.25 wcsph cpu coupling=one_way' (DFSPH rows with their
+        own density tolerance: ' tol1e-05' after the device)."""
         parts = [self.case.value, f"{self.dim}-D", str(self.particles_across), self.kernel.value, f"cfl{self.cfl:g}",
                  self.pressure_solver.value, self.device]
+        if self.density_tolerance is not None:
+            parts.append(f"tol{self.density_tolerance:g}")
         parts += [f"{k.rsplit('.', 1)[-1]}={v}" for k, v in self.options]
         return " ".join(parts)

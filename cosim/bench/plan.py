@@ -27,6 +27,9 @@ REFERENCE_ACROSS = 48  # particles across the pourer of the reference pour (1.5 
 # solver every earlier table was referenced to, favours the solver the default does not use.
 REFERENCE_SOLVER = PressureSolver.WCSPH
 CFL_LEVELS = (0.15, 0.4)  # besides the default 0.25 (the stress matrix goes to twice the default)
+# DFSPH's density-solve tolerance besides the default 5e-5, at each case's default resolution: its Jacobi iterations
+# are about half of a DFSPH substep, so it is the solver's own speed-against-error knob
+DENSITY_TOLERANCE_LEVELS = (1.0e-5, 3.0e-5, 1.0e-4)
 # s, max_duration of the early-stop pair at 24 across (the pour is done at about 14 s; the run without the early stop
 # goes on to this; the default scene's 60 s would cost 2.5 x more)
 FULL_POUR_SECONDS = 24.0
@@ -103,6 +106,8 @@ def _axis_rows(case: BenchCase, axes: CaseAxes, device: str) -> list[BenchConfig
     rows = [replace(base, particles_across=n) for n in axes.resolutions]
     rows += [replace(base, kernel=k) for k in KernelType if k is not base.kernel]
     rows += [replace(base, cfl=c) for c in axes.cfl_levels if c != base.cfl]
+    if base.pressure_solver is PressureSolver.DFSPH:
+        rows += [replace(base, particles_across=axes.resolutions[-1], density_tolerance=t) for t in DENSITY_TOLERANCE_LEVELS]
     # every other pressure solver over the whole resolution sweep, so the two can be compared at equal error
     rows += [replace(base, particles_across=n, pressure_solver=s) for s in PressureSolver if s is not base.pressure_solver for n in axes.resolutions]
     return rows

@@ -42,7 +42,7 @@ ERROR_TITLES = {
     "joint_rms_rad": "joint trajectory RMS diff (rad)",
     "final_caught_error": "final caught volume diff / initial volume",
 }
-CSV_COLUMNS = ("case", "dim", "particles_across", "kernel", "cfl", "pressure_solver", "device", "length", "options",
+CSV_COLUMNS = ("case", "dim", "particles_across", "kernel", "cfl", "pressure_solver", "density_tolerance", "device", "length", "options",
                "status", "particles", "sim_s", "wall_s", "wall_per_sim_s", *ERROR_TITLES, "compared_with", "key")
 
 
@@ -115,7 +115,8 @@ def rows_csv(rows: list[Row]) -> str:
     w.writerow(CSV_COLUMNS)
     for r in rows:
         c = r.config
-        w.writerow([c.case.value, c.dim, c.particles_across, c.kernel.value, c.cfl, c.pressure_solver.value, c.device,
+        w.writerow([c.case.value, c.dim, c.particles_across, c.kernel.value, c.cfl, c.pressure_solver.value,
+                    "" if c.density_tolerance is None else c.density_tolerance, c.device,
                     c.length, " ".join(f"{k}={v}" for k, v in c.options), r.status if not r.message else f"{r.status}: {r.message}",
                     r.particles, _fmt(r.sim_s, 6), _fmt(r.wall_s, 6), _fmt(r.wall_per_sim_s, 6),
                     *(_fmt(r.errors.get(name, math.nan), 6) for name in ERROR_TITLES), r.compared_with, r.key])
@@ -138,7 +139,7 @@ def _describe(cfg: BenchConfig, default: BenchConfig) -> str:
     diffs = []
     if cfg.particles_across != default.particles_across:
         diffs.append(f"{cfg.particles_across} across")
-    for name in ("dim", "kernel", "cfl", "pressure_solver", "device"):
+    for name in ("dim", "kernel", "cfl", "pressure_solver", "density_tolerance", "device"):
         a, b = getattr(cfg, name), getattr(default, name)
         if a != b:
             diffs.append(f"{name} {getattr(a, 'value', a)}")

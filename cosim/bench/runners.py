@@ -36,7 +36,8 @@ TRAJECTORY_KEEP_HZ = 100.0
 
 def numerics(cfg: BenchConfig) -> tuple[tuple[str, Any], ...]:
     """The configuration's numerical settings as FluidConfig overrides (``FluidCaseParams.numerics``)."""
-    return (("kernel", cfg.kernel), ("cfl", cfg.cfl))
+    tolerance = () if cfg.density_tolerance is None else (("density_tolerance", cfg.density_tolerance),)
+    return (("kernel", cfg.kernel), ("cfl", cfg.cfl), *tolerance)
 
 
 def case_width(cfg: BenchConfig) -> float:
@@ -94,6 +95,8 @@ def pour_scene(cfg: BenchConfig) -> PourScene:
         "coupling": {"max_duration": cfg.length},
         "logging": {"enabled": False},
     }
+    if cfg.density_tolerance is not None:
+        table["fluid"]["density_tolerance"] = cfg.density_tolerance
     for key, value in cfg.options:
         *path, leaf = key.split(".")
         node = table
