@@ -84,12 +84,12 @@ class FluidConfig:
         shortens it when the flow or the walls outrun the expectation.
     density_tolerance: DFSPH: the density solve stops when the average compression (rho* - rho0) / rho0 is below
         this (0.005 %: the hydrostatic validation's worst probe stays within -0.79 to +1.04 % from 1 to 3 s, its
-        density error within 0.035 %; at SPlisHSPlasH's 0.01 % the probe wanders between +2.0 and +3.0 %, at
-        0.003 % it stays within +0.95 to +1.28 % (density error 0.016 %) for 1.25 x the default pour's time, at
-        0.001 % within +0.85 to +0.99 % for 1.6 x; 0.1 % leaves a pressure noise of tens of % between substeps that
-        kicks particles over rims. The Jacobi iterations converge slowly near these levels, so the tolerance sets
-        most of a DFSPH substep's cost: docs/benchmarks.md has every case at 0.001, 0.003 and 0.01 % besides).
-        (0, 0.05]
+        density error within 0.035 %; at SPlisHSPlasH's 0.01 % the probe wanders between +2.0 and +3.0 %; at
+        0.003 % it stays within +0.95 to +1.28 % (density error 0.016 %) for 1.16 to 1.30 x the default pour's
+        time, at 0.001 % within +0.85 to +0.99 % for about 2 x; 0.1 % leaves a pressure noise of tens of % between
+        substeps that kicks particles over rims. The Jacobi iterations converge slowly near these levels, so the
+        tolerance sets most of a DFSPH substep's cost: docs/benchmarks.md has every case at 0.001, 0.003 and
+        0.01 % besides). (0, 0.05]
     divergence_tolerance: DFSPH: the divergence solve stops when the average density rate times dt, over rho0, is
         below this (the paper's 0.1 % per step). (0, 0.05]
     max_solver_iterations: DFSPH: iteration cap of each of the two solves (a solve that hits it is not an error;
