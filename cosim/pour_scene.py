@@ -82,7 +82,7 @@ class FluidSettings:
     density_diffusion: float = 0.1
     kinematic_viscosity: float = 1.0e-6
     max_density_error: float = 0.3
-    density_tolerance: float = 0.00005
+    density_tolerance: float = FluidConfig.density_tolerance  # the solver's own default, not a copy of it
 
     def __post_init__(self) -> None:
         check_int("fluid.dim", self.dim, 2, 3)

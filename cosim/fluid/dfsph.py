@@ -59,8 +59,9 @@ The average error is summed as integers (quanta of ``ERROR_QUANTUM``) so it does
 iteration count, and with it the trajectory, is deterministic on every device.
 
 Diagnostics: ``max_density_error`` and ``max_compression`` are the compression max(rho - rho0, 0) / rho0 of the
-density the solves hold the particle to (:func:`bound_or_free_density`) at the substep's start (the state the previous substep left), ``max_acceleration`` is
-that of the non-pressure forces; the solves' final errors and iteration counts have their own fields.
+density the solves hold the particle to (:func:`bound_or_free_density`) at the substep's start (the state the
+previous substep left), ``max_acceleration`` is that of the non-pressure forces; the solves' final errors and
+iteration counts have their own fields.
 """
 
 from __future__ import annotations
