@@ -215,6 +215,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
         summary.update(
             scene_name=scene.name,
             device=str(pour.fluid.device),
+            fluid_threads=pour.fluid.lanes.count,
             dim=pour.fluid.config.dim,
             particle_spacing=pour.fluid.config.spacing,
             trajectory={

@@ -64,6 +64,8 @@ class FluidSettings:
     density_tolerance: DFSPH: the density solve stops when the average compression is below this fraction of rho0
       (``cosim.fluid.config.FluidConfig``; the pour's time against its errors at three other tolerances is in
       docs/benchmarks.md). (0, 0.05]
+    cpu_threads: threads the CPU solver splits each substep over; 0: one per available core (at most one per 400
+      particles). The results are the same for any number. [0, 256]
     """
 
     dim: int = 2
@@ -83,6 +85,7 @@ class FluidSettings:
     kinematic_viscosity: float = 1.0e-6
     max_density_error: float = 0.3
     density_tolerance: float = FluidConfig.density_tolerance  # the solver's own default, not a copy of it
+    cpu_threads: int = FluidConfig.cpu_threads
 
     def __post_init__(self) -> None:
         check_int("fluid.dim", self.dim, 2, 3)
@@ -112,6 +115,7 @@ class FluidSettings:
             kinematic_viscosity=self.kinematic_viscosity,
             max_density_error=self.max_density_error,
             density_tolerance=self.density_tolerance,
+            cpu_threads=self.cpu_threads,
         )
 
 

@@ -12,7 +12,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from cosim.checks import check_device, check_positive
+from cosim.checks import check_device, check_int, check_positive
 from cosim.pour_run import run_pour
 from cosim.pour_scene import PourScene, load_scene
 
@@ -23,6 +23,7 @@ def register(subparsers) -> None:
     p.add_argument("scene", nargs="?", type=Path, help="scene TOML file (default: the embedded default scene)")
     p.add_argument("--out", type=Path, help="output folder (must not exist or be empty; default: a new folder under recordings/)")
     p.add_argument("--device", help="cpu or cuda[:N] (overrides the scene)")
+    p.add_argument("--threads", type=int, help="CPU threads the liquid solver splits each substep over, 0: one per core (overrides fluid.cpu_threads)")
     p.add_argument("--dim", type=int, choices=(2, 3), help="2-D or 3-D liquid (overrides the scene)")
     p.add_argument("--duration", type=float, help="longest simulated time, s (overrides coupling.max_duration)")
     p.add_argument("--no-log", action="store_true", help="skip the Rerun recording")
@@ -34,6 +35,8 @@ def scene_from_args(args) -> PourScene:
     scene = load_scene(args.scene) if args.scene is not None else PourScene()
     if args.device is not None:
         scene = replace(scene, device=check_device("--device", args.device))
+    if args.threads is not None:
+        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=check_int("--threads", args.threads, 0, 256)))
     if args.dim is not None:
         scene = replace(scene, fluid=replace(scene.fluid, dim=args.dim))
     if args.duration is not None:
@@ -57,6 +60,7 @@ def run(args) -> int:
     )
     phases = " -> ".join(f"{p['phase']} {p['start']:.2f}-{p['end']:.2f}s" for p in summary["phases"])
     print(f"phases: {phases}")
+    threads = f" ({summary['fluid_threads']} threads)" if summary["device"] == "cpu" else ""
     print(f"simulated {summary['sim_time']:.2f} s in {summary['wall_time']:.1f} s wall (real-time factor {summary['real_time_factor']:.3f}), "
-          f"{summary['particles']} particles, {summary['device']}", file=sys.stdout)
+          f"{summary['particles']} particles, {summary['device']}{threads}", file=sys.stdout)
     return 0

@@ -94,6 +94,7 @@ def advance_vessel_poses(
 
 @wp.kernel
 def place_wall_particles(
+    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
     # Model
     local_pos: wp.array(dtype=wp.vec3),
     vessel_of: wp.array(dtype=wp.int32),
@@ -104,7 +105,7 @@ def place_wall_particles(
     v: wp.array(dtype=wp.vec3),
 ):
     """World position and velocity of each wall sample at the current substep's start pose."""
-    b = wp.tid()
+    b = wp.tid() + first
     m = motions[vessel_of[b]]
     arm = m.r_now @ local_pos[b]
     x[b] = m.p_now + arm
@@ -113,6 +114,7 @@ def place_wall_particles(
 
 @wp.kernel
 def extrapolate_wall_state(
+    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
     # Model
     prm: SPHParams,
     g: GridSpec,
@@ -133,7 +135,7 @@ def extrapolate_wall_state(
     b_v_noslip: wp.array(dtype=wp.vec3),
 ):
     """Pressure, density and no-slip velocity of each dummy wall particle from the liquid around it."""
-    b = wp.tid()
+    b = wp.tid() + first
     xb = bx[b]
     m = motions[b_vessel[b]]
     arm = xb - m.p_now

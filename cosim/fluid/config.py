@@ -94,6 +94,9 @@ class FluidConfig:
         below this (the paper's 0.1 % per step). (0, 0.05]
     max_solver_iterations: DFSPH: iteration cap of each of the two solves (a solve that hits it is not an error;
         the remaining error shows in the diagnostics). [2, 1000]
+    cpu_threads: threads a CPU substep is split over (``cosim.fluid.lanes``; each takes a contiguous share of the
+        particles, and the results are the same to the bit for any number); 0: one per core this process may run
+        on, at most one per 400 particles. Ignored on CUDA. [0, 256]
     depth_2d: m, liquid thickness perpendicular to the pour plane in 2-D (the pouring vessel's depth): masses,
         volumes and wrenches reported to the outside are per unit depth times this. (0, 2]
     boundary_spacing_ratio: wall sample spacing / dx. [0.3, 1.0]
@@ -134,6 +137,7 @@ class FluidConfig:
     density_tolerance: float = 0.00005
     divergence_tolerance: float = 0.001
     max_solver_iterations: int = 100
+    cpu_threads: int = 0
     depth_2d: float = 0.1
     boundary_spacing_ratio: float = 0.75
     domain_min: tuple[float, float, float] = (-1.0, -0.5, 0.0)
@@ -169,6 +173,7 @@ class FluidConfig:
         s(self, "density_tolerance", check_range("fluid.density_tolerance", self.density_tolerance, 0.0, 0.05, lo_open=True))
         s(self, "divergence_tolerance", check_range("fluid.divergence_tolerance", self.divergence_tolerance, 0.0, 0.05, lo_open=True))
         s(self, "max_solver_iterations", check_int("fluid.max_solver_iterations", self.max_solver_iterations, 2, 1000))
+        s(self, "cpu_threads", check_int("fluid.cpu_threads", self.cpu_threads, 0, 256))
         s(self, "depth_2d", check_positive("fluid.depth_2d", self.depth_2d, "m", 2.0))
         s(self, "boundary_spacing_ratio", check_range("fluid.boundary_spacing_ratio", self.boundary_spacing_ratio, 0.3, 1.0))
         lo = check_vector("fluid.domain_min", self.domain_min, 3)

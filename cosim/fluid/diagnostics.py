@@ -1,7 +1,8 @@
 """Per-substep diagnostics: layout of the device rows and the host-side record.
 
-Each substep writes one row of floats and one row of ints (atomics: max for maxima, integer adds for counts, so
-every field but the energies is order-independent and deterministic on any device).
+Each substep writes one row of floats and one row of ints per lane (atomics: max for maxima, integer adds for counts,
+so every field but the energies is order-independent and deterministic on any device; the lanes' rows are combined in
+lane order, :func:`combine_lanes`).
 """
 
 from __future__ import annotations
@@ -33,6 +34,17 @@ DIAG_DENSITY_ITERATIONS = wp.constant(5)  # DFSPH: iterations of the density sol
 DIAG_PAIR_OVERFLOW = wp.constant(6)  # particles with more neighbours than the pair list holds (instability)
 DIAG_INSIDE0 = wp.constant(7)  # particles inside vessel k at DIAG_INSIDE0 + k
 N_DIAG_INT_BASE = 7
+# float fields the lanes' rows combine by their maximum (every other field by the sum: counts, energies, and the
+# solves' fields, which lane 0 alone writes)
+LANE_MAX_FIELDS = (DIAG_MAX_SPEED, DIAG_MAX_ACCEL, DIAG_MAX_DENSITY_ERROR, DIAG_MAX_COMPRESSION)
+
+
+def combine_lanes(lanes_f: np.ndarray, lanes_i: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rows of all lanes (``cosim.fluid.lanes``; arrays (lanes, substeps, fields)) as one row per substep:
+    maxima by the maximum, the rest summed over the lanes in lane order."""
+    rows_f = lanes_f.sum(axis=0, dtype=lanes_f.dtype)
+    rows_f[:, list(LANE_MAX_FIELDS)] = lanes_f[:, :, list(LANE_MAX_FIELDS)].max(axis=0)
+    return rows_f, lanes_i.sum(axis=0, dtype=lanes_i.dtype)
 
 
 @dataclass(frozen=True)

@@ -19,8 +19,9 @@ convergence loops read a device flag through ``wp.capture_while``, see ``cosim.f
 interval on each substep is replayed as one captured graph: a CUDA graph on a CUDA device (written without a GPU at
 hand: ``python -m cosim.bench.device_check`` is the check to run where one is), on the CPU warp's operation stream
 (APIC), which replays the launches in C++ without Python's per-launch argument handling (same results to the bit,
-tests/test_fluid_graphs.py). After the
-interval the per-substep diagnostics are checked and an instability raises :class:`FluidInstabilityError`
+tests/test_fluid_graphs.py). On the CPU the particle kernels are split over threads, each replaying its own
+graph of its share of the particles with barriers between the stages (``cosim.fluid.lanes``, ``cpu_threads``; same
+results to the bit, tests/test_fluid_lanes.py). After the interval the per-substep diagnostics are checked and an instability raises :class:`FluidInstabilityError`
 naming the step and what broke. Results come back as numpy arrays in the particles' original order.
 """
 
@@ -41,9 +42,11 @@ from cosim.fluid import dfsph, wcsph
 from cosim.fluid.config import FluidConfig, PressureSolver
 from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, pair_capacity, sum_wall_wrench_chunks
 from cosim.fluid.diagnostics import (
-    DIAG_INTERNAL_ENERGY, DIAG_KINETIC_ENERGY, DIAG_POTENTIAL_ENERGY, DIAG_REMOVED_ENERGY, N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, rows_to_records,
+    DIAG_INTERNAL_ENERGY, DIAG_KINETIC_ENERGY, DIAG_POTENTIAL_ENERGY, DIAG_REMOVED_ENERGY, N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, combine_lanes,
+    rows_to_records,
 )
 from cosim.fluid.energy import EnergyAccount
+from cosim.fluid.lanes import Lanes, Loop, PerLane, Program, Stage, lane_count, run_serial
 from cosim.fluid.model import FluidModel, FluidState, build_model
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
@@ -119,6 +122,7 @@ class FluidSolver:
         self.device = resolve_device(device)
         self.n_particles = len(particles)
         self.model: FluidModel = build_model(config, tuple(vessels), self.n_particles, self.device)
+        self.lanes = Lanes(lane_count(config.cpu_threads, self.n_particles, self.device), self.device)
         self.time = 0.0
         self.step_count = 0
         self.substep_wall_time = 0.0  # s of wall clock spent in the substeps (device work included), for benchmarks
@@ -130,7 +134,7 @@ class FluidSolver:
         self._last_report: IntervalReport | None = None
         self._capture_graphs = graphs
         self.graph_capture_error: str | None = None
-        self._graphs: tuple | None = None
+        self._graphs: tuple | None = None  # per lane: (even, odd) substep graphs
         self._allocate(particles)
         self.energy_account = EnergyAccount(config, vessels, particles.positions, particles.velocities, self._internal_energy())
 
@@ -164,7 +168,8 @@ class FluidSolver:
         self._v_star = wp.zeros(n, dtype=wp.vec3, device=d)
         self._alpha = wp.zeros(n, dtype=float, device=d)
         self._increment = wp.zeros(n, dtype=float, device=d)
-        self._solve_stats = wp.zeros(dfsph.N_STATS, dtype=wp.int64, device=d)
+        self._solve_stats = wp.zeros((self.lanes.count, dfsph.N_STATS), dtype=wp.int64, device=d)
+        self._lane_stats = PerLane(self._solve_stats[k] for k in range(self.lanes.count))
         capacity = pair_capacity(self.config.dim, self.config.smoothing_ratio)
         self._pair_count = wp.zeros(n, dtype=wp.int32, device=d)
         self._pair_index = wp.zeros((n, capacity), dtype=wp.int32, device=d)
@@ -221,8 +226,11 @@ class FluidSolver:
         if n <= self._rows_capacity:
             return
         self._rows_capacity = max(n, 2 * self._rows_capacity)
-        self._diag_f = wp.zeros((self._rows_capacity, N_DIAG_FLOAT), dtype=float, device=self.device)
-        self._diag_i = wp.zeros((self._rows_capacity, N_DIAG_INT_BASE + self.model.n_vessels), dtype=wp.int32, device=self.device)
+        lanes = self.lanes.count
+        self._diag_f = wp.zeros((lanes, self._rows_capacity, N_DIAG_FLOAT), dtype=float, device=self.device)
+        self._diag_i = wp.zeros((lanes, self._rows_capacity, N_DIAG_INT_BASE + self.model.n_vessels), dtype=wp.int32, device=self.device)
+        self._lane_diag_f = PerLane(self._diag_f[k] for k in range(lanes))
+        self._lane_diag_i = PerLane(self._diag_i[k] for k in range(lanes))
         self._ops = None
         self._graphs = None
 
@@ -302,15 +310,13 @@ class FluidSolver:
         self._force_sum.zero_()
         self._torque_sum.zero_()
         start = time.perf_counter()
-        for _ in range(n_sub):
-            self._substep()
+        self._run_substeps(n_sub)
         if self.device.is_cuda:
             wp.synchronize_device(self.device)  # the diagnostics copy below waits for the device anyway
         self.substep_wall_time += time.perf_counter() - start
         if self._capture_graphs and self._graphs is None:
             self._graphs = self._capture()
-        rows_f = self._diag_f.numpy()[:n_sub].copy()
-        rows_i = self._diag_i.numpy()[:n_sub].copy()
+        rows_f, rows_i = combine_lanes(self._diag_f.numpy()[:, :n_sub], self._diag_i.numpy()[:, :n_sub])
         first = self.step_count
         t0 = self.time
         self.step_count += n_sub
@@ -333,30 +339,35 @@ class FluidSolver:
         )
         return self._last_report
 
-    def _substep_commands(self, src: FluidState, dst: FluidState) -> list:
-        """The substep as a list of operations with bound arguments (recorded launches: no per-call argument
-        packing), for the particle state ``src``, which is reordered into ``dst`` and advanced there.
+    def _substep_commands(self, src: FluidState, dst: FluidState) -> list[Stage | Loop]:
+        """The substep as stages of operations with bound arguments (recorded launches: no per-call argument
+        packing), for the particle state ``src``, which is reordered into ``dst`` and advanced there; the particle
+        kernels split over the lanes (``cosim.fluid.lanes``).
 
-        Stages: move_vessels; place_wall_particles; find_neighbors (wall particles by indirection, liquid
-        reordered into cell order); the pressure solver's stages; reduce_wrenches (fixed order); next_substep."""
+        Stages: move_vessels; place_wall_particles; find_neighbors (wall particles by indirection on lane 0, liquid
+        reordered into cell order on the last lane); the pressure solver's stages; reduce_wrenches (fixed order);
+        next_substep."""
         m, n, nb, nv = self.model, self.n_particles, self.model.n_boundary, self.model.n_vessels
-        ops = []
+        lanes = self.lanes
+        stages = []
         if nv:
-            ops.append(self._rec(bd.advance_vessel_poses, nv, [self._row, self._dt], [self._motions]))
-            ops.append(self._rec(bd.place_wall_particles, nb, [m.b_local, m.b_vessel, self._motions], [self._bx, self._bv]))
-        ops += m.b_grid.build_commands(self._bx, self._b_active, nb)
-        ops += m.grid.build_commands(src.x, src.active, n)
-        ops.append(self._rec(gather_particles, n, [m.grid.order, *src.arrays()], dst.arrays()))
+            stages.append(lanes.on_lane(0, self._rec(bd.advance_vessel_poses, nv, [self._row, self._dt], [self._motions])))
+            stages.append(lanes.launch(bd.place_wall_particles, nb, [m.b_local, m.b_vessel, self._motions], [self._bx, self._bv]))
+        walls, liquid = lanes.on_lane(0, *m.b_grid.build_commands(self._bx, self._b_active, nb)), lanes.on_lane(-1, *m.grid.build_commands(src.x, src.active, n))
+        stages.append(Stage(tuple(w + q for w, q in zip(walls.parts, liquid.parts))))
+        stages.append(lanes.launch(gather_particles, n, [m.grid.order, *src.arrays()], dst.arrays()))
         if self.config.pressure_solver is PressureSolver.DFSPH:
-            ops += self._dfsph_commands(dst)
+            stages += self._dfsph_commands(dst)
         else:
-            ops += self._wcsph_commands(dst)
+            stages += self._wcsph_commands(dst)
+        tail = []
         if nv:
             chunk = math.ceil(n / WRENCH_CHUNKS)
-            ops.append(self._rec(sum_wall_wrench_chunks, (nv, WRENCH_CHUNKS), [n, chunk, self._wall_force, self._wall_torque], [self._partial_force, self._partial_torque]))
-            ops.append(self._rec(accumulate_wall_wrench, nv, [WRENCH_CHUNKS, self._partial_force, self._partial_torque], [self._force_sum, self._torque_sum]))
-        ops.append(self._rec(next_substep, 1, [self._row]))
-        return ops
+            tail.append(self._rec(sum_wall_wrench_chunks, (nv, WRENCH_CHUNKS), [n, chunk, self._wall_force, self._wall_torque], [self._partial_force, self._partial_torque]))
+            tail.append(self._rec(accumulate_wall_wrench, nv, [WRENCH_CHUNKS, self._partial_force, self._partial_torque], [self._force_sum, self._torque_sum]))
+        tail.append(self._rec(next_substep, 1, [self._row]))
+        stages.append(lanes.on_lane(0, *tail))
+        return stages
 
     def _rec(self, kernel, dim, inputs, outputs=()):
         """A launch recorded with its arguments bound (call ``.launch()`` to run it)."""
@@ -369,27 +380,28 @@ class FluidSolver:
             cfg.max_wall_penetration * cfg.spacing, self._motions, self._dt, self._row,
         ]
 
-    def _wcsph_commands(self, st: FluidState) -> list:
+    def _wcsph_commands(self, st: FluidState) -> list[Stage]:
         """update_free_liquid (if ``free_liquid``); extrapolate_wall_state; compute_forces; compute_density_rate;
         integrate (``cosim.fluid.wcsph``)."""
         m, prm, n, nb = self.model, self.model.params, self.n_particles, self.model.n_boundary
-        rec = self._rec
+        launch = self.lanes.launch
         pairs = [self._pair_count, self._pair_index, self._pair_grad]
-        ops = []
+        diag = [self._lane_diag_f, self._lane_diag_i]
+        stages = []
         if self.config.free_liquid:
-            ops.append(rec(
+            stages.append(launch(
                 wcsph.update_free_liquid, n,
                 [prm, m.grid.spec, m.vessels, m.b_volume, self._motions, st.x, st.active, m.grid.cell_start, m.grid.cell_end,
                  self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end],
                 [st.free, st.rho, st.p],
             ))
         if nb:
-            ops.append(rec(
+            stages.append(launch(
                 bd.extrapolate_wall_state, nb,
                 [prm, m.grid.spec, m.b_vessel, self._motions, self._bx, self._bv, st.x, st.v, st.rho, st.p, m.grid.cell_start, m.grid.cell_end],
                 [self._b_p, self._b_rho, self._b_v_noslip],
             ))
-        ops.append(rec(
+        stages.append(launch(
             wcsph.compute_forces, n,
             [
                 prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel,
@@ -397,71 +409,72 @@ class FluidSolver:
                 self._bx, self._bv, self._b_p, self._b_rho, self._b_v_noslip,
                 m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, self._row, self._pair_index.shape[1],
             ],
-            [self._acc, self._rho_grad, self._wall_force, self._wall_torque, *pairs, self._diag_f, self._diag_i],
+            [self._acc, self._rho_grad, self._wall_force, self._wall_torque, *pairs, *diag],
         ))
-        ops.append(rec(
+        stages.append(launch(
             wcsph.compute_density_rate, n,
             [prm, m.b_volume, st.x, st.v, self._acc, st.rho, self._rho_grad, st.active, self._dt, self._bv, *pairs],
             [self._drho],
         ))
-        ops.append(rec(
+        stages.append(launch(
             wcsph.integrate, n, [*self._integrate_model_args(), self._drho, self._acc, st.free],
-            [st.x, st.v, st.rho, st.p, st.active, self._wall_force, self._wall_torque, self._diag_f, self._diag_i],
+            [st.x, st.v, st.rho, st.p, st.active, self._wall_force, self._wall_torque, *diag],
         ))
-        return ops
+        return stages
 
-    def _dfsph_commands(self, st: FluidState) -> list:
+    def _dfsph_commands(self, st: FluidState) -> list[Stage | Loop]:
         """compute_density_factor; divergence solve; compute_nonpressure; density solve; compute_wall_reaction;
         integrate (``cosim.fluid.dfsph``). Each solve is a ``wp.capture_while`` loop on a device flag."""
-        m, prm, n = self.model, self.model.params, self.n_particles
-        rec = self._rec
+        m, prm, n, nb = self.model, self.model.params, self.n_particles, self.model.n_boundary
+        launch = self.lanes.launch
         grid = [m.grid.cell_start, m.grid.cell_end]
         walls = [self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end]
         pairs = [self._pair_count, self._pair_index, self._pair_grad]
-
-        nb = m.n_boundary
         b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_grad]
+        stats, diag_f, diag_i = self._lane_stats, self._lane_diag_f, self._lane_diag_i
 
-        def solve(mode: int, v: wp.array, kappa: wp.array, b_kappa: wp.array):
-            body = [
-                rec(dfsph.apply_stiffness, n, [prm, m.b_volume, st.rho, self._increment, st.active, self._dt, *pairs, self._b_rho, self._b_increment], [v, kappa]),
-                rec(dfsph.compute_solve_error, n, [prm, m.b_volume, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [self._increment, self._solve_stats]),
-                rec(
-                    dfsph.compute_wall_solve_error, nb, [prm, mode, v, self._dt, self._bv, self._b_rho, self._b_alpha, *b_pairs],
-                    [b_kappa, self._b_increment, self._solve_stats],
+        def both(*stages: Stage) -> Stage:
+            """Independent stages run between the same two barriers."""
+            return Stage(tuple(sum(parts, ()) for parts in zip(*(s.parts for s in stages))))
+
+        def solve(mode: int, v: wp.array, kappa: wp.array, b_kappa: wp.array) -> Loop:
+            check = self._rec(dfsph.check_convergence, 1, [prm, mode, self._row], [self._solve_stats, self._keep_going, diag_f[0], diag_i[0]])
+            return Loop(self._keep_going, (
+                launch(dfsph.apply_stiffness, n, [prm, m.b_volume, st.rho, self._increment, st.active, self._dt, *pairs, self._b_rho, self._b_increment], [v, kappa]),
+                both(
+                    launch(dfsph.compute_solve_error, n, [prm, m.b_volume, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [self._increment, stats]),
+                    launch(dfsph.compute_wall_solve_error, nb, [prm, mode, v, self._dt, self._bv, self._b_rho, self._b_alpha, *b_pairs], [b_kappa, self._b_increment, stats]),
                 ),
-                rec(dfsph.check_convergence, 1, [prm, mode, self._row], [self._solve_stats, self._keep_going, self._diag_f, self._diag_i]),
-            ]
-
-            def iterate() -> None:
-                for op in body:
-                    op()
-
-            return lambda: wp.capture_while(self._keep_going, iterate)
+                self.lanes.on_lane(0, check),
+            ))
 
         return [
-            rec(
+            launch(
                 dfsph.compute_density_factor, n,
                 [
                     prm, m.grid.spec, m.vessels, m.b_volume, self._pair_index.shape[1], int(self.config.free_liquid), self._motions, st.x, st.active,
                     *grid, *walls, self._row, st.kappa_divergence, st.free, st.rest_offset,
                 ],
-                [st.rho, self._alpha, self._increment, *pairs, self._solve_stats, self._keep_going, self._diag_f, self._diag_i],
+                [st.rho, self._alpha, self._increment, *pairs, stats, self._keep_going, diag_f, diag_i],
             ),
-            rec(
-                dfsph.compute_wall_density_factor, nb,
-                [prm, m.grid.spec, m.b_volume, m.b_wetted, self._b_pair_index.shape[1], st.x, *grid, *walls, self._row],
-                [self._b_rho, self._b_alpha, *b_pairs, self._solve_stats, self._diag_i],
+            both(
+                launch(
+                    dfsph.compute_wall_density_factor, nb,
+                    [prm, m.grid.spec, m.b_volume, m.b_wetted, self._b_pair_index.shape[1], st.x, *grid, *walls, self._row],
+                    [self._b_rho, self._b_alpha, *b_pairs, stats, diag_i],
+                ),
+                launch(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE)], [self._b_kappa_divergence, self._b_increment]),
             ),
-            rec(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE)], [self._b_kappa_divergence, self._b_increment]),
             solve(dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence, self._b_kappa_divergence),
-            rec(
-                dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.free, st.kappa_density],
-                [self._v_star, self._increment, self._solve_stats, self._keep_going, self._diag_f],
+            both(
+                launch(
+                    dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.free, st.kappa_density],
+                    [self._v_star, self._increment, stats, self._keep_going, diag_f],
+                ),
+                launch(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY)], [self._b_kappa_density, self._b_increment]),
             ),
-            rec(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY)], [self._b_kappa_density, self._b_increment]),
             solve(dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density, self._b_kappa_density),
-            rec(
+            launch(
                 dfsph.compute_wall_reaction, n,
                 [
                     prm, m.vessels, m.b_volume, m.b_vessel, self._motions, st.x, st.v, st.rho, st.kappa_density,
@@ -470,37 +483,43 @@ class FluidSolver:
                 ],
                 [self._wall_force, self._wall_torque, st.p],
             ),
-            rec(dfsph.integrate, n, [*self._integrate_model_args(), self._v_star, st.rho], [st.x, st.v, st.active, self._wall_force, self._wall_torque, self._diag_f, self._diag_i]),
-            self._solve_stats.zero_,
+            launch(dfsph.integrate, n, [*self._integrate_model_args(), self._v_star, st.rho], [st.x, st.v, st.active, self._wall_force, self._wall_torque, diag_f, diag_i]),
+            self.lanes.on_lane(0, self._solve_stats.zero_),
         ]
 
     def _capture(self) -> tuple | None:
-        """Both parities' substeps as graphs (DFSPH's solve loops become conditional nodes on CUDA, while
-        operations on the CPU), or None, with the reason in :attr:`graph_capture_error`, where warp or the driver
-        cannot capture them."""
-        graphs = []
+        """Each lane's graphs of both parities' substeps (DFSPH's solve loops become conditional nodes on CUDA,
+        while operations on the CPU; one lane on CUDA), or None, with the reason in :attr:`graph_capture_error`,
+        where warp or the driver cannot capture them."""
         try:
-            for ops in self._ops:
-                with wp.ScopedCapture(device=self.device) as capture:
-                    for op in ops:
-                        op()
-                graphs.append(capture.graph)
+            by_parity = [self.lanes.capture(program) if self.lanes.count > 1 else (self._capture_serial(program),) for program in self._ops]
         except Exception as exc:  # warp raises RuntimeError and others (e.g. no conditional nodes before CUDA 12.4)
             self._capture_graphs = False
             self.graph_capture_error = f"{type(exc).__name__}: {exc}"
             return None
-        return tuple(graphs)
+        return tuple(zip(*by_parity))
 
-    def _substep(self) -> None:
-        """One substep: replay the current parity's graph or run its recorded operations, then swap the particle
-        buffers."""
+    def _capture_serial(self, program: Program):
+        with wp.ScopedCapture(device=self.device) as capture:
+            run_serial(program)
+        return capture.graph
+
+    def _run_substeps(self, count: int) -> None:
+        """``count`` substeps: each lane replays its graphs (the lanes at once), or the operations run one by one
+        (every lane's share in turn); the particle buffers swap after each substep."""
         if self._graphs is not None:
-            wp.capture_launch(self._graphs[self._parity])
+            parities = [(self._parity + k) % 2 for k in range(count)]
+            if self.lanes.count > 1:
+                self.lanes.replay([[graphs[p] for p in parities] for graphs in self._graphs])
+            else:
+                for p in parities:
+                    wp.capture_launch(self._graphs[0][p])
         else:
-            for op in self._ops[self._parity]:
-                op()
-        self._parity ^= 1
-        self.state, self._spare = self._spare, self.state
+            for k in range(count):
+                run_serial(self._ops[(self._parity + k) % 2])
+        if count % 2:
+            self._parity ^= 1
+            self.state, self._spare = self._spare, self.state
 
     def _check(self, first: int, t0: float, dt: float, rows_f: np.ndarray, rows_i: np.ndarray) -> None:
         cfg = self.config

@@ -223,6 +223,7 @@ def finish_particle(
 
 @wp.kernel
 def gather_particles(
+    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
     order: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
@@ -246,7 +247,7 @@ def gather_particles(
     rest_offset_out: wp.array(dtype=float),
 ):
     """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
-    i = wp.tid()
+    i = wp.tid() + first
     src = order[i]
     x_out[i] = x[src]
     v_out[i] = v[src]

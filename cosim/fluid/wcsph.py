@@ -82,6 +82,7 @@ def tait_internal_energy(prm: SPHParams, rho: float) -> float:
 
 @wp.kernel
 def update_free_liquid(
+    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
     # Model
     prm: SPHParams,
     g: GridSpec,
@@ -112,7 +113,7 @@ def update_free_liquid(
     the vessel it left). It becomes bound when its summation density reaches rho0 inside a
     vessel; the continuity equation then continues from that density, so the pressure is continuous and the
     caught liquid keeps no memory of the loose packing it arrived in."""
-    i = wp.tid()
+    i = wp.tid() + first
     if active[i] == 0:
         return
     xi = x[i]
@@ -147,6 +148,7 @@ def update_free_liquid(
 
 @wp.kernel
 def compute_forces(
+    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
     # Model
     prm: SPHParams,
     g: GridSpec,
@@ -190,7 +192,7 @@ def compute_forces(
     the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``:
     grad_i W), in the order of the neighbour loop, which compute_density_rate sums over instead of searching the
     cells again; more than ``capacity`` neighbours count as an overflow, an instability."""
-    i = wp.tid()
+    i = wp.tid() + first
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
@@ -270,6 +272,7 @@ def compute_forces(
 
 @wp.kernel
 def compute_density_rate(
+    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
     # Model
     prm: SPHParams,
     b_volume: wp.array(dtype=float),
@@ -293,7 +296,7 @@ def compute_density_rate(
     delta h c0 sum_j V_j [2 (rho_i - rho_j) r_ij . grad W / (r^2 + eta^2) - (<grad rho>_i + <grad rho>_j) . grad W],
     which vanishes for any linear density field (a resting column) and conserves mass between pairs. Sums over
     compute_forces' pair list, in its order (the neighbours have not moved since)."""
-    i = wp.tid()
+    i = wp.tid() + first
     if active[i] == 0:
         drho[i] = 0.0
         return
@@ -323,6 +326,7 @@ def compute_density_rate(
 
 @wp.kernel
 def integrate(
+    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -349,7 +353,7 @@ def integrate(
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
 ):
-    i = wp.tid()
+    i = wp.tid() + first
     if active[i] == 0:
         return
     s = row[0]

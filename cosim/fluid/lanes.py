@@ -1,0 +1,208 @@
+"""A substep split over CPU threads ("lanes"): warp runs a CPU kernel on one thread (NVIDIA/warp#1309), so on its
+own the solver leaves every other core idle.
+
+Each lane launches the particle kernels over its own contiguous share of the particles (the kernels take the share's
+first index, ``first``) and every lane waits for the others between stages (:data:`barrier_wait`, a spin barrier in
+native code inside the captured graph), so each lane's substep is one graph of warp's CPU operation stream that its
+own thread replays. The split changes no result: every kernel computes each particle as before, and what the lanes
+accumulate together (the solves' error sums, the diagnostics' counts and maxima) is kept per lane and combined in a
+fixed order, as integers or maxima where it steers the run. Without graphs (the first interval, ``graphs=False``)
+the lanes' shares run one after the other on the calling thread.
+
+A stage is the unit between two barriers: :class:`Stage` (the operations each lane runs) or :class:`Loop` (a
+``wp.capture_while`` loop of stages on a device flag).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Callable, Sequence, Union
+
+import warp as wp
+
+# Fewest particles per lane the automatic thread count gives a lane: below it the barriers and launches of a lane
+# cost more than its share of the work (at 864 particles, the default pour, 2 lanes are 1.6 x faster than 1 on the
+# 2-core CPU; more lanes are not measured, having no machine with more cores to hand).
+MIN_PARTICLES_PER_LANE = 400
+# Spins (x86 ``pause`` / arm ``yield`` hints) before a waiting lane gives its core away on every further check:
+# about 40-100 us, several stages' worth, so a lane that is running is waited for on the spot, one whose core the OS
+# gave to another process is not spun against for a whole time slice.
+SPINS_BEFORE_YIELD = 4000
+
+
+@wp.func_native(
+    """
+const int generation = __atomic_load_n(&state.data[1], __ATOMIC_ACQUIRE);
+if (__atomic_add_fetch(&state.data[0], 1, __ATOMIC_ACQ_REL) == parties) {
+    __atomic_store_n(&state.data[0], 0, __ATOMIC_RELAXED);
+    __atomic_store_n(&state.data[1], generation + 1, __ATOMIC_RELEASE);
+    return;
+}
+for (long spins = 0; __atomic_load_n(&state.data[1], __ATOMIC_ACQUIRE) == generation; ++spins) {
+    if (spins < spins_before_yield) {
+#if defined(__x86_64__) || defined(__i386__)
+        __builtin_ia32_pause();
+#elif defined(__aarch64__)
+        __asm__ __volatile__("yield");
+#endif
+    } else {
+        ((void (*)())yield_fn)();
+    }
+}
+"""
+)
+def barrier_wait(state: wp.array(dtype=wp.int32), parties: int, spins_before_yield: int, yield_fn: wp.uint64): ...
+
+
+@wp.kernel
+def lane_barrier(state: wp.array(dtype=wp.int32), parties: int, spins_before_yield: int, yield_fn: wp.uint64):
+    """One thread: return once all ``parties`` lanes have arrived (state: [arrived, generation], zeroed at start)."""
+    barrier_wait(state, parties, spins_before_yield, yield_fn)
+
+
+def _yield_function() -> int:
+    """Address of the OS call that gives the core to another thread (sched_yield; SwitchToThread on Windows)."""
+    if sys.platform == "win32":
+        return ctypes.cast(ctypes.windll.kernel32.SwitchToThread, ctypes.c_void_p).value
+    return ctypes.cast(ctypes.CDLL(None).sched_yield, ctypes.c_void_p).value
+
+
+def available_cores() -> int:
+    """CPU cores this process may run on (its affinity mask where the OS has one)."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
+
+
+def lane_count(threads: int, n_particles: int, device) -> int:
+    """Lanes for a solver: 1 on CUDA (the device is parallel already), ``threads`` on the CPU, or with 0 (auto)
+    one per available core, at most one per :data:`MIN_PARTICLES_PER_LANE` particles."""
+    if device.is_cuda:
+        return 1
+    if threads > 0:
+        return threads
+    return max(1, min(available_cores(), n_particles // MIN_PARTICLES_PER_LANE))
+
+
+def lane_ranges(count: int, lanes: int) -> list[tuple[int, int]]:
+    """(first, size) of each lane's contiguous share of ``count`` items; shares differ by at most one."""
+    base, extra = divmod(count, lanes)
+    out, first = [], 0
+    for lane in range(lanes):
+        size = base + (1 if lane < extra else 0)
+        out.append((first, size))
+        first += size
+    return out
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One step between barriers: ``parts[lane]`` are the operations (recorded launches, memsets, sorts) that lane
+    runs, in order."""
+
+    parts: tuple[tuple[Callable[[], None], ...], ...]
+
+
+@dataclass(frozen=True)
+class Loop:
+    """``wp.capture_while(flag, body)``: the stages of ``body`` repeated while ``flag[0]`` is non-zero. Every lane
+    reads the flag after the body's last barrier, and waits at one more barrier after the loop before any stage can
+    write the flag again (the DFSPH solves' first stages set it for the next solve), so all lanes take the same
+    number of iterations."""
+
+    flag: wp.array
+    body: tuple[Union[Stage, "Loop"], ...]
+
+
+Program = Sequence[Union[Stage, Loop]]
+
+
+class PerLane(tuple):
+    """An argument with one value per lane (e.g. each lane's row of a diagnostics array); :meth:`Lanes.launch`
+    passes lane L its L-th value."""
+
+
+def run_serial(program: Program) -> None:
+    """Every lane's operations in lane order on the calling thread (uncaptured, or captured as one graph)."""
+    for item in program:
+        if isinstance(item, Loop):
+            wp.capture_while(item.flag, lambda body=item.body: run_serial(body))
+        else:
+            for part in item.parts:
+                for op in part:
+                    op()
+
+
+class Lanes:
+    """The lanes of one solver: launches split over them, their per-lane graphs, and the threads that replay them."""
+
+    def __init__(self, count: int, device):
+        self.count = count
+        self.device = device
+        self._barrier_state = wp.zeros(2, dtype=wp.int32, device=device)
+        self._barrier = None
+        self._pool: ThreadPoolExecutor | None = None
+
+    def launch(self, kernel, items: int, inputs: Sequence, outputs: Sequence = ()) -> Stage:
+        """``kernel`` over ``items`` items, each lane its share (its first index passed first; :class:`PerLane`
+        arguments resolved per lane); a lane with no share launches nothing."""
+        parts = []
+        for lane, (first, size) in enumerate(lane_ranges(items, self.count)):
+            if size == 0:
+                parts.append(())
+                continue
+            pick = [a[lane] if isinstance(a, PerLane) else a for a in inputs]
+            out = [a[lane] if isinstance(a, PerLane) else a for a in outputs]
+            parts.append((wp.launch(kernel, dim=size, inputs=[first, *pick], outputs=out, device=self.device, record_cmd=True).launch,))
+        return Stage(tuple(parts))
+
+    def on_lane(self, lane: int, *ops: Callable[[], None]) -> Stage:
+        """``ops`` on one lane (``lane`` taken modulo the lane count); the others only wait."""
+        lane %= self.count
+        return Stage(tuple(tuple(ops) if k == lane else () for k in range(self.count)))
+
+    def _wait(self) -> None:
+        if self._barrier is None:
+            self._barrier = wp.launch(
+                lane_barrier, dim=1, inputs=[self._barrier_state, self.count, SPINS_BEFORE_YIELD, wp.uint64(_yield_function())],
+                device=self.device, record_cmd=True,
+            ).launch
+        self._barrier()
+
+    def run_lane(self, program: Program, lane: int) -> None:
+        """Lane ``lane``'s operations with a barrier after every stage: to be captured as that lane's graph."""
+        for item in program:
+            if isinstance(item, Loop):
+                wp.capture_while(item.flag, lambda body=item.body: self.run_lane(body, lane))
+            else:
+                for op in item.parts[lane]:
+                    op()
+            self._wait()  # after a loop too: no lane may set the flag again before every lane has read it
+
+    def capture(self, program: Program) -> tuple:
+        """One graph per lane of ``program`` (capturing runs nothing)."""
+        graphs = []
+        for lane in range(self.count):
+            with wp.ScopedCapture(device=self.device) as capture:
+                self.run_lane(program, lane)
+            graphs.append(capture.graph)
+        return tuple(graphs)
+
+    def replay(self, schedules: Sequence[Sequence]) -> None:
+        """Lane L replays the graphs ``schedules[L]`` in order, all lanes at once (lane 0 on the calling thread);
+        returns when every lane has finished."""
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(max_workers=self.count - 1, thread_name_prefix="cosim-fluid-lane")
+        futures = [self._pool.submit(_replay_all, schedule) for schedule in schedules[1:]]
+        _replay_all(schedules[0])
+        for future in futures:
+            future.result()
+
+
+def _replay_all(graphs: Sequence) -> None:
+    for graph in graphs:
+        wp.capture_launch(graph)

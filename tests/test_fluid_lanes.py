@@ -1,0 +1,109 @@
+"""A CPU substep split over threads (``cosim.fluid.lanes``): the liquid must evolve to the bit as on one thread,
+whatever the number of lanes, with the lanes replaying their graphs at once or run one after the other; only the
+energies' float sums may round differently, being summed per lane."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from cosim.errors import InputError
+from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
+from cosim.fluid.diagnostics import DIAG_KINETIC_ENERGY, DIAG_MAX_SPEED, N_DIAG_FLOAT, combine_lanes
+from cosim.fluid.lanes import MIN_PARTICLES_PER_LANE, available_cores, lane_count, lane_ranges
+from cosim.fluid.seeding import fill_vessel
+from cosim.fluid.solver import FluidSolver
+from cosim.frames import Pose, rotation_y
+from cosim.vessel import VesselSpec
+
+B = 0.191  # m, the seed's vessel width
+FILL = 0.1  # m
+# Relative rounding of a float32 energy summed in two parts instead of one (a few ulps of the total).
+ENERGY_SUM_RTOL = 1e-5
+ENERGY_KEYS = ("kinetic_energy", "potential_energy")
+
+
+def _tank(solver: PressureSolver, threads: int, graphs: bool = True) -> FluidSolver:
+    tank = VesselSpec(name="tank", inner_width=B, inner_depth=0.1, inner_height=0.2)
+    cfg = FluidConfig(
+        dim=2, spacing=B / 16, pressure_solver=solver, max_expected_speed=2 * math.sqrt(GRAVITY * FILL),
+        domain_min=(-0.3, -0.15, -0.1), domain_max=(0.3, 0.15, 0.4), cpu_threads=threads,
+    )
+    return FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, FILL, cfg), graphs=graphs)
+
+
+def _shake(fluid: FluidSolver) -> None:
+    """Tilt and slide the tank over 12 intervals of 10 ms, then one of 40 ms (the rows grow: captured again)."""
+    for k in range(1, 13):
+        t = 0.01 * k
+        fluid.set_vessel_poses([Pose((0.02 * math.sin(8 * t), 0.0, 0.0), rotation_y(0.2 * math.sin(6 * t)))])
+        fluid.advance(0.01)
+    fluid.set_vessel_poses([Pose((0.0, 0.0, 0.0), rotation_y(0.1))])
+    fluid.advance(0.04)
+
+
+def _assert_same_run(fluid: FluidSolver, reference: FluidSolver) -> None:
+    assert fluid.step_count == reference.step_count
+    for read in (FluidSolver.positions, FluidSolver.velocities, FluidSolver.densities, FluidSolver.pressures, FluidSolver.vessel_wrenches):
+        np.testing.assert_array_equal(read(fluid), read(reference))
+    for key, values in reference.history().items():
+        if key in ENERGY_KEYS:
+            np.testing.assert_allclose(fluid.history()[key], values, rtol=ENERGY_SUM_RTOL, err_msg=key)
+        else:
+            np.testing.assert_array_equal(fluid.history()[key], values, err_msg=key)
+
+
+@pytest.mark.parametrize("solver", [PressureSolver.WCSPH, PressureSolver.DFSPH])
+def test_lanes_give_the_single_thread_run_to_the_bit(solver):
+    one = _tank(solver, 1)
+    _shake(one)
+    assert one.lanes.count == 1
+    for threads, graphs in ((2, True), (3, True), (2, False)):
+        fluid = _tank(solver, threads, graphs)
+        _shake(fluid)
+        assert fluid.lanes.count == threads
+        assert (fluid._graphs is not None) == graphs and fluid.graph_capture_error is None  # it replayed the lanes' graphs
+        _assert_same_run(fluid, one)
+    assert one.history()["density_iterations" if solver is PressureSolver.DFSPH else "active"].max() > 0  # the solves ran
+
+
+def test_lane_ranges_partition_the_items():
+    for count in (0, 1, 7, 864, 1001):
+        for lanes in (1, 2, 3, 8):
+            ranges = lane_ranges(count, lanes)
+            assert len(ranges) == lanes
+            assert [first for first, _ in ranges] == list(np.cumsum([0] + [size for _, size in ranges[:-1]]))
+            assert sum(size for _, size in ranges) == count
+            assert max(size for _, size in ranges) - min(size for _, size in ranges) <= 1
+
+
+def test_lane_count():
+    cpu, cuda = SimpleNamespace(is_cuda=False), SimpleNamespace(is_cuda=True)
+    assert lane_count(4, 10, cpu) == 4  # asked for: given, however few particles
+    assert lane_count(4, 10**6, cuda) == 1
+    assert lane_count(0, MIN_PARTICLES_PER_LANE - 1, cpu) == 1
+    assert lane_count(0, 10**6, cpu) == available_cores()
+    assert lane_count(0, 2 * MIN_PARTICLES_PER_LANE, cpu) == min(2, available_cores())
+
+
+def test_combine_lanes_takes_maxima_and_sums():
+    lanes_f = np.zeros((2, 3, N_DIAG_FLOAT), dtype=np.float32)
+    lanes_i = np.arange(2 * 3 * 4, dtype=np.int32).reshape(2, 3, 4)
+    lanes_f[0, :, DIAG_MAX_SPEED], lanes_f[1, :, DIAG_MAX_SPEED] = [1.0, 5.0, 2.0], [3.0, 4.0, 2.5]
+    lanes_f[0, :, DIAG_KINETIC_ENERGY], lanes_f[1, :, DIAG_KINETIC_ENERGY] = [1.0, 2.0, 3.0], [0.5, 0.25, 0.0]
+    rows_f, rows_i = combine_lanes(lanes_f, lanes_i)
+    np.testing.assert_array_equal(rows_f[:, DIAG_MAX_SPEED], [3.0, 5.0, 2.5])
+    np.testing.assert_array_equal(rows_f[:, DIAG_KINETIC_ENERGY], [1.5, 2.25, 3.0])
+    np.testing.assert_array_equal(rows_i, lanes_i[0] + lanes_i[1])
+    assert rows_f.dtype == np.float32 and rows_i.dtype == np.int32
+
+
+def test_cpu_threads_out_of_range_is_refused():
+    with pytest.raises(InputError, match=r"fluid.cpu_threads: .*\[0, 256\]"):
+        replace(FluidConfig(), cpu_threads=-1)
+    with pytest.raises(InputError, match="fluid.cpu_threads: must be an integer"):
+        replace(FluidConfig(), cpu_threads=1.5)
