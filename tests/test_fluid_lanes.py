@@ -10,11 +10,12 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import warp as wp
 
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
 from cosim.fluid.diagnostics import DIAG_KINETIC_ENERGY, DIAG_MAX_SPEED, N_DIAG_FLOAT, combine_lanes
-from cosim.fluid.lanes import MIN_PARTICLES_PER_LANE, available_cores, lane_count, lane_ranges
+from cosim.fluid.lanes import LANE_CHUNK, MIN_PARTICLES_PER_LANE, available_cores, lane_count, lane_item, lane_sizes
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose, rotation_y
@@ -71,14 +72,25 @@ def test_lanes_give_the_single_thread_run_to_the_bit(solver):
     assert one.history()["density_iterations" if solver is PressureSolver.DFSPH else "active"].max() > 0  # the solves ran
 
 
-def test_lane_ranges_partition_the_items():
-    for count in (0, 1, 7, 864, 1001):
+@wp.kernel
+def _mark_items(lane: wp.vec2i, hits: wp.array(dtype=wp.int32), owner: wp.array(dtype=wp.int32)):
+    i = lane_item(wp.tid(), lane)
+    hits[i] += 1
+    owner[i] = lane[0]
+
+
+def test_lanes_compute_every_item_once():
+    for count in (1, 7, LANE_CHUNK, 864, 1001):
         for lanes in (1, 2, 3, 8):
-            ranges = lane_ranges(count, lanes)
-            assert len(ranges) == lanes
-            assert [first for first, _ in ranges] == list(np.cumsum([0] + [size for _, size in ranges[:-1]]))
-            assert sum(size for _, size in ranges) == count
-            assert max(size for _, size in ranges) - min(size for _, size in ranges) <= 1
+            hits = wp.zeros(count, dtype=wp.int32, device="cpu")
+            owner = wp.zeros(count, dtype=wp.int32, device="cpu")
+            sizes = lane_sizes(count, lanes)
+            for lane, size in enumerate(sizes):
+                wp.launch(_mark_items, dim=size, inputs=[wp.vec2i(lane, lanes), hits, owner], device="cpu")
+            np.testing.assert_array_equal(hits.numpy(), 1)
+            # chunks of LANE_CHUNK items dealt out in turn; the shares differ by at most one chunk
+            np.testing.assert_array_equal(owner.numpy(), (np.arange(count) // LANE_CHUNK) % lanes)
+            assert max(sizes) - min(sizes) <= LANE_CHUNK
 
 
 def test_lane_count():

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import warp as wp
 
+from cosim.fluid.lanes import lane_item
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_w
@@ -94,7 +95,7 @@ def advance_vessel_poses(
 
 @wp.kernel
 def place_wall_particles(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     local_pos: wp.array(dtype=wp.vec3),
     vessel_of: wp.array(dtype=wp.int32),
@@ -105,7 +106,7 @@ def place_wall_particles(
     v: wp.array(dtype=wp.vec3),
 ):
     """World position and velocity of each wall sample at the current substep's start pose."""
-    b = wp.tid() + first
+    b = lane_item(wp.tid(), lane)
     m = motions[vessel_of[b]]
     arm = m.r_now @ local_pos[b]
     x[b] = m.p_now + arm
@@ -114,7 +115,7 @@ def place_wall_particles(
 
 @wp.kernel
 def extrapolate_wall_state(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     g: GridSpec,
@@ -135,7 +136,7 @@ def extrapolate_wall_state(
     b_v_noslip: wp.array(dtype=wp.vec3),
 ):
     """Pressure, density and no-slip velocity of each dummy wall particle from the liquid around it."""
-    b = wp.tid() + first
+    b = lane_item(wp.tid(), lane)
     xb = bx[b]
     m = motions[b_vessel[b]]
     arm = xb - m.p_now

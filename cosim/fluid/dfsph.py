@@ -79,6 +79,7 @@ from cosim.fluid.diagnostics import (
     DIAG_MAX_DENSITY_ERROR,
     DIAG_PAIR_OVERFLOW,
 )
+from cosim.fluid.lanes import lane_item
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
@@ -176,7 +177,7 @@ def bound_or_free_density(
 
 @wp.kernel
 def compute_density_factor(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     g: GridSpec,
@@ -216,7 +217,7 @@ def compute_density_factor(
     :func:`pair_mass`), which the later stages loop over instead of the cell grid; the divergence solve's warm start (increment = a fraction of the
     last substep's stiffness, applied by the first iteration) and its counters. More than ``capacity`` neighbours
     (impossible below ~2x compression) count as an overflow, an instability."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)
         keep_going[0] = 1
@@ -292,7 +293,7 @@ def pair_mass(prm: SPHParams, b_volume: wp.array(dtype=float), j: int) -> float:
 
 @wp.kernel
 def apply_stiffness(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     b_volume: wp.array(dtype=float),
@@ -313,7 +314,7 @@ def apply_stiffness(
     """v_i -= dt [sum_j m (k_i/rho_i + k_j/rho_j) grad W_ij + sum_b rho0 V_b (k_i/rho_i + k_b/rho_b) grad W_ib]
     (k_b: the wall layer's increment, zero for the deeper wall particles); kappa_i += k_i. The first iteration of a solve applies its warm start; once a solve has converged, the increments its last
     iteration measured are not applied (the loop ends before this stage)."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     if active[i] == 0:
         return
     ki = increment[i] / rho[i]
@@ -333,7 +334,7 @@ def apply_stiffness(
 
 @wp.kernel
 def compute_solve_error(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     b_volume: wp.array(dtype=float),
@@ -356,7 +357,7 @@ def compute_solve_error(
     dt Drho/Dt; only compression: e_i >= 0), its next stiffness increment omega e_i alpha_i / dt^2 (omega:
     ``prm.jacobi_relaxation``, 1 unless the support holds so many neighbours that plain Jacobi would diverge) and the
     error sum."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     if active[i] == 0:
         increment[i] = 0.0
         return
@@ -426,7 +427,7 @@ def check_convergence(
 
 @wp.kernel
 def compute_wall_density_factor(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     g: GridSpec,
@@ -456,7 +457,7 @@ def compute_wall_density_factor(
     rho0 V_b' W_bb') / s, its factor alpha_b = rho_b / sum_j m rho0 V_b |grad W_bj|^2 (the density change its
     stiffness causes by pushing its liquid neighbours away; bounded below as the liquid's) and its list of liquid
     neighbours with grad_b W. Other wall particles carry no stiffness (rho_b = rho0, no pairs)."""
-    b = wp.tid() + first
+    b = lane_item(wp.tid(), lane)
     b_pair_count[b] = 0
     b_rho[b] = prm.rest_density
     b_alpha[b] = 0.0
@@ -499,7 +500,7 @@ def compute_wall_density_factor(
 
 @wp.kernel
 def start_wall_solve(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     warm_start: float,
     # State in/out
     b_kappa: wp.array(dtype=float),
@@ -507,14 +508,14 @@ def start_wall_solve(
     b_increment: wp.array(dtype=float),
 ):
     """A solve's warm start for the wall layer: a fraction of the stiffness it applied in the last substep."""
-    b = wp.tid() + first
+    b = lane_item(wp.tid(), lane)
     b_increment[b] = warm_start * b_kappa[b]
     b_kappa[b] = 0.0
 
 
 @wp.kernel
 def compute_wall_solve_error(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     mode: int,
@@ -535,7 +536,7 @@ def compute_wall_solve_error(
     """The wall layer's side of one iteration: adds the increment the liquid just received from it to its
     stiffness, then its remaining error e_b (dt Drho_b/Dt, plus rho_b - rho0 in the density solve; compression
     only), with Drho_b/Dt = sum_j m (v_b - v_j) . grad W_bj, and its next increment omega e_b alpha_b / dt^2."""
-    b = wp.tid() + first
+    b = lane_item(wp.tid(), lane)
     b_kappa[b] = b_kappa[b] + b_increment[b]
     n = b_pair_count[b]
     if n == 0:
@@ -566,7 +567,7 @@ def wall_pair_viscosity(prm: SPHParams, alpha: float, volume: float, r: wp.vec3,
 
 @wp.kernel
 def compute_nonpressure(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     b_volume: wp.array(dtype=float),
@@ -594,7 +595,7 @@ def compute_nonpressure(
 ):
     """v* = v + dt (g + viscosity) over the substep's pair list (walls: their own velocity, rest density;
     :func:`wall_pair_viscosity`); the density solve's warm start and counters."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)
         keep_going[0] = 1
@@ -628,7 +629,7 @@ def compute_nonpressure(
 
 @wp.kernel
 def compute_wall_reaction(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -665,7 +666,7 @@ def compute_wall_reaction(
     centre of mass. Also adds this substep's share (``substep_weight`` = 1 / substeps of the interval) of the
     reported pressure p_i = rho_i kappa_i (Pa): the pressure is the interval's average, as the wrenches are (one
     substep's stiffness is the multiplier of that substep's residual, noisy from substep to substep)."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
@@ -693,7 +694,7 @@ def compute_wall_reaction(
 
 @wp.kernel
 def integrate(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -718,7 +719,7 @@ def integrate(
     diag_i: wp.array2d(dtype=wp.int32),
 ):
     """x += dt v* (the velocity both solves corrected), then the shared guard, deactivation and diagnostics."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     if active[i] == 0:
         return
     x_old = x[i]

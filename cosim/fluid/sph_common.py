@@ -20,6 +20,7 @@ from cosim.fluid.diagnostics import (
     DIAG_MAX_SPEED,
     DIAG_NONFINITE,
 )
+from cosim.fluid.lanes import lane_item
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_dw, kernel_w
 
@@ -223,7 +224,7 @@ def finish_particle(
 
 @wp.kernel
 def gather_particles(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     order: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
@@ -247,7 +248,7 @@ def gather_particles(
     rest_offset_out: wp.array(dtype=float),
 ):
     """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     src = order[i]
     x_out[i] = x[src]
     v_out[i] = v[src]

@@ -32,6 +32,7 @@ import warp as wp
 
 from cosim.fluid.boundary import VesselGeometry, VesselMotion
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
+from cosim.fluid.lanes import lane_item
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
@@ -82,7 +83,7 @@ def tait_internal_energy(prm: SPHParams, rho: float) -> float:
 
 @wp.kernel
 def update_free_liquid(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     g: GridSpec,
@@ -113,7 +114,7 @@ def update_free_liquid(
     the vessel it left). It becomes bound when its summation density reaches rho0 inside a
     vessel; the continuity equation then continues from that density, so the pressure is continuous and the
     caught liquid keeps no memory of the loose packing it arrived in."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     if active[i] == 0:
         return
     xi = x[i]
@@ -148,7 +149,7 @@ def update_free_liquid(
 
 @wp.kernel
 def compute_forces(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     g: GridSpec,
@@ -192,7 +193,7 @@ def compute_forces(
     the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``:
     grad_i W), in the order of the neighbour loop, which compute_density_rate sums over instead of searching the
     cells again; more than ``capacity`` neighbours count as an overflow, an instability."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
@@ -272,7 +273,7 @@ def compute_forces(
 
 @wp.kernel
 def compute_density_rate(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     b_volume: wp.array(dtype=float),
@@ -296,7 +297,7 @@ def compute_density_rate(
     delta h c0 sum_j V_j [2 (rho_i - rho_j) r_ij . grad W / (r^2 + eta^2) - (<grad rho>_i + <grad rho>_j) . grad W],
     which vanishes for any linear density field (a resting column) and conserves mass between pairs. Sums over
     compute_forces' pair list, in its order (the neighbours have not moved since)."""
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     if active[i] == 0:
         drho[i] = 0.0
         return
@@ -326,7 +327,7 @@ def compute_density_rate(
 
 @wp.kernel
 def integrate(
-    first: int,  # lane: the first item of this launch's share (cosim.fluid.lanes)
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -353,7 +354,7 @@ def integrate(
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
 ):
-    i = wp.tid() + first
+    i = lane_item(wp.tid(), lane)
     if active[i] == 0:
         return
     s = row[0]
