@@ -69,7 +69,8 @@ SMOKE_AXES = {  # seconds of CPU: for tests and a quick check of the machinery, 
 
 @dataclass(frozen=True)
 class SkipOption:
-    """A scene option that skips work: ``skip`` runs with it, ``full`` without (everything else equal)."""
+    """A scene option that skips work (or spreads it over the cores): ``skip`` runs with it, ``full`` without
+    (everything else equal)."""
 
     name: str
     setting: str
@@ -136,6 +137,8 @@ def _skip_options(device: str) -> list[SkipOption]:
                    "speed)", at[24], opt(at[24], "fluid.adaptive_time_step", False)),
         SkipOption("neighbour grid restricted to the liquid", "fluid.grid_reset = occupied (full: whole)", at[24],
                    opt(at[24], "fluid.grid_reset", "whole")),
+        SkipOption("substeps split over the CPU cores", "fluid.cpu_threads = 0, one per core (full: 1)", at[24],
+                   opt(at[24], "fluid.cpu_threads", 1)),
     ]
 
 

@@ -19,6 +19,7 @@ from cosim.bench.config import BenchCase, BenchConfig
 from cosim.bench.pareto import pareto_front
 from cosim.bench.plan import BenchPlan
 from cosim.bench.pour_compare import POUR_ERRORS, compare_pours
+from cosim.fluid.lanes import MIN_PARTICLES_PER_LANE, available_cores
 
 # Errors per case, in table order, with their headers (relative errors unless the unit says otherwise).
 CASE_ERRORS = {
@@ -157,7 +158,9 @@ def markdown(plan: BenchPlan, results: dict[BenchConfig, dict], rows: list[Row],
     out = [header]
     if loads:
         out.append(f"1-minute load average after each computed row: {min(loads):.1f} to {max(loads):.1f} "
-                   f"(on {os.cpu_count()} logical cores; above that, other jobs shared the CPU and the wall times are longer).\n")
+                   f"(on {os.cpu_count()} logical cores; above that, other jobs shared the CPU and the wall times are longer). "
+                   f"CPU rows split each substep over one thread per core this process may use ({available_cores()} here), at most "
+                   f"one per {MIN_PARTICLES_PER_LANE} particles (`fluid.cpu_threads` = 0), unless a row sets it.\n")
     for case, errors in CASE_ERRORS.items():
         case_rows = sorted((r for r in rows if r.config.case is case), key=lambda r: (r.config.device, r.wall_per_sim_s))
         if not case_rows:
