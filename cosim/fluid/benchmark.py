@@ -2,13 +2,16 @@
 ``example_sph`` at the same particle count (a benchmark, not a test).
 
     python -m cosim.fluid.benchmark [--device cpu|cuda] [--counts2d 1000 4000 16000] [--counts3d 4000 16000 62500]
-                                    [--solvers wcsph dfsph] [--repeats 3] [--no-graphs] [--out docs/benchmarks.md]
+                                    [--solvers wcsph dfsph] [--threads 0 1] [--repeats 3] [--no-graphs]
+                                    [--out docs/benchmarks.md]
 
 Ours: a resting box of liquid in a tank (the hydrostatic case), every stage of a substep (walls, neighbour sort,
 reorder, then the pressure solver's stages, integration, wrench reduction), for each pressure solver. Besides
 particle-steps/s (cost per substep) it reports simulated seconds per wall-clock second over the same interval,
 the comparison that matters between solvers whose time steps differ (WCSPH: acoustic CFL; DFSPH: flow CFL and the
-force criterion, with its iterations per substep). ``example_sph``: warp's own
+force criterion, with its iterations per substep). On the CPU each thread count asked for is a row of its own
+(``FluidConfig.cpu_threads``; 0: one per core, at most one per 400 particles), the threads column the number used.
+``example_sph``: warp's own
 3-D toy (Mueller 2003 kernels on ``wp.HashGrid``, a handful of neighbours per particle), re-sized to the same
 count by reallocating its particle arrays with its own initialisation kernel. Both are timed after a warm-up
 step (kernel compilation excluded); the median of ``repeats`` timed batches is reported. Appends a dated section
@@ -38,8 +41,8 @@ from cosim.vessel import VesselSpec
 TANK_ASPECT = 1.0  # the liquid block is as tall as it is wide
 
 
-def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, graphs: bool = True) -> tuple[float, float, int, float]:
-    """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s) of our
+def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, graphs: bool = True, threads: int = 0) -> tuple[float, float, int, float, int]:
+    """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s, threads) of our
     solver on a resting liquid block of ~n particles, timed over intervals of ``steps`` WCSPH substeps after a
     settling interval of the same length (kernel compilation, DFSPH's cold start and the CUDA graph capture
     excluded)."""
@@ -50,7 +53,7 @@ def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: Press
     tank = VesselSpec(name="tank", inner_width=width, inner_depth=depth, inner_height=1.5 * width)
     m = 0.1 * width
     cfg = FluidConfig(
-        dim=dim, spacing=dx, max_expected_speed=2 * math.sqrt(9.81 * width), pressure_solver=solver,
+        dim=dim, spacing=dx, max_expected_speed=2 * math.sqrt(9.81 * width), pressure_solver=solver, cpu_threads=threads,
         domain_min=(-0.5 * width - m, -0.5 * depth - m, -m), domain_max=(0.5 * width + m, 0.5 * depth + m, 1.5 * width + m),
     )
     block = liquid_block((-0.5 * width, -0.5 * depth, 0.0), (0.5 * width, 0.5 * depth, width * TANK_ASPECT), cfg)
@@ -67,7 +70,7 @@ def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: Press
         rates.append(fluid.n_particles * fluid.last_report.substeps / wall)
         speeds.append(interval / wall)
         dts.append(fluid.last_report.dt)
-    return statistics.median(rates), statistics.median(speeds), fluid.n_particles, statistics.mean(dts)
+    return statistics.median(rates), statistics.median(speeds), fluid.n_particles, statistics.mean(dts), fluid.lanes.count
 
 
 def _example_sph(n: int, device: str, steps: int, repeats: int) -> float:
@@ -124,6 +127,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--steps", type=int, default=20, help="WCSPH substeps per timed interval (the same simulated interval for every solver)")
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--solvers", nargs="*", choices=[s.value for s in PressureSolver], default=[s.value for s in PressureSolver])
+    p.add_argument("--threads", type=int, nargs="*", default=[0], help="CPU threads of the solver, one row each (0: one per core)")
     p.add_argument("--no-graphs", action="store_true", help="run a substep's launches one by one instead of replaying its captured graph")
     p.add_argument("--out", type=Path, default=None, help="append the table to this Markdown file")
     args = p.parse_args(argv)
@@ -132,23 +136,25 @@ def main(argv: list[str] | None = None) -> int:
     for dim, counts in ((2, args.counts2d), (3, args.counts3d)):
         for n in counts:
             theirs = float("nan")
-            for k, name in enumerate(args.solvers):
-                ours, sim_rate, actual, dt = _ours(n, dim, str(device), args.steps, args.repeats, PressureSolver(name), not args.no_graphs)
-                if dim == 3 and k == 0:
-                    theirs = _example_sph(actual, str(device), args.steps, args.repeats)
-                rows.append((dim, actual, name, ours, sim_rate, dt, theirs))
-                print(f"{dim}-D {actual:>8d} particles {name}: {ours / 1e6:8.3f} M particle-steps/s, dt {dt * 1e6:8.1f} us, "
-                      f"{sim_rate:8.4f} simulated s per wall s" + (f"   example_sph {theirs / 1e6:8.3f} M" if dim == 3 else ""), flush=True)
-    table = ["| dim | particles | solver | M particle-steps/s | steps/s | substep dt (us) | simulated s / wall s | warp example_sph (M particle-steps/s) |",
-             "|---|---|---|---|---|---|---|---|"]
-    for dim, n, name, ours, sim_rate, dt, theirs in rows:
+            for name in args.solvers:
+                for threads in args.threads:
+                    ours, sim_rate, actual, dt, used = _ours(n, dim, str(device), args.steps, args.repeats, PressureSolver(name), not args.no_graphs, threads)
+                    if dim == 3 and math.isnan(theirs):
+                        theirs = _example_sph(actual, str(device), args.steps, args.repeats)
+                    rows.append((dim, actual, name, used, ours, sim_rate, dt, theirs))
+                    print(f"{dim}-D {actual:>8d} particles {name} {used} threads: {ours / 1e6:8.3f} M particle-steps/s, dt {dt * 1e6:8.1f} us, "
+                          f"{sim_rate:8.4f} simulated s per wall s" + (f"   example_sph {theirs / 1e6:8.3f} M" if dim == 3 else ""), flush=True)
+    table = ["| dim | particles | solver | threads | M particle-steps/s | steps/s | substep dt (us) | simulated s / wall s | warp example_sph (M particle-steps/s) |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for dim, n, name, used, ours, sim_rate, dt, theirs in rows:
         ex = f"{theirs / 1e6:.3f}" if not math.isnan(theirs) else "- (3-D only)"
-        table.append(f"| {dim}-D | {n} | {name} | {ours / 1e6:.3f} | {ours / n:.0f} | {dt * 1e6:.1f} | {sim_rate:.4f} | {ex} |")
+        table.append(f"| {dim}-D | {n} | {name} | {used} | {ours / 1e6:.3f} | {ours / n:.0f} | {dt * 1e6:.1f} | {sim_rate:.4f} | {ex} |")
     header = (
         f"\n## Fluid step throughput, {device} ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
         f"Machine: {_machine()}. Versions: Python {platform.python_version()}, warp {wp.__version__}, numpy {np.__version__}.\n"
         f"Command: `python -m cosim.fluid.benchmark --device {args.device} --counts2d {' '.join(map(str, args.counts2d))} "
-        f"--counts3d {' '.join(map(str, args.counts3d))} --solvers {' '.join(args.solvers)} --steps {args.steps} --repeats {args.repeats}"
+        f"--counts3d {' '.join(map(str, args.counts3d))} --solvers {' '.join(args.solvers)} --threads {' '.join(map(str, args.threads))} "
+        f"--steps {args.steps} --repeats {args.repeats}"
         f"{' --no-graphs' if args.no_graphs else ''}`. "
         f"Median of {args.repeats} intervals of {args.steps} WCSPH substeps' simulated time after a settling interval; one step "
         "is the full substep (walls, neighbour sort and reorder, the pressure solver's stages, integration, wrench "
