@@ -64,7 +64,7 @@ class FluidSettings:
     density_tolerance: DFSPH: the density solve stops when the average compression is below this fraction of rho0
       (``cosim.fluid.config.FluidConfig``; the pour's time against its errors at three other tolerances is in
       docs/benchmarks.md). (0, 0.05]
-    cpu_threads: threads the CPU solver splits each substep over; 0: one per available core (at most one per 400
+    cpu_threads: threads the CPU solver splits each substep over; 0: one per available core (at most one per 200
       particles). The results are the same for any number. [0, 256]
     """
 

@@ -5,7 +5,10 @@ energies' float sums may round differently, being summed per lane."""
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 from dataclasses import replace
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -119,3 +122,42 @@ def test_cpu_threads_out_of_range_is_refused():
         replace(FluidConfig(), cpu_threads=-1)
     with pytest.raises(InputError, match="fluid.cpu_threads: must be an integer"):
         replace(FluidConfig(), cpu_threads=1.5)
+
+
+ABORT_SCRIPT = """
+import threading, warp as wp
+from cosim.errors import SimulationError
+from cosim.fluid.config import PressureSolver
+from tests.test_fluid_lanes import _tank
+fluid = _tank(PressureSolver.DFSPH, 2)
+fluid.advance(0.01)
+fluid.advance(0.01)  # captured and replayed by both lanes
+assert fluid._graphs is not None
+real = wp.capture_launch
+def failing(graph):
+    if threading.current_thread() is not threading.main_thread():
+        raise RuntimeError("lane failed")
+    real(graph)
+wp.capture_launch = failing
+try:
+    fluid.advance(0.01)
+except RuntimeError as exc:
+    assert str(exc) == "lane failed", exc
+else:
+    raise AssertionError("the failing lane's error was not raised")
+wp.capture_launch = real
+assert fluid.lanes.aborted
+try:
+    fluid.advance(0.01)
+except SimulationError as exc:
+    print("refused:", exc)
+"""
+
+
+def test_a_failing_lane_raises_instead_of_leaving_the_others_waiting():
+    """Lane 1 fails before its first substep: lane 0 would wait at the first barrier forever without the abort. Run in
+    a child process under a time limit, so that a hang fails the test instead of stalling the suite."""
+    root = Path(__file__).resolve().parents[1]
+    done = subprocess.run([sys.executable, "-c", ABORT_SCRIPT], cwd=root, capture_output=True, text=True, timeout=240)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "refused: fluid: an earlier interval was interrupted" in done.stdout

@@ -10,7 +10,7 @@ reorder, then the pressure solver's stages, integration, wrench reduction), for 
 particle-steps/s (cost per substep) it reports simulated seconds per wall-clock second over the same interval,
 the comparison that matters between solvers whose time steps differ (WCSPH: acoustic CFL; DFSPH: flow CFL and the
 force criterion, with its iterations per substep). On the CPU each thread count asked for is a row of its own
-(``FluidConfig.cpu_threads``; 0: one per core, at most one per 400 particles), the threads column the number used.
+(``FluidConfig.cpu_threads``; 0: one per core, at most one per 200 particles), the threads column the number used.
 ``example_sph``: warp's own
 3-D toy (Mueller 2003 kernels on ``wp.HashGrid``, a handful of neighbours per particle), re-sized to the same
 count by reallocating its particle arrays with its own initialisation kernel. Both are timed after a warm-up

@@ -96,7 +96,7 @@ class FluidConfig:
         the remaining error shows in the diagnostics). [2, 1000]
     cpu_threads: threads a CPU substep is split over (``cosim.fluid.lanes``; each takes a contiguous share of the
         particles, and the results are the same to the bit for any number); 0: one per core this process may run
-        on, at most one per 400 particles. Ignored on CUDA. [0, 256]
+        on, at most one per 200 particles. Ignored on CUDA. [0, 256]
     depth_2d: m, liquid thickness perpendicular to the pour plane in 2-D (the pouring vessel's depth): masses,
         volumes and wrenches reported to the outside are per unit depth times this. (0, 2]
     boundary_spacing_ratio: wall sample spacing / dx. [0.3, 1.0]

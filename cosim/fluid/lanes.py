@@ -2,12 +2,12 @@
 own the solver leaves every other core idle.
 
 Each lane launches the particle kernels over its own share of the particles (chunks dealt out in turn,
-:func:`lane_item`; the kernels take their lane as first argument) and every lane waits for the others between stages (:data:`barrier_wait`, a spin barrier in
-native code inside the captured graph), so each lane's substep is one graph of warp's CPU operation stream that its
-own thread replays. The split changes no result: every kernel computes each particle as before, and what the lanes
-accumulate together (the solves' error sums, the diagnostics' counts and maxima) is kept per lane and combined in a
-fixed order, as integers or maxima where it steers the run. Without graphs (the first interval, ``graphs=False``)
-the lanes' shares run one after the other on the calling thread.
+:func:`lane_item`; the kernels take their lane as first argument) and every lane waits for the others between stages
+(:func:`barrier_wait`, a spin barrier in native code inside the captured graph), so each lane's substep is one graph
+of warp's CPU operation stream that its own thread replays. The split changes no result: every kernel computes each
+particle as before, and what the lanes accumulate together (the solves' error sums, the diagnostics' counts and
+maxima) is kept per lane and combined in a fixed order, as integers or maxima where it steers the run. Without
+graphs (the first interval, ``graphs=False``) the lanes' shares run one after the other on the calling thread.
 
 A stage is the unit between two barriers: :class:`Stage` (the operations each lane runs) or :class:`Loop` (a
 ``wp.capture_while`` loop of stages on a device flag).
@@ -24,10 +24,11 @@ from typing import Callable, Sequence, Union
 
 import warp as wp
 
-# Fewest particles per lane the automatic thread count gives a lane: below it the barriers and launches of a lane
-# cost more than its share of the work (at 864 particles, the default pour, 2 lanes are 1.6 x faster than 1 on the
-# 2-core CPU; more lanes are not measured, having no machine with more cores to hand).
-MIN_PARTICLES_PER_LANE = 400
+# Fewest particles per lane the automatic thread count gives a lane. Measured on the 2-core CPU (a resting 2-D tank,
+# `python -m cosim.fluid.benchmark --counts2d 400 800 1600 --solvers dfsph wcsph --threads 1 2`): 2 lanes run 1.57,
+# 1.52 and 1.79 x the particle-steps of one under DFSPH at 400, 784 and 1600 particles, 1.58, 1.74 and 1.84 x under
+# WCSPH; smaller liquids were not measured (the benchmark's tank needs 400), so 400 particles get 2 lanes, fewer one.
+MIN_PARTICLES_PER_LANE = 200
 # Spins (x86 ``pause`` / arm ``yield`` hints) before a waiting lane gives its core away on every further check:
 # about 40-100 us, several stages' worth, so a lane that is running is waited for on the spot, one whose core the OS
 # gave to another process is not spun against for a whole time slice.
@@ -41,13 +42,17 @@ LANE_CHUNK = wp.constant(16)
 
 @wp.func_native(
     """
+if (__atomic_load_n(&state.data[2], __ATOMIC_ACQUIRE) != 0) {
+    return;
+}
 const int generation = __atomic_load_n(&state.data[1], __ATOMIC_ACQUIRE);
 if (__atomic_add_fetch(&state.data[0], 1, __ATOMIC_ACQ_REL) == parties) {
     __atomic_store_n(&state.data[0], 0, __ATOMIC_RELAXED);
     __atomic_store_n(&state.data[1], generation + 1, __ATOMIC_RELEASE);
     return;
 }
-for (long spins = 0; __atomic_load_n(&state.data[1], __ATOMIC_ACQUIRE) == generation; ++spins) {
+for (long spins = 0; __atomic_load_n(&state.data[1], __ATOMIC_ACQUIRE) == generation
+                     && __atomic_load_n(&state.data[2], __ATOMIC_ACQUIRE) == 0; ++spins) {
     if (spins < spins_before_yield) {
 #if defined(__x86_64__) || defined(__i386__)
         __builtin_ia32_pause();
@@ -65,7 +70,8 @@ def barrier_wait(state: wp.array(dtype=wp.int32), parties: int, spins_before_yie
 
 @wp.kernel
 def lane_barrier(state: wp.array(dtype=wp.int32), parties: int, spins_before_yield: int, yield_fn: wp.uint64):
-    """One thread: return once all ``parties`` lanes have arrived (state: [arrived, generation], zeroed at start)."""
+    """One thread: return once all ``parties`` lanes have arrived, or at once after an abort (state: [arrived,
+    generation, aborted], zeroed at start)."""
     barrier_wait(state, parties, spins_before_yield, yield_fn)
 
 
@@ -152,9 +158,10 @@ class Lanes:
     def __init__(self, count: int, device):
         self.count = count
         self.device = device
-        self._barrier_state = wp.zeros(2, dtype=wp.int32, device=device)
+        self._barrier_state = wp.zeros(3, dtype=wp.int32, device=device)
         self._barrier = None
         self._pool: ThreadPoolExecutor | None = None
+        self._aborted = False
 
     def launch(self, kernel, items: int, inputs: Sequence, outputs: Sequence = ()) -> Stage:
         """``kernel`` over ``items`` items, each lane its share (:func:`lane_item`; the kernel's first argument is
@@ -203,17 +210,39 @@ class Lanes:
             graphs.append(capture.graph)
         return tuple(graphs)
 
+    @property
+    def aborted(self) -> bool:
+        """A replay was abandoned (an error or an interrupt in one lane): the particle state is undefined."""
+        return self._aborted
+
     def replay(self, schedules: Sequence[Sequence]) -> None:
         """Lane L replays the graphs ``schedules[L]`` in order, all lanes at once (lane 0 on the calling thread);
-        returns when every lane has finished."""
+        returns when every lane has finished. Should a lane fail or the caller be interrupted (Ctrl-C), the barriers
+        are opened for good so that no lane waits forever for it, every lane is waited for, and the first error is
+        raised (:attr:`aborted` stays true)."""
         if self._pool is None:
             self._pool = ThreadPoolExecutor(max_workers=self.count - 1, thread_name_prefix="cosim-fluid-lane")
-        futures = [self._pool.submit(_replay_all, schedule) for schedule in schedules[1:]]
-        _replay_all(schedules[0])
+        futures = []
+        try:
+            futures = [self._pool.submit(self._replay_lane, schedule) for schedule in schedules[1:]]
+            self._replay_lane(schedules[0])
+        except BaseException:
+            self._abort()
+            raise
+        finally:
+            for future in futures:
+                future.exception()  # waits; the first error is raised below or above
         for future in futures:
             future.result()
 
+    def _replay_lane(self, graphs: Sequence) -> None:
+        try:
+            for graph in graphs:
+                wp.capture_launch(graph)
+        except BaseException:
+            self._abort()
+            raise
 
-def _replay_all(graphs: Sequence) -> None:
-    for graph in graphs:
-        wp.capture_launch(graph)
+    def _abort(self) -> None:
+        self._aborted = True
+        self._barrier_state.numpy()[2] = 1  # CPU memory: the spinning lanes see it

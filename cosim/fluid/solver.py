@@ -19,10 +19,11 @@ convergence loops read a device flag through ``wp.capture_while``, see ``cosim.f
 interval on each substep is replayed as one captured graph: a CUDA graph on a CUDA device (written without a GPU at
 hand: ``python -m cosim.bench.device_check`` is the check to run where one is), on the CPU warp's operation stream
 (APIC), which replays the launches in C++ without Python's per-launch argument handling (same results to the bit,
-tests/test_fluid_graphs.py). On the CPU the particle kernels are split over threads, each replaying its own
-graph of its share of the particles with barriers between the stages (``cosim.fluid.lanes``, ``cpu_threads``; same
-results to the bit, tests/test_fluid_lanes.py). After the interval the per-substep diagnostics are checked and an instability raises :class:`FluidInstabilityError`
-naming the step and what broke. Results come back as numpy arrays in the particles' original order.
+tests/test_fluid_graphs.py). On the CPU the particle kernels are split over threads, each replaying its own graph of
+its share of the particles with barriers between the stages (``cosim.fluid.lanes``, ``cpu_threads``; same results to
+the bit, tests/test_fluid_lanes.py). After the interval the per-substep diagnostics are checked and an instability
+raises :class:`FluidInstabilityError` naming the step and what broke. Results come back as numpy arrays in the
+particles' original order.
 """
 
 from __future__ import annotations
@@ -507,6 +508,8 @@ class FluidSolver:
     def _run_substeps(self, count: int) -> None:
         """``count`` substeps: each lane replays its graphs (the lanes at once), or the operations run one by one
         (every lane's share in turn); the particle buffers swap after each substep."""
+        if self.lanes.aborted:
+            raise SimulationError("fluid: an earlier interval was interrupted inside its substeps; the liquid's state is undefined")
         if self._graphs is not None:
             parities = [(self._parity + k) % 2 for k in range(count)]
             if self.lanes.count > 1:
