@@ -60,7 +60,7 @@ def run(args) -> int:
     )
     phases = " -> ".join(f"{p['phase']} {p['start']:.2f}-{p['end']:.2f}s" for p in summary["phases"])
     print(f"phases: {phases}")
-    threads = f" ({summary['fluid_threads']} threads)" if summary["device"] == "cpu" else ""
+    threads = f" ({summary['fluid_threads']} thread{'s' if summary['fluid_threads'] > 1 else ''})" if summary["device"] == "cpu" else ""
     print(f"simulated {summary['sim_time']:.2f} s in {summary['wall_time']:.1f} s wall (real-time factor {summary['real_time_factor']:.3f}), "
           f"{summary['particles']} particles, {summary['device']}{threads}", file=sys.stdout)
     return 0
