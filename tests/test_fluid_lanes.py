@@ -4,7 +4,6 @@ energies' float sums may round differently, being summed per lane."""
 
 from __future__ import annotations
 
-import math
 import subprocess
 import sys
 from dataclasses import replace
@@ -16,38 +15,17 @@ import pytest
 import warp as wp
 
 from cosim.errors import InputError
-from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
+from cosim.fluid.config import FluidConfig, PressureSolver
 from cosim.fluid.diagnostics import DIAG_KINETIC_ENERGY, DIAG_MAX_SPEED, N_DIAG_FLOAT, combine_lanes
 from cosim.fluid.lanes import LANE_CHUNK, MIN_PARTICLES_PER_LANE, available_cores, lane_count, lane_item, lane_sizes
-from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
-from cosim.frames import Pose, rotation_y
-from cosim.vessel import VesselSpec
+from tests.support.shaken_tank import shake, tank
 
-B = 0.191  # m, the seed's vessel width
-FILL = 0.1  # m
 # Relative rounding of a float32 energy summed in two parts instead of one (a few ulps of the total).
 ENERGY_SUM_RTOL = 1e-5
 ENERGY_KEYS = ("kinetic_energy", "potential_energy")
-
-
-def _tank(solver: PressureSolver, threads: int, graphs: bool = True) -> FluidSolver:
-    tank = VesselSpec(name="tank", inner_width=B, inner_depth=0.1, inner_height=0.2)
-    cfg = FluidConfig(
-        dim=2, spacing=B / 16, pressure_solver=solver, max_expected_speed=2 * math.sqrt(GRAVITY * FILL),
-        domain_min=(-0.3, -0.15, -0.1), domain_max=(0.3, 0.15, 0.4), cpu_threads=threads,
-    )
-    return FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, FILL, cfg), graphs=graphs)
-
-
-def _shake(fluid: FluidSolver) -> None:
-    """Tilt and slide the tank over 12 intervals of 10 ms, then one of 40 ms (the rows grow: captured again)."""
-    for k in range(1, 13):
-        t = 0.01 * k
-        fluid.set_vessel_poses([Pose((0.02 * math.sin(8 * t), 0.0, 0.0), rotation_y(0.2 * math.sin(6 * t)))])
-        fluid.advance(0.01)
-    fluid.set_vessel_poses([Pose((0.0, 0.0, 0.0), rotation_y(0.1))])
-    fluid.advance(0.04)
+ACROSS = 16  # 128 particles: too few for 2 automatic lanes, so the tests ask for them
+SHAKE = dict(intervals=12, tilt=0.2)
 
 
 def _assert_same_run(fluid: FluidSolver, reference: FluidSolver) -> None:
@@ -63,12 +41,12 @@ def _assert_same_run(fluid: FluidSolver, reference: FluidSolver) -> None:
 
 @pytest.mark.parametrize("solver", [PressureSolver.WCSPH, PressureSolver.DFSPH])
 def test_lanes_give_the_single_thread_run_to_the_bit(solver):
-    one = _tank(solver, 1)
-    _shake(one)
+    one = tank(solver, ACROSS, threads=1)
+    shake(one, **SHAKE)
     assert one.lanes.count == 1
     for threads, graphs in ((2, True), (3, True), (2, False)):
-        fluid = _tank(solver, threads, graphs)
-        _shake(fluid)
+        fluid = tank(solver, ACROSS, graphs, threads)
+        shake(fluid, **SHAKE)
         assert fluid.lanes.count == threads
         assert (fluid._graphs is not None) == graphs and fluid.graph_capture_error is None  # it replayed the lanes' graphs
         _assert_same_run(fluid, one)
@@ -128,8 +106,8 @@ ABORT_SCRIPT = """
 import threading, warp as wp
 from cosim.errors import SimulationError
 from cosim.fluid.config import PressureSolver
-from tests.test_fluid_lanes import _tank
-fluid = _tank(PressureSolver.DFSPH, 2)
+from tests.support.shaken_tank import tank
+fluid = tank(PressureSolver.DFSPH, 16, threads=2)
 fluid.advance(0.01)
 fluid.advance(0.01)  # captured and replayed by both lanes
 assert fluid._graphs is not None
