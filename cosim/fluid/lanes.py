@@ -122,6 +122,11 @@ class Stage:
     parts: tuple[tuple[Callable[[], None], ...], ...]
 
 
+def together(*stages: Stage) -> Stage:
+    """Independent stages run between the same two barriers: each lane runs its parts of all of them, in order."""
+    return Stage(tuple(sum(parts, ()) for parts in zip(*(stage.parts for stage in stages))))
+
+
 @dataclass(frozen=True)
 class Loop:
     """``wp.capture_while(flag, body)``: the stages of ``body`` repeated while ``flag[0]`` is non-zero. Every lane
@@ -202,11 +207,14 @@ class Lanes:
             self._wait()  # after a loop too: no lane may set the flag again before every lane has read it
 
     def capture(self, program: Program) -> tuple:
-        """One graph per lane of ``program`` (capturing runs nothing)."""
+        """One graph per lane of ``program`` (capturing runs nothing); a single lane's without barriers."""
         graphs = []
         for lane in range(self.count):
             with wp.ScopedCapture(device=self.device) as capture:
-                self.run_lane(program, lane)
+                if self.count == 1:
+                    run_serial(program)
+                else:
+                    self.run_lane(program, lane)
             graphs.append(capture.graph)
         return tuple(graphs)
 
@@ -220,6 +228,9 @@ class Lanes:
         returns when every lane has finished. Should a lane fail or the caller be interrupted (Ctrl-C), the barriers
         are opened for good so that no lane waits forever for it, every lane is waited for, and the first error is
         raised (:attr:`aborted` stays true)."""
+        if self.count == 1:
+            self._replay_lane(schedules[0])
+            return
         if self._pool is None:
             self._pool = ThreadPoolExecutor(max_workers=self.count - 1, thread_name_prefix="cosim-fluid-lane")
         futures = []

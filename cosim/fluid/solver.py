@@ -47,7 +47,7 @@ from cosim.fluid.diagnostics import (
     rows_to_records,
 )
 from cosim.fluid.energy import EnergyAccount
-from cosim.fluid.lanes import Lanes, Loop, PerLane, Program, Stage, lane_count, run_serial
+from cosim.fluid.lanes import Lanes, Loop, PerLane, Stage, lane_count, run_serial, together
 from cosim.fluid.model import FluidModel, FluidState, build_model
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
@@ -354,8 +354,9 @@ class FluidSolver:
         if nv:
             stages.append(lanes.on_lane(0, self._rec(bd.advance_vessel_poses, nv, [self._row, self._dt], [self._motions])))
             stages.append(lanes.launch(bd.place_wall_particles, nb, [m.b_local, m.b_vessel, self._motions], [self._bx, self._bv]))
-        walls, liquid = lanes.on_lane(0, *m.b_grid.build_commands(self._bx, self._b_active, nb)), lanes.on_lane(-1, *m.grid.build_commands(src.x, src.active, n))
-        stages.append(Stage(tuple(w + q for w, q in zip(walls.parts, liquid.parts))))
+        stages.append(together(
+            lanes.on_lane(0, *m.b_grid.build_commands(self._bx, self._b_active, nb)), lanes.on_lane(-1, *m.grid.build_commands(src.x, src.active, n)),
+        ))
         stages.append(lanes.launch(gather_particles, n, [m.grid.order, *src.arrays()], dst.arrays()))
         if self.config.pressure_solver is PressureSolver.DFSPH:
             stages += self._dfsph_commands(dst)
@@ -434,15 +435,11 @@ class FluidSolver:
         b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_grad]
         stats, diag_f, diag_i = self._lane_stats, self._lane_diag_f, self._lane_diag_i
 
-        def both(*stages: Stage) -> Stage:
-            """Independent stages run between the same two barriers."""
-            return Stage(tuple(sum(parts, ()) for parts in zip(*(s.parts for s in stages))))
-
         def solve(mode: int, v: wp.array, kappa: wp.array, b_kappa: wp.array) -> Loop:
             check = self._rec(dfsph.check_convergence, 1, [prm, mode, self._row], [self._solve_stats, self._keep_going, diag_f[0], diag_i[0]])
             return Loop(self._keep_going, (
                 launch(dfsph.apply_stiffness, n, [prm, m.b_volume, st.rho, self._increment, st.active, self._dt, *pairs, self._b_rho, self._b_increment], [v, kappa]),
-                both(
+                together(
                     launch(dfsph.compute_solve_error, n, [prm, m.b_volume, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [self._increment, stats]),
                     launch(dfsph.compute_wall_solve_error, nb, [prm, mode, v, self._dt, self._bv, self._b_rho, self._b_alpha, *b_pairs], [b_kappa, self._b_increment, stats]),
                 ),
@@ -458,7 +455,7 @@ class FluidSolver:
                 ],
                 [st.rho, self._alpha, self._increment, *pairs, stats, self._keep_going, diag_f, diag_i],
             ),
-            both(
+            together(
                 launch(
                     dfsph.compute_wall_density_factor, nb,
                     [prm, m.grid.spec, m.b_volume, m.b_wetted, self._b_pair_index.shape[1], st.x, *grid, *walls, self._row],
@@ -467,7 +464,7 @@ class FluidSolver:
                 launch(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE)], [self._b_kappa_divergence, self._b_increment]),
             ),
             solve(dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence, self._b_kappa_divergence),
-            both(
+            together(
                 launch(
                     dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.free, st.kappa_density],
                     [self._v_star, self._increment, stats, self._keep_going, diag_f],
@@ -493,17 +490,12 @@ class FluidSolver:
         while operations on the CPU; one lane on CUDA), or None, with the reason in :attr:`graph_capture_error`,
         where warp or the driver cannot capture them."""
         try:
-            by_parity = [self.lanes.capture(program) if self.lanes.count > 1 else (self._capture_serial(program),) for program in self._ops]
+            by_parity = [self.lanes.capture(program) for program in self._ops]
         except Exception as exc:  # warp raises RuntimeError and others (e.g. no conditional nodes before CUDA 12.4)
             self._capture_graphs = False
             self.graph_capture_error = f"{type(exc).__name__}: {exc}"
             return None
         return tuple(zip(*by_parity))
-
-    def _capture_serial(self, program: Program):
-        with wp.ScopedCapture(device=self.device) as capture:
-            run_serial(program)
-        return capture.graph
 
     def _run_substeps(self, count: int) -> None:
         """``count`` substeps: each lane replays its graphs (the lanes at once), or the operations run one by one
@@ -512,11 +504,7 @@ class FluidSolver:
             raise SimulationError("fluid: an earlier interval was interrupted inside its substeps; the liquid's state is undefined")
         if self._graphs is not None:
             parities = [(self._parity + k) % 2 for k in range(count)]
-            if self.lanes.count > 1:
-                self.lanes.replay([[graphs[p] for p in parities] for graphs in self._graphs])
-            else:
-                for p in parities:
-                    wp.capture_launch(self._graphs[0][p])
+            self.lanes.replay([[graphs[p] for p in parities] for graphs in self._graphs])
         else:
             for k in range(count):
                 run_serial(self._ops[(self._parity + k) % 2])
