@@ -137,6 +137,10 @@ STAT_COUNT = wp.constant(1)
 STAT_ITERATIONS = wp.constant(2)
 STAT_MAX_ERROR = wp.constant(3)
 N_STATS = 4
+# Each lane's row of solve_stats is padded to this many int64 (128 bytes: two cache lines, as the CPU's adjacent-line
+# prefetch fetches them): every particle adds to its lane's row atomically, and rows sharing a cache line would
+# pass it back and forth between the cores on every add.
+STATS_ROW_STRIDE = 16
 
 
 @wp.func
@@ -204,18 +208,21 @@ def compute_density_factor(
     rho: wp.array(dtype=float),
     alpha: wp.array(dtype=float),
     increment: wp.array(dtype=float),
+    increment_per_rho: wp.array(dtype=float),
     pair_count: wp.array(dtype=wp.int32),
     pair_index: wp.array2d(dtype=wp.int32),
     pair_grad: wp.array2d(dtype=wp.vec3),
+    pair_mass_grad: wp.array2d(dtype=wp.vec3),
     solve_stats: wp.array(dtype=wp.int64),
     keep_going: wp.array(dtype=wp.int32),
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
 ):
     """Summation density, DFSPH factor and the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall
-    code :func:`wall_pair`; ``pair_grad[i, k]``: grad_i W, 1/m^(dim+1), weighted by the pair's mass where used:
-    :func:`pair_mass`), which the later stages loop over instead of the cell grid; the divergence solve's warm start (increment = a fraction of the
-    last substep's stiffness, applied by the first iteration) and its counters. More than ``capacity`` neighbours
+    code :func:`wall_pair`; ``pair_grad[i, k]``: grad_i W, 1/m^(dim+1); ``pair_mass_grad[i, k]``: the same times the
+    pair's mass, m or rho0 V_b, as the solves use it), which the later stages loop over instead of the cell grid;
+    the divergence solve's warm start (increment = a fraction of the last substep's stiffness, applied by the first
+    iteration; ``increment_per_rho`` = increment / rho, as the neighbours read it) and its counters. More than ``capacity`` neighbours
     (impossible below ~2x compression) count as an overflow, an instability."""
     i = lane_item(wp.tid(), lane)
     if i == 0:
@@ -228,6 +235,7 @@ def compute_density_factor(
         rho[i] = prm.rest_density
         alpha[i] = 0.0
         increment[i] = 0.0
+        increment_per_rho[i] = 0.0
         return
     wp.atomic_add(solve_stats, STAT_COUNT, wp.int64(1))
     xi = x[i]
@@ -254,6 +262,7 @@ def compute_density_factor(
                     if count < capacity:
                         pair_index[i, count] = j
                         pair_grad[i, count] = gw
+                        pair_mass_grad[i, count] = gm
                     count += 1
                 for kk in range(b_cell_start[cell], b_cell_end[cell]):
                     b = b_order[kk]
@@ -264,10 +273,12 @@ def compute_density_factor(
                     mw = prm.rest_density * b_volume[b]
                     density += mw * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
                     gw = kernel_gradient(prm, r, r2)
-                    grad_sum += mw * gw
+                    gm = mw * gw
+                    grad_sum += gm
                     if count < capacity:
                         pair_index[i, count] = wall_pair(b)
                         pair_grad[i, count] = gw
+                        pair_mass_grad[i, count] = gm
                     count += 1
     if count > capacity:
         wp.atomic_add(diag_i, row[0], DIAG_PAIR_OVERFLOW, 1)
@@ -277,57 +288,46 @@ def compute_density_factor(
     rho[i] = density
     alpha[i] = density / denominator
     increment[i] = warm
+    increment_per_rho[i] = warm / density
     compression = wp.max(density - prm.rest_density, 0.0) / prm.rest_density
     wp.atomic_max(diag_f, row[0], DIAG_MAX_DENSITY_ERROR, compression)
     wp.atomic_max(diag_f, row[0], DIAG_MAX_COMPRESSION, compression)
 
 
-@wp.func
-def pair_mass(prm: SPHParams, b_volume: wp.array(dtype=float), j: int) -> float:
-    """Mass (kg, or kg/m in 2-D) of pair-list entry ``j``: the particle mass, or rho0 V_b of wall particle
-    :func:`pair_wall` of j."""
-    if j >= 0:
-        return prm.mass
-    return prm.rest_density * b_volume[pair_wall(j)]
-
-
 @wp.kernel
 def apply_stiffness(
     lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
-    # Model
-    prm: SPHParams,
-    b_volume: wp.array(dtype=float),
     # State in
-    rho: wp.array(dtype=float),
     increment: wp.array(dtype=float),
+    increment_per_rho: wp.array(dtype=float),
     active: wp.array(dtype=wp.int32),
     dt: wp.array(dtype=float),
     pair_count: wp.array(dtype=wp.int32),
     pair_index: wp.array2d(dtype=wp.int32),
-    pair_grad: wp.array2d(dtype=wp.vec3),
-    b_rho: wp.array(dtype=float),
-    b_increment: wp.array(dtype=float),
+    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    b_increment_per_rho: wp.array(dtype=float),
     # State in/out
     v: wp.array(dtype=wp.vec3),
     kappa: wp.array(dtype=float),
 ):
     """v_i -= dt [sum_j m (k_i/rho_i + k_j/rho_j) grad W_ij + sum_b rho0 V_b (k_i/rho_i + k_b/rho_b) grad W_ib]
-    (k_b: the wall layer's increment, zero for the deeper wall particles); kappa_i += k_i. The first iteration of a solve applies its warm start; once a solve has converged, the increments its last
-    iteration measured are not applied (the loop ends before this stage)."""
+    (k_b: the wall layer's increment, zero for the deeper wall particles; k / rho read from ``increment_per_rho``,
+    which the stage that set the increments wrote); kappa_i += k_i. The first iteration of a solve applies its warm
+    start; once a solve has converged, the increments its last iteration measured are not applied (the loop ends
+    before this stage)."""
     i = lane_item(wp.tid(), lane)
     if active[i] == 0:
         return
-    ki = increment[i] / rho[i]
+    ki = increment_per_rho[i]
     dv = wp.vec3(0.0)
     for k in range(pair_count[i]):
         j = pair_index[i, k]
         kj = float(0.0)
         if j >= 0:
-            kj = increment[j] / rho[j]
+            kj = increment_per_rho[j]
         else:
-            b = pair_wall(j)
-            kj = b_increment[b] / b_rho[b]
-        dv += (ki + kj) * (pair_mass(prm, b_volume, j) * pair_grad[i, k])
+            kj = b_increment_per_rho[pair_wall(j)]
+        dv += (ki + kj) * pair_mass_grad[i, k]
     v[i] = v[i] - dt[0] * dv
     kappa[i] = kappa[i] + increment[i]
 
@@ -337,7 +337,6 @@ def compute_solve_error(
     lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
-    b_volume: wp.array(dtype=float),
     mode: int,
     # State in
     v: wp.array(dtype=wp.vec3),
@@ -348,9 +347,10 @@ def compute_solve_error(
     bv: wp.array(dtype=wp.vec3),
     pair_count: wp.array(dtype=wp.int32),
     pair_index: wp.array2d(dtype=wp.int32),
-    pair_grad: wp.array2d(dtype=wp.vec3),
+    pair_mass_grad: wp.array2d(dtype=wp.vec3),
     # Out
     increment: wp.array(dtype=float),
+    increment_per_rho: wp.array(dtype=float),
     solve_stats: wp.array(dtype=wp.int64),
 ):
     """Each particle's remaining error e_i (``mode`` SOLVE_DIVERGENCE: dt Drho/Dt; SOLVE_DENSITY: rho_i - rho0 +
@@ -360,6 +360,7 @@ def compute_solve_error(
     i = lane_item(wp.tid(), lane)
     if active[i] == 0:
         increment[i] = 0.0
+        increment_per_rho[i] = 0.0
         return
     h = dt[0]
     vi = v[i]
@@ -371,12 +372,14 @@ def compute_solve_error(
             vj = v[j]
         else:
             vj = bv[pair_wall(j)]
-        rate += wp.dot(vi - vj, pair_mass(prm, b_volume, j) * pair_grad[i, k])
+        rate += wp.dot(vi - vj, pair_mass_grad[i, k])
     e = h * rate
     if mode == SOLVE_DENSITY:
         e += rho[i] - prm.rest_density
     e = wp.max(e, 0.0)
-    increment[i] = prm.jacobi_relaxation * e * alpha[i] / (h * h)
+    k_i = prm.jacobi_relaxation * e * alpha[i] / (h * h)
+    increment[i] = k_i
+    increment_per_rho[i] = k_i / rho[i]
     rel = wp.min(e / prm.rest_density, MAX_PARTICLE_ERROR)
     wp.atomic_add(solve_stats, STAT_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
     wp.atomic_max(solve_stats, STAT_MAX_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
@@ -448,7 +451,7 @@ def compute_wall_density_factor(
     b_alpha: wp.array(dtype=float),
     b_pair_count: wp.array(dtype=wp.int32),
     b_pair_index: wp.array2d(dtype=wp.int32),
-    b_pair_grad: wp.array2d(dtype=wp.vec3),
+    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
     solve_stats: wp.array(dtype=wp.int64),
     diag_i: wp.array2d(dtype=wp.int32),
 ):
@@ -456,7 +459,7 @@ def compute_wall_density_factor(
     liquid particle that does not move. Its summation density rho_b = (rho0 V_b W(0) + sum_j m W_bj + sum_b'
     rho0 V_b' W_bb') / s, its factor alpha_b = rho_b / sum_j m rho0 V_b |grad W_bj|^2 (the density change its
     stiffness causes by pushing its liquid neighbours away; bounded below as the liquid's) and its list of liquid
-    neighbours with grad_b W. Other wall particles carry no stiffness (rho_b = rho0, no pairs)."""
+    neighbours with m grad_b W. Other wall particles carry no stiffness (rho_b = rho0, no pairs)."""
     b = lane_item(wp.tid(), lane)
     b_pair_count[b] = 0
     b_rho[b] = prm.rest_density
@@ -484,7 +487,7 @@ def compute_wall_density_factor(
                     grad_sq += prm.mass * mb * wp.dot(gw, gw)
                     if count < capacity:
                         b_pair_index[b, count] = j
-                        b_pair_grad[b, count] = gw
+                        b_pair_mass_grad[b, count] = prm.mass * gw
                     count += 1
                 density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xb, density)
     if count == 0:
@@ -502,14 +505,20 @@ def compute_wall_density_factor(
 def start_wall_solve(
     lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     warm_start: float,
+    # State in
+    b_rho: wp.array(dtype=float),
     # State in/out
     b_kappa: wp.array(dtype=float),
     # Out
     b_increment: wp.array(dtype=float),
+    b_increment_per_rho: wp.array(dtype=float),
 ):
-    """A solve's warm start for the wall layer: a fraction of the stiffness it applied in the last substep."""
+    """A solve's warm start for the wall layer: a fraction of the stiffness it applied in the last substep (and
+    that over the wall particle's density, as the liquid reads it)."""
     b = lane_item(wp.tid(), lane)
-    b_increment[b] = warm_start * b_kappa[b]
+    warm = warm_start * b_kappa[b]
+    b_increment[b] = warm
+    b_increment_per_rho[b] = warm / b_rho[b]
     b_kappa[b] = 0.0
 
 
@@ -527,10 +536,11 @@ def compute_wall_solve_error(
     b_alpha: wp.array(dtype=float),
     b_pair_count: wp.array(dtype=wp.int32),
     b_pair_index: wp.array2d(dtype=wp.int32),
-    b_pair_grad: wp.array2d(dtype=wp.vec3),
+    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
     # State in/out
     b_kappa: wp.array(dtype=float),
     b_increment: wp.array(dtype=float),
+    b_increment_per_rho: wp.array(dtype=float),
     solve_stats: wp.array(dtype=wp.int64),
 ):
     """The wall layer's side of one iteration: adds the increment the liquid just received from it to its
@@ -541,17 +551,20 @@ def compute_wall_solve_error(
     n = b_pair_count[b]
     if n == 0:
         b_increment[b] = 0.0
+        b_increment_per_rho[b] = 0.0
         return
     h = dt[0]
     vb = bv[b]
     rate = float(0.0)
     for k in range(n):
-        rate += wp.dot(vb - v[b_pair_index[b, k]], prm.mass * b_pair_grad[b, k])
+        rate += wp.dot(vb - v[b_pair_index[b, k]], b_pair_mass_grad[b, k])
     e = h * rate
     if mode == SOLVE_DENSITY:
         e += b_rho[b] - prm.rest_density
     e = wp.max(e, 0.0)
-    b_increment[b] = WALL_RELAXATION * prm.jacobi_relaxation * e * b_alpha[b] / (h * h)
+    k_b = WALL_RELAXATION * prm.jacobi_relaxation * e * b_alpha[b] / (h * h)
+    b_increment[b] = k_b
+    b_increment_per_rho[b] = k_b / b_rho[b]
     rel = wp.min(e / prm.rest_density, MAX_PARTICLE_ERROR)
     wp.atomic_add(solve_stats, STAT_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
     wp.atomic_max(solve_stats, STAT_MAX_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
@@ -589,12 +602,13 @@ def compute_nonpressure(
     # Out
     v_star: wp.array(dtype=wp.vec3),
     increment: wp.array(dtype=float),
+    increment_per_rho: wp.array(dtype=float),
     solve_stats: wp.array(dtype=wp.int64),
     keep_going: wp.array(dtype=wp.int32),
     diag_f: wp.array2d(dtype=float),
 ):
     """v* = v + dt (g + viscosity) over the substep's pair list (walls: their own velocity, rest density;
-    :func:`wall_pair_viscosity`); the density solve's warm start and counters."""
+    :func:`wall_pair_viscosity`); the density solve's warm start (and it over rho) and counters."""
     i = lane_item(wp.tid(), lane)
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)
@@ -604,6 +618,7 @@ def compute_nonpressure(
     if active[i] == 0:
         v_star[i] = v[i]
         increment[i] = 0.0
+        increment_per_rho[i] = 0.0
         return
     xi = x[i]
     vi = v[i]
@@ -624,6 +639,7 @@ def compute_nonpressure(
     a += prm.gravity
     v_star[i] = vi + dt[0] * a
     increment[i] = warm
+    increment_per_rho[i] = warm / rhoi
     wp.atomic_max(diag_f, row[0], DIAG_MAX_ACCEL, wp.length(a))
 
 

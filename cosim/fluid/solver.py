@@ -169,12 +169,14 @@ class FluidSolver:
         self._v_star = wp.zeros(n, dtype=wp.vec3, device=d)
         self._alpha = wp.zeros(n, dtype=float, device=d)
         self._increment = wp.zeros(n, dtype=float, device=d)
-        self._solve_stats = wp.zeros((self.lanes.count, dfsph.N_STATS), dtype=wp.int64, device=d)
+        self._increment_per_rho = wp.zeros(n, dtype=float, device=d)
+        self._solve_stats = wp.zeros((self.lanes.count, dfsph.STATS_ROW_STRIDE), dtype=wp.int64, device=d)
         self._lane_stats = PerLane(self._solve_stats[k] for k in range(self.lanes.count))
         capacity = pair_capacity(self.config.dim, self.config.smoothing_ratio)
         self._pair_count = wp.zeros(n, dtype=wp.int32, device=d)
         self._pair_index = wp.zeros((n, capacity), dtype=wp.int32, device=d)
         self._pair_grad = wp.zeros((n, capacity), dtype=wp.vec3, device=d)
+        self._pair_mass_grad = wp.zeros((n, capacity), dtype=wp.vec3, device=d) if self.config.pressure_solver is PressureSolver.DFSPH else None
         self._keep_going = wp.zeros(1, dtype=wp.int32, device=d)
         self._wall_force = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
         self._wall_torque = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
@@ -191,11 +193,12 @@ class FluidSolver:
         if self.config.pressure_solver is PressureSolver.DFSPH:
             self._b_alpha = wp.zeros(nb, dtype=float, device=d)
             self._b_increment = wp.zeros(nb, dtype=float, device=d)
+            self._b_increment_per_rho = wp.zeros(nb, dtype=float, device=d)
             self._b_kappa_density = wp.zeros(nb, dtype=float, device=d)
             self._b_kappa_divergence = wp.zeros(nb, dtype=float, device=d)
             self._b_pair_count = wp.zeros(nb, dtype=wp.int32, device=d)
             self._b_pair_index = wp.zeros((nb, capacity), dtype=wp.int32, device=d)
-            self._b_pair_grad = wp.zeros((nb, capacity), dtype=wp.vec3, device=d)
+            self._b_pair_mass_grad = wp.zeros((nb, capacity), dtype=wp.vec3, device=d)
         self._b_active = wp.ones(nb, dtype=wp.int32, device=d)
         self._motions = wp.zeros(m.n_vessels, dtype=bd.VesselMotion, device=d)
         # the motions are written on the host through a structured numpy view (the CPU device's array itself, else a
@@ -432,16 +435,21 @@ class FluidSolver:
         grid = [m.grid.cell_start, m.grid.cell_end]
         walls = [self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end]
         pairs = [self._pair_count, self._pair_index, self._pair_grad]
-        b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_grad]
+        solve_pairs = [self._pair_count, self._pair_index, self._pair_mass_grad]
+        b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_mass_grad]
+        increments = [self._increment, self._increment_per_rho]
         stats, diag_f, diag_i = self._lane_stats, self._lane_diag_f, self._lane_diag_i
 
         def solve(mode: int, v: wp.array, kappa: wp.array, b_kappa: wp.array) -> Loop:
             check = self._rec(dfsph.check_convergence, 1, [prm, mode, self._row], [self._solve_stats, self._keep_going, diag_f[0], diag_i[0]])
             return Loop(self._keep_going, (
-                launch(dfsph.apply_stiffness, n, [prm, m.b_volume, st.rho, self._increment, st.active, self._dt, *pairs, self._b_rho, self._b_increment], [v, kappa]),
+                launch(dfsph.apply_stiffness, n, [*increments, st.active, self._dt, *solve_pairs, self._b_increment_per_rho], [v, kappa]),
                 together(
-                    launch(dfsph.compute_solve_error, n, [prm, m.b_volume, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [self._increment, stats]),
-                    launch(dfsph.compute_wall_solve_error, nb, [prm, mode, v, self._dt, self._bv, self._b_rho, self._b_alpha, *b_pairs], [b_kappa, self._b_increment, stats]),
+                    launch(dfsph.compute_solve_error, n, [prm, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *solve_pairs], [*increments, stats]),
+                    launch(
+                        dfsph.compute_wall_solve_error, nb, [prm, mode, v, self._dt, self._bv, self._b_rho, self._b_alpha, *b_pairs],
+                        [b_kappa, self._b_increment, self._b_increment_per_rho, stats],
+                    ),
                 ),
                 self.lanes.on_lane(0, check),
             ))
@@ -453,7 +461,7 @@ class FluidSolver:
                     prm, m.grid.spec, m.vessels, m.b_volume, self._pair_index.shape[1], int(self.config.free_liquid), self._motions, st.x, st.active,
                     *grid, *walls, self._row, st.kappa_divergence, st.free, st.rest_offset,
                 ],
-                [st.rho, self._alpha, self._increment, *pairs, stats, self._keep_going, diag_f, diag_i],
+                [st.rho, self._alpha, *increments, *pairs, self._pair_mass_grad, stats, self._keep_going, diag_f, diag_i],
             ),
             together(
                 launch(
@@ -461,15 +469,15 @@ class FluidSolver:
                     [prm, m.grid.spec, m.b_volume, m.b_wetted, self._b_pair_index.shape[1], st.x, *grid, *walls, self._row],
                     [self._b_rho, self._b_alpha, *b_pairs, stats, diag_i],
                 ),
-                launch(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE)], [self._b_kappa_divergence, self._b_increment]),
+                launch(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE), self._b_rho], [self._b_kappa_divergence, self._b_increment, self._b_increment_per_rho]),
             ),
             solve(dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence, self._b_kappa_divergence),
             together(
                 launch(
                     dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.free, st.kappa_density],
-                    [self._v_star, self._increment, stats, self._keep_going, diag_f],
+                    [self._v_star, *increments, stats, self._keep_going, diag_f],
                 ),
-                launch(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY)], [self._b_kappa_density, self._b_increment]),
+                launch(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY), self._b_rho], [self._b_kappa_density, self._b_increment, self._b_increment_per_rho]),
             ),
             solve(dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density, self._b_kappa_density),
             launch(
