@@ -94,8 +94,8 @@ class FluidConfig:
         below this (the paper's 0.1 % per step). (0, 0.05]
     max_solver_iterations: DFSPH: iteration cap of each of the two solves (a solve that hits it is not an error;
         the remaining error shows in the diagnostics). [2, 1000]
-    cpu_threads: threads a CPU substep is split over (``cosim.fluid.lanes``; each takes a contiguous share of the
-        particles, and the results are the same to the bit for any number); 0: one per core this process may run
+    cpu_threads: threads a CPU substep is split over (``cosim.fluid.lanes``; each takes every n-th chunk of 16 particles
+        in cell order, and the results are the same to the bit for any number); 0: one per core this process may run
         on, at most one per 200 particles. Ignored on CUDA. [0, 256]
     depth_2d: m, liquid thickness perpendicular to the pour plane in 2-D (the pouring vessel's depth): masses,
         volumes and wrenches reported to the outside are per unit depth times this. (0, 2]
