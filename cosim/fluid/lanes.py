@@ -161,7 +161,8 @@ def run_serial(program: Program) -> None:
 
 class _LaneThread:
     """A thread that runs one job at a time when asked: two locks hand each job over and back, cheaper than a thread
-    pool's futures (measured: the pool's submit and wait were 8 % of the default pour's host time)."""
+    pool's futures (measured: the pool's submit and wait were 8 % of the default pour's host time under py-spy, and
+    the substep loop runs 0.966 x the time without them, two pours side by side in one process)."""
 
     _STOP = object()
 
