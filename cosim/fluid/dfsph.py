@@ -222,8 +222,8 @@ def compute_density_factor(
     code :func:`wall_pair`; ``pair_grad[i, k]``: grad_i W, 1/m^(dim+1); ``pair_mass_grad[i, k]``: the same times the
     pair's mass, m or rho0 V_b, as the solves use it), which the later stages loop over instead of the cell grid;
     the divergence solve's warm start (increment = a fraction of the last substep's stiffness, applied by the first
-    iteration; ``increment_per_rho`` = increment / rho, as the neighbours read it) and its counters. More than ``capacity`` neighbours
-    (impossible below ~2x compression) count as an overflow, an instability."""
+    iteration; ``increment_per_rho`` = increment / rho, as the neighbours read it) and its counters. More than
+    ``capacity`` neighbours (impossible below ~2x compression) count as an overflow, an instability."""
     i = lane_item(wp.tid(), lane)
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)

@@ -176,7 +176,8 @@ class FluidSolver:
         self._pair_count = wp.zeros(n, dtype=wp.int32, device=d)
         self._pair_index = wp.zeros((n, capacity), dtype=wp.int32, device=d)
         self._pair_grad = wp.zeros((n, capacity), dtype=wp.vec3, device=d)
-        self._pair_mass_grad = wp.zeros((n, capacity), dtype=wp.vec3, device=d) if self.config.pressure_solver is PressureSolver.DFSPH else None
+        dfsph_only = self.config.pressure_solver is PressureSolver.DFSPH
+        self._pair_mass_grad = wp.zeros((n, capacity), dtype=wp.vec3, device=d) if dfsph_only else None
         self._keep_going = wp.zeros(1, dtype=wp.int32, device=d)
         self._wall_force = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
         self._wall_torque = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
@@ -445,7 +446,10 @@ class FluidSolver:
             return Loop(self._keep_going, (
                 launch(dfsph.apply_stiffness, n, [*increments, st.active, self._dt, *solve_pairs, self._b_increment_per_rho], [v, kappa]),
                 together(
-                    launch(dfsph.compute_solve_error, n, [prm, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *solve_pairs], [*increments, stats]),
+                    launch(
+                        dfsph.compute_solve_error, n, [prm, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *solve_pairs],
+                        [*increments, stats],
+                    ),
                     launch(
                         dfsph.compute_wall_solve_error, nb, [prm, mode, v, self._dt, self._bv, self._b_rho, self._b_alpha, *b_pairs],
                         [b_kappa, self._b_increment, self._b_increment_per_rho, stats],
@@ -469,7 +473,10 @@ class FluidSolver:
                     [prm, m.grid.spec, m.b_volume, m.b_wetted, self._b_pair_index.shape[1], st.x, *grid, *walls, self._row],
                     [self._b_rho, self._b_alpha, *b_pairs, stats, diag_i],
                 ),
-                launch(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE), self._b_rho], [self._b_kappa_divergence, self._b_increment, self._b_increment_per_rho]),
+                launch(
+                    dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE), self._b_rho],
+                    [self._b_kappa_divergence, self._b_increment, self._b_increment_per_rho],
+                ),
             ),
             solve(dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence, self._b_kappa_divergence),
             together(
@@ -477,7 +484,10 @@ class FluidSolver:
                     dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.free, st.kappa_density],
                     [self._v_star, *increments, stats, self._keep_going, diag_f],
                 ),
-                launch(dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY), self._b_rho], [self._b_kappa_density, self._b_increment, self._b_increment_per_rho]),
+                launch(
+                    dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY), self._b_rho],
+                    [self._b_kappa_density, self._b_increment, self._b_increment_per_rho],
+                ),
             ),
             solve(dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density, self._b_kappa_density),
             launch(
