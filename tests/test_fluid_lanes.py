@@ -139,3 +139,40 @@ def test_a_failing_lane_raises_instead_of_leaving_the_others_waiting():
     done = subprocess.run([sys.executable, "-c", ABORT_SCRIPT], cwd=root, capture_output=True, text=True, timeout=240)
     assert done.returncode == 0, done.stderr[-2000:]
     assert "refused: fluid: an earlier interval was interrupted" in done.stdout
+
+
+INTERRUPTED_WAIT_SCRIPT = """
+from cosim.errors import SimulationError
+from cosim.fluid import lanes
+from cosim.fluid.config import PressureSolver
+from tests.support.shaken_tank import tank
+fluid = tank(PressureSolver.DFSPH, 16, threads=2)
+fluid.advance(0.01)
+fluid.advance(0.01)  # captured and replayed by both lanes
+assert fluid._graphs is not None
+real = lanes._LaneThread.join
+def interrupted(self):
+    raise KeyboardInterrupt  # Ctrl-C while lane 0 waits for the others, which may still be running
+lanes._LaneThread.join = interrupted
+try:
+    fluid.advance(0.01)
+except KeyboardInterrupt:
+    pass
+else:
+    raise AssertionError("the interrupt was not raised")
+lanes._LaneThread.join = real
+assert fluid.lanes.aborted
+try:
+    fluid.advance(0.01)
+except SimulationError as exc:
+    print("refused:", exc)
+"""
+
+
+def test_an_interrupted_wait_for_the_lanes_refuses_further_intervals():
+    """Ctrl-C while lane 0 waits for the other lanes: a lane may still be replaying, so the solver must refuse the next
+    interval (starting one would hand that lane a second job and confuse their completions) instead of racing it."""
+    root = Path(__file__).resolve().parents[1]
+    done = subprocess.run([sys.executable, "-c", INTERRUPTED_WAIT_SCRIPT], cwd=root, capture_output=True, text=True, timeout=240)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "refused: fluid: an earlier interval was interrupted" in done.stdout

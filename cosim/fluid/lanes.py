@@ -278,7 +278,8 @@ class Lanes:
         """Lane L replays the graphs ``schedules[L]`` in order, all lanes at once (lane 0 on the calling thread);
         returns when every lane has finished. Should a lane fail or the caller be interrupted (Ctrl-C), the barriers
         are opened for good so that no lane waits forever for it, every lane is waited for, and the first error is
-        raised (:attr:`aborted` stays true)."""
+        raised; :attr:`aborted` then stays true, also when the wait itself is interrupted (a lane may still be
+        running, so no replay may follow)."""
         if self.count == 1:
             self._replay_lane(schedules[0])
             return
@@ -295,7 +296,11 @@ class Lanes:
             self._abort()
             raise
         finally:
-            errors = [thread.join() for thread in started]  # waits; the first error is raised below or above
+            try:
+                errors = [thread.join() for thread in started]  # waits; the first error is raised below or above
+            except BaseException:  # interrupted while waiting: a lane may still run, so no replay may follow
+                self._abort()
+                raise
         for error in errors:
             if error is not None:
                 raise error
