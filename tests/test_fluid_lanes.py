@@ -102,15 +102,39 @@ def test_cpu_threads_out_of_range_is_refused():
         replace(FluidConfig(), cpu_threads=1.5)
 
 
-ABORT_SCRIPT = """
+# Child processes (run under a time limit, so that a hang fails the test instead of stalling the suite): a 2-lane
+# tank whose substeps have been captured and replayed, then SCRIPT's interruption of a replay, then the check that
+# the lanes are marked aborted and the next interval is refused.
+CHILD_SETUP = """
 import threading, warp as wp
 from cosim.errors import SimulationError
+from cosim.fluid import lanes
 from cosim.fluid.config import PressureSolver
 from tests.support.shaken_tank import tank
 fluid = tank(PressureSolver.DFSPH, 16, threads=2)
 fluid.advance(0.01)
 fluid.advance(0.01)  # captured and replayed by both lanes
 assert fluid._graphs is not None
+"""
+CHILD_CHECK = """
+assert fluid.lanes.aborted
+try:
+    fluid.advance(0.01)
+except SimulationError as exc:
+    print("refused:", exc)
+"""
+
+
+def _assert_interruption_is_contained(script: str) -> None:
+    root = Path(__file__).resolve().parents[1]
+    done = subprocess.run([sys.executable, "-c", CHILD_SETUP + script + CHILD_CHECK], cwd=root, capture_output=True, text=True, timeout=240)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "refused: fluid: an earlier interval was interrupted" in done.stdout
+
+
+def test_a_failing_lane_raises_instead_of_leaving_the_others_waiting():
+    """Lane 1 fails before its first substep: lane 0 would wait at the first barrier forever without the abort."""
+    _assert_interruption_is_contained("""
 real = wp.capture_launch
 def failing(graph):
     if threading.current_thread() is not threading.main_thread():
@@ -124,32 +148,13 @@ except RuntimeError as exc:
 else:
     raise AssertionError("the failing lane's error was not raised")
 wp.capture_launch = real
-assert fluid.lanes.aborted
-try:
-    fluid.advance(0.01)
-except SimulationError as exc:
-    print("refused:", exc)
-"""
+""")
 
 
-def test_a_failing_lane_raises_instead_of_leaving_the_others_waiting():
-    """Lane 1 fails before its first substep: lane 0 would wait at the first barrier forever without the abort. Run in
-    a child process under a time limit, so that a hang fails the test instead of stalling the suite."""
-    root = Path(__file__).resolve().parents[1]
-    done = subprocess.run([sys.executable, "-c", ABORT_SCRIPT], cwd=root, capture_output=True, text=True, timeout=240)
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert "refused: fluid: an earlier interval was interrupted" in done.stdout
-
-
-INTERRUPTED_WAIT_SCRIPT = """
-from cosim.errors import SimulationError
-from cosim.fluid import lanes
-from cosim.fluid.config import PressureSolver
-from tests.support.shaken_tank import tank
-fluid = tank(PressureSolver.DFSPH, 16, threads=2)
-fluid.advance(0.01)
-fluid.advance(0.01)  # captured and replayed by both lanes
-assert fluid._graphs is not None
+def test_an_interrupted_wait_for_the_lanes_refuses_further_intervals():
+    """Ctrl-C while lane 0 waits for the other lanes: a lane may still be replaying, so the solver must refuse the next
+    interval (starting one would hand that lane a second job and confuse their completions) instead of racing it."""
+    _assert_interruption_is_contained("""
 real = lanes._LaneThread.join
 def interrupted(self):
     raise KeyboardInterrupt  # Ctrl-C while lane 0 waits for the others, which may still be running
@@ -161,18 +166,4 @@ except KeyboardInterrupt:
 else:
     raise AssertionError("the interrupt was not raised")
 lanes._LaneThread.join = real
-assert fluid.lanes.aborted
-try:
-    fluid.advance(0.01)
-except SimulationError as exc:
-    print("refused:", exc)
-"""
-
-
-def test_an_interrupted_wait_for_the_lanes_refuses_further_intervals():
-    """Ctrl-C while lane 0 waits for the other lanes: a lane may still be replaying, so the solver must refuse the next
-    interval (starting one would hand that lane a second job and confuse their completions) instead of racing it."""
-    root = Path(__file__).resolve().parents[1]
-    done = subprocess.run([sys.executable, "-c", INTERRUPTED_WAIT_SCRIPT], cwd=root, capture_output=True, text=True, timeout=240)
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert "refused: fluid: an earlier interval was interrupted" in done.stdout
+""")
