@@ -42,8 +42,12 @@ SPINS_BEFORE_YIELD = 4000
 LANE_CHUNK = wp.constant(16)
 
 
+# The barrier's native code is for the CPU only: CUDA runs one lane and never launches it. NVRTC, which compiles the
+# module whenever warp loads it for a GPU (wp.force_load, ahead-of-time builds), has no GCC atomics, so there it
+# compiles to nothing (tests/test_cuda_compile.py).
 @wp.func_native(
     """
+#if !defined(__CUDA_ARCH__)
 if (__atomic_load_n(&state.data[2], __ATOMIC_ACQUIRE) != 0) {
     return;
 }
@@ -65,6 +69,7 @@ for (long spins = 0; __atomic_load_n(&state.data[1], __ATOMIC_ACQUIRE) == genera
         ((void (*)())yield_fn)();
     }
 }
+#endif
 """
 )
 def barrier_wait(state: wp.array(dtype=wp.int32), parties: int, spins_before_yield: int, yield_fn: wp.uint64): ...
