@@ -13,6 +13,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from cosim.checks import check_device, check_int, check_positive
+from cosim.fluid.config import MAX_CPU_THREADS
 from cosim.pour_run import run_pour
 from cosim.pour_scene import PourScene, load_scene
 
@@ -36,7 +37,7 @@ def scene_from_args(args) -> PourScene:
     if args.device is not None:
         scene = replace(scene, device=check_device("--device", args.device))
     if args.threads is not None:
-        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=check_int("--threads", args.threads, 0, 256)))
+        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=check_int("--threads", args.threads, 0, MAX_CPU_THREADS)))
     if args.dim is not None:
         scene = replace(scene, fluid=replace(scene.fluid, dim=args.dim))
     if args.duration is not None:

@@ -16,6 +16,7 @@ from cosim.checks import check_choice, check_int, check_positive, check_range, c
 from cosim.errors import InputError
 
 GRAVITY = 9.81  # m/s^2, standard gravity magnitude used across the project
+MAX_CPU_THREADS = 256  # most threads a CPU substep may be split over (FluidConfig.cpu_threads, cosim pour --threads)
 
 
 class KernelType(Enum):
@@ -173,7 +174,7 @@ class FluidConfig:
         s(self, "density_tolerance", check_range("fluid.density_tolerance", self.density_tolerance, 0.0, 0.05, lo_open=True))
         s(self, "divergence_tolerance", check_range("fluid.divergence_tolerance", self.divergence_tolerance, 0.0, 0.05, lo_open=True))
         s(self, "max_solver_iterations", check_int("fluid.max_solver_iterations", self.max_solver_iterations, 2, 1000))
-        s(self, "cpu_threads", check_int("fluid.cpu_threads", self.cpu_threads, 0, 256))
+        s(self, "cpu_threads", check_int("fluid.cpu_threads", self.cpu_threads, 0, MAX_CPU_THREADS))
         s(self, "depth_2d", check_positive("fluid.depth_2d", self.depth_2d, "m", 2.0))
         s(self, "boundary_spacing_ratio", check_range("fluid.boundary_spacing_ratio", self.boundary_spacing_ratio, 0.3, 1.0))
         lo = check_vector("fluid.domain_min", self.domain_min, 3)
