@@ -19,7 +19,7 @@ from cosim.config_mapping import from_mapping, to_toml
 from cosim.coupling.pose_filter import PoseFilterLimits
 from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig, GridReset, KernelType, PressureSolver
+from cosim.fluid.config import DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
 from cosim.io.recording_config import RecordingConfig
 from cosim.trajectory.limits import JointLimitOverride
 
@@ -61,8 +61,11 @@ class FluidSettings:
     density_diffusion: delta-SPH delta. [0, 1]
     kinematic_viscosity: m^2/s (water 1e-6). [0, 0.01]
     max_density_error: compression that counts as an instability (impacts reach about v / c0). (0, 1]
-    density_tolerance: DFSPH: the density solve stops when the average compression is below this fraction of rho0
-      (``cosim.fluid.config.FluidConfig``; the pour's time against its errors at three other tolerances is in
+    density_iteration: DFSPH: 'gauss_seidel' (the default; fewer iterations at equal error, the same results on any
+      number of threads and any device) or 'jacobi' (every particle at once: the choice for large scenes on a GPU).
+    density_tolerance: DFSPH: the density solve stops when the average compression is below this fraction of rho0;
+      not set: the iteration's own default, 1.5e-4 for 'gauss_seidel', 5e-5 for 'jacobi'
+      (``cosim.fluid.config.FluidConfig``; the pour's time against its errors at other tolerances is in
       docs/benchmarks.md). (0, 0.05]
     cpu_threads: threads the CPU solver splits each substep over; 0: one per available core (at most one per 200
       particles). The results are the same for any number. [0, 256]
@@ -84,7 +87,8 @@ class FluidSettings:
     density_diffusion: float = 0.1
     kinematic_viscosity: float = 1.0e-6
     max_density_error: float = 0.3
-    density_tolerance: float = FluidConfig.density_tolerance  # the solver's own default, not a copy of it
+    density_iteration: DensityIteration = FluidConfig.density_iteration
+    density_tolerance: float | None = None  # the iteration's own default (FluidConfig)
     cpu_threads: int = FluidConfig.cpu_threads
 
     def __post_init__(self) -> None:
@@ -114,6 +118,7 @@ class FluidSettings:
             density_diffusion=self.density_diffusion,
             kinematic_viscosity=self.kinematic_viscosity,
             max_density_error=self.max_density_error,
+            density_iteration=self.density_iteration,
             density_tolerance=self.density_tolerance,
             cpu_threads=self.cpu_threads,
         )

@@ -33,6 +33,8 @@ def test_pour_rows_split_the_wall_time_into_substeps_and_the_rest():
     assert 0.0 < row["substeps_ms_per_step"] and 0.0 < row["host_ms_per_step"]
     assert abs((row["substeps_ms_per_step"] + row["host_ms_per_step"]) * steps - 1e3 * row["wall_s"]) < 1e-6
     table = "\n".join(device_check._pour_table([row]))
-    assert f"| 2-D, 12 across, {FluidSettings().pressure_solver.value} |" in table and "the rest (host) ms per step" in table
+    default = FluidSettings()
+    label = f"{default.pressure_solver.value} ({default.density_iteration.value})"  # the default scene's solver is DFSPH
+    assert f"| 2-D, 12 across, {label} |" in table and "the rest (host) ms per step" in table
     needed = row["particles"] * row["sph_substeps"] / row["simulated_s"] / 1e9  # G particle-substeps per second
     assert f"| {needed:.3f} |" in table

@@ -7,14 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from cosim.fluid.config import PressureSolver
 from cosim.fluid.solver import FluidSolver
-from tests.support.shaken_tank import shake, tank
+from tests.support.shaken_tank import SOLVER_VARIANTS, shake, tank
 
 
-@pytest.mark.parametrize("solver", [PressureSolver.WCSPH, PressureSolver.DFSPH])
-def test_replayed_substeps_match_the_launches_one_by_one(solver):
-    replayed, launched = tank(solver, 12, graphs=True), tank(solver, 12, graphs=False)
+@pytest.mark.parametrize(("solver", "iteration"), SOLVER_VARIANTS)
+def test_replayed_substeps_match_the_launches_one_by_one(solver, iteration):
+    replayed, launched = tank(solver, 12, graphs=True, iteration=iteration), tank(solver, 12, graphs=False, iteration=iteration)
     for fluid in (replayed, launched):
         shake(fluid, intervals=20, tilt=0.15)
     assert replayed.graph_capture_error is None and replayed._graphs is not None  # it did replay

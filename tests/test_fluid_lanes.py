@@ -19,7 +19,7 @@ from cosim.fluid.config import FluidConfig, PressureSolver
 from cosim.fluid.diagnostics import DIAG_KINETIC_ENERGY, DIAG_MAX_SPEED, N_DIAG_FLOAT, combine_lanes
 from cosim.fluid.lanes import LANE_CHUNK, MIN_PARTICLES_PER_LANE, available_cores, lane_count, lane_item, lane_sizes
 from cosim.fluid.solver import FluidSolver
-from tests.support.shaken_tank import shake, tank
+from tests.support.shaken_tank import SOLVER_VARIANTS, shake, tank
 
 # Relative rounding of a float32 energy summed in two parts instead of one (a few ulps of the total).
 ENERGY_SUM_RTOL = 1e-5
@@ -39,13 +39,13 @@ def _assert_same_run(fluid: FluidSolver, reference: FluidSolver) -> None:
             np.testing.assert_array_equal(fluid.history()[key], values, err_msg=key)
 
 
-@pytest.mark.parametrize("solver", [PressureSolver.WCSPH, PressureSolver.DFSPH])
-def test_lanes_give_the_single_thread_run_to_the_bit(solver):
-    one = tank(solver, ACROSS, threads=1)
+@pytest.mark.parametrize(("solver", "iteration"), SOLVER_VARIANTS)
+def test_lanes_give_the_single_thread_run_to_the_bit(solver, iteration):
+    one = tank(solver, ACROSS, threads=1, iteration=iteration)
     shake(one, **SHAKE)
     assert one.lanes.count == 1
     for threads, graphs in ((2, True), (3, True), (2, False)):
-        fluid = tank(solver, ACROSS, graphs, threads)
+        fluid = tank(solver, ACROSS, graphs, threads, iteration)
         shake(fluid, **SHAKE)
         assert fluid.lanes.count == threads
         assert (fluid._graphs is not None) == graphs and fluid.graph_capture_error is None  # it replayed the lanes' graphs

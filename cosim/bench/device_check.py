@@ -13,7 +13,9 @@ report, DIR/device_check.md, is printed at the end:
 3. throughput: ``cosim.fluid.benchmark`` on the device (issue 7's sizes: 2-D 10k, 3-D 100k and 1M particles,
    both solvers, warp's ``example_sph`` beside the 3-D rows), and the 2-D row again without graph replay.
 4. pour: the coupled pour (robots, controllers, trajectory generation, no recording) on the device: the default
-   2-D scene (its own solver, DFSPH), and the 3-D one at 64 across (~112k particles) under WCSPH and DFSPH, :data:`POUR_SECONDS` simulated
+   2-D scene (its own solver, DFSPH with Gauss-Seidel density sweeps), and the 3-D one at 64 across (~112k
+   particles) under WCSPH and DFSPH with the Jacobi density solve (the GPU's choice for large scenes: a Gauss-Seidel
+   colour runs a 27th of the occupied cells at once), :data:`POUR_SECONDS` simulated
    after a warm-up that compiles the kernels and captures the graphs; real-time factor, the wall time per 2 ms
    MuJoCo step split into the substeps and the rest (``cosim.bench.host_overhead``: the rest bounds the real-time
    factor), and the particle-substeps per second real time would take (particles x substeps per simulated
@@ -164,17 +166,19 @@ def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
 
 
 # ---- pour -------------------------------------------------------------------------------------------------
-def _pour(device: str, dim: int, across: int, seconds: float, solver: str | None = None) -> dict:
-    """The pour row: ``solver`` None runs the default scene's pressure solver."""
+def _pour(device: str, dim: int, across: int, seconds: float, solver: str | None = None, iteration: str | None = None) -> dict:
+    """The pour row: ``solver`` None runs the default scene's pressure solver, ``iteration`` None DFSPH's default
+    density iteration."""
     from cosim.bench.host_overhead import time_steps
     from cosim.coupling.settings import CouplingSettings
     from cosim.pour_run import prepare
     from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene
 
     solver = solver or FluidSettings().pressure_solver.value
+    iteration = iteration or FluidSettings().density_iteration.value
 
     scene = PourScene(
-        device=device, fluid=replace(FluidSettings(), dim=dim, particles_across=across, pressure_solver=solver),
+        device=device, fluid=replace(FluidSettings(), dim=dim, particles_across=across, pressure_solver=solver, density_iteration=iteration),
         coupling=CouplingSettings(max_duration=POUR_WARM_UP + seconds), logging=LoggingSettings(enabled=False),
     )
     pour = prepare(scene)
@@ -182,7 +186,7 @@ def _pour(device: str, dim: int, across: int, seconds: float, solver: str | None
     substeps0 = pour.fluid.step_count
     split = time_steps(pour, seconds)
     return {
-        "dim": dim, "across": across, "solver": solver, "particles": split.particles, "simulated_s": seconds, "wall_s": split.wall_s,
+        "dim": dim, "across": across, "solver": solver if solver == "wcsph" else f"{solver} ({iteration})", "particles": split.particles, "simulated_s": seconds, "wall_s": split.wall_s,
         "real_time_factor": seconds / split.wall_s, "sph_substeps": pour.fluid.step_count - substeps0,
         "substeps_ms_per_step": split.substep_ms_per_step, "host_ms_per_step": split.host_ms_per_step,
         "graphs": _capture_status(pour.fluid),
@@ -191,11 +195,11 @@ def _pour(device: str, dim: int, across: int, seconds: float, solver: str | None
 
 def check_pour(device: str, quick: bool) -> list[dict]:
     if quick:
-        return [_pour(device, 2, 32, 0.05), _pour(device, 3, 12, 0.05, "wcsph"), _pour(device, 3, 12, 0.05, "dfsph")]
+        return [_pour(device, 2, 32, 0.05), _pour(device, 3, 12, 0.05, "wcsph"), _pour(device, 3, 12, 0.05, "dfsph", "jacobi")]
     return [
         _pour(device, 2, 32, POUR_SECONDS[2]),
         _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "wcsph"),
-        _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "dfsph"),
+        _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "dfsph", "jacobi"),
     ]
 
 

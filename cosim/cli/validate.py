@@ -17,7 +17,7 @@ from pathlib import Path
 
 from cosim.atomic_files import atomic_path
 from cosim.errors import InputError
-from cosim.fluid.config import PressureSolver
+from cosim.fluid.config import DensityIteration, PressureSolver
 from cosim.pour_scene import FluidSettings
 from cosim.validation import CASES, DEFAULT_CASES, slosh
 from cosim.validation.common import CaseResult
@@ -39,6 +39,9 @@ def register(subparsers) -> None:
     default_solver = FluidSettings().pressure_solver.value
     p.add_argument("--solver", choices=[s.value for s in PressureSolver], default=default_solver,
                    help=f"pressure solver: wcsph (weakly compressible) or dfsph (divergence-free) (default: the default scene's, {default_solver})")
+    default_iteration = FluidSettings().density_iteration.value
+    p.add_argument("--density-iteration", choices=[d.value for d in DensityIteration], default=default_iteration,
+                   help=f"DFSPH's density solve: gauss_seidel or jacobi, each at its own default tolerance (default: {default_iteration})")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
@@ -46,7 +49,8 @@ def register(subparsers) -> None:
 
 
 def _case_params(name: str, args) -> list:
-    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing, "solver": args.solver}
+    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing, "solver": args.solver,
+              "numerics": (("density_iteration", args.density_iteration),)}
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
     if name in ("tilt", "shake", "free-fall", "coupling-static"):

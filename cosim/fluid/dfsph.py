@@ -19,12 +19,17 @@ A substep, after the neighbour search:
                            compressing density rate times dt is below ``divergence_tolerance`` rho0 and no
                            particle's above MAX_PARTICLE_RESIDUAL (or the iteration cap).
   compute_nonpressure      v* = v + dt (gravity + viscosity); starts the density solve (warm start).
-  density solve            the same iteration on the predicted density rho_i + dt Drho_i/Dt until its average
-                           compression is below ``density_tolerance`` rho0 (and no particle's above
-                           MAX_PARTICLE_RESIDUAL).
+  density solve            on the predicted density rho_i + dt Drho_i/Dt until its average compression is below
+                           ``density_tolerance`` rho0 (and no particle's above MAX_PARTICLE_RESIDUAL): by
+                           Gauss-Seidel sweeps (``density_iteration`` 'gauss_seidel', the default: the warm start
+                           applied by apply_stiffness, then gauss_seidel_density_sweep once per cell colour and
+                           check_convergence, repeated) or by the divergence solve's Jacobi iteration ('jacobi').
   compute_wall_reaction    the liquid's force on each vessel from exactly the pair forces its wall particles
                            exerted in both solves (Newton's third law), per particle, reduced later in fixed order.
   integrate                x += dt v*, then the shared wall guard, deactivation and diagnostics.
+
+One Gauss-Seidel step of a particle: the same increment from its error as the velocities are at that moment,
+applied to it and its neighbours at once (:func:`relax_liquid_density`, :func:`relax_wall_density`).
 
 One Jacobi iteration, for stiffness increments k_i (m^2/s^2, a pressure over density p / rho):
   k_i = omega max(e_i, 0) alpha_i / dt^2, with e_i = dt Drho_i/Dt (divergence) or rho_i - rho0 + dt Drho_i/Dt (density),
@@ -130,6 +135,8 @@ UNSEEDED_OFFSET = wp.constant(-1.0)
 
 SOLVE_DIVERGENCE = 0
 SOLVE_DENSITY = 1
+# Colours of the Gauss-Seidel density sweep by dimension (:func:`cell_color`)
+CELL_COLORS = {2: 9, 3: 27}
 
 # solve_stats (int64): error sum (quanta), active particle count, iterations of the current solve, largest error
 STAT_ERROR = wp.constant(0)
@@ -294,6 +301,12 @@ def compute_density_factor(
     wp.atomic_max(diag_f, row[0], DIAG_MAX_COMPRESSION, compression)
 
 
+@wp.func
+def error_quanta(relative: float) -> wp.int64:
+    """A constraint's relative error (capped at MAX_PARTICLE_ERROR) in ERROR_QUANTUM units, as the solves sum it."""
+    return wp.int64(wp.min(relative, MAX_PARTICLE_ERROR) / ERROR_QUANTUM + 0.5)
+
+
 @wp.kernel
 def apply_stiffness(
     lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
@@ -380,9 +393,9 @@ def compute_solve_error(
     k_i = prm.jacobi_relaxation * e * alpha[i] / (h * h)
     increment[i] = k_i
     increment_per_rho[i] = k_i / rho[i]
-    rel = wp.min(e / prm.rest_density, MAX_PARTICLE_ERROR)
-    wp.atomic_add(solve_stats, STAT_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
-    wp.atomic_max(solve_stats, STAT_MAX_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
+    quanta = error_quanta(e / prm.rest_density)
+    wp.atomic_add(solve_stats, STAT_ERROR, quanta)
+    wp.atomic_max(solve_stats, STAT_MAX_ERROR, quanta)
 
 
 @wp.kernel
@@ -505,6 +518,7 @@ def compute_wall_density_factor(
 def start_wall_solve(
     lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     warm_start: float,
+    warm_start_applied: int,
     # State in
     b_rho: wp.array(dtype=float),
     # State in/out
@@ -514,12 +528,15 @@ def start_wall_solve(
     b_increment_per_rho: wp.array(dtype=float),
 ):
     """A solve's warm start for the wall layer: a fraction of the stiffness it applied in the last substep (and
-    that over the wall particle's density, as the liquid reads it)."""
+    that over the wall particle's density, as the liquid reads it). The Jacobi iteration counts the warm start into
+    the stiffness when its first iteration has applied it (:func:`compute_wall_solve_error`); with
+    ``warm_start_applied`` (the Gauss-Seidel density solve, whose warm start is applied before its sweeps) it
+    counts from here."""
     b = lane_item(wp.tid(), lane)
     warm = warm_start * b_kappa[b]
     b_increment[b] = warm
     b_increment_per_rho[b] = warm / b_rho[b]
-    b_kappa[b] = 0.0
+    b_kappa[b] = wp.where(warm_start_applied != 0, warm, 0.0)
 
 
 @wp.kernel
@@ -565,9 +582,188 @@ def compute_wall_solve_error(
     k_b = WALL_RELAXATION * prm.jacobi_relaxation * e * b_alpha[b] / (h * h)
     b_increment[b] = k_b
     b_increment_per_rho[b] = k_b / b_rho[b]
-    rel = wp.min(e / prm.rest_density, MAX_PARTICLE_ERROR)
-    wp.atomic_add(solve_stats, STAT_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
-    wp.atomic_max(solve_stats, STAT_MAX_ERROR, wp.int64(rel / ERROR_QUANTUM + 0.5))
+    quanta = error_quanta(e / prm.rest_density)
+    wp.atomic_add(solve_stats, STAT_ERROR, quanta)
+    wp.atomic_max(solve_stats, STAT_MAX_ERROR, quanta)
+
+
+@wp.func
+def cell_color(g: GridSpec, cell: int) -> int:
+    """The colour of a grid cell for the Gauss-Seidel sweep: cells whose indices differ by a multiple of 3 on every
+    axis share one (9 colours in 2-D, 27 in 3-D). Cells are one support wide, so a particle's pairs reach only the
+    adjacent cells, and two cells of one colour, 3 apart, have no particle within reach of both."""
+    cx = cell % g.nx
+    cy = (cell // g.nx) % g.ny
+    cz = cell // (g.nx * g.ny)
+    return cx % 3 + 3 * (cz % 3) + 9 * (cy % 3)
+
+
+@wp.func
+def relax_liquid_density(
+    prm: SPHParams,
+    i: int,
+    h: float,
+    rho: wp.array(dtype=float),
+    alpha: wp.array(dtype=float),
+    bv: wp.array(dtype=wp.vec3),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    kappa: wp.array(dtype=float),
+) -> float:
+    """One Gauss-Seidel step of liquid particle i's density constraint: its predicted compression e_i = rho_i - rho0
+    + dt sum_j m (v_i - v_j) . grad W_ij from the velocities as they are now (compression only), the stiffness
+    increment k_i = e_i alpha_i / dt^2 that removes it, added to kappa_i, and applied at once to i and to its liquid
+    neighbours (v_i -= dt (k_i / rho_i) sum_j m grad W_ij, v_j += dt (k_i / rho_i) m grad W_ij: the k_i part of the
+    Jacobi step's pair force, so the momentum exchanged is the same). Returns e_i / rho0."""
+    vi = v[i]
+    rate = float(0.0)
+    n = pair_count[i]
+    for k in range(n):
+        j = pair_index[i, k]
+        vj = wp.vec3(0.0)
+        if j >= 0:
+            vj = v[j]
+        else:
+            vj = bv[pair_wall(j)]
+        rate += wp.dot(vi - vj, pair_mass_grad[i, k])
+    e = wp.max(h * rate + rho[i] - prm.rest_density, 0.0)
+    if e == 0.0:
+        return 0.0
+    k_i = e * alpha[i] / (h * h)
+    kappa[i] = kappa[i] + k_i
+    push = h * k_i / rho[i]
+    dv = wp.vec3(0.0)
+    for k in range(n):
+        j = pair_index[i, k]
+        gm = pair_mass_grad[i, k]
+        dv += gm
+        if j >= 0:
+            v[j] = v[j] + push * gm
+    v[i] = vi - push * dv
+    return e / prm.rest_density
+
+
+@wp.func
+def relax_wall_density(
+    prm: SPHParams,
+    b: int,
+    h: float,
+    b_volume: wp.array(dtype=float),
+    bv: wp.array(dtype=wp.vec3),
+    b_rho: wp.array(dtype=float),
+    b_alpha: wp.array(dtype=float),
+    b_pair_count: wp.array(dtype=wp.int32),
+    b_pair_index: wp.array2d(dtype=wp.int32),
+    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    b_kappa: wp.array(dtype=float),
+) -> float:
+    """The same step for wall-layer particle b (compression e_b = rho_b - rho0 + dt sum_j m (v_b - v_j) . grad W_bj),
+    pushing its liquid neighbours only (v_j += dt (k_b / rho_b) rho0 V_b grad_b W_bj, the wall term of the pair
+    force). Not relaxed: the Jacobi step halves the wall's increment because the liquid's constraints correct the
+    same approach in the same iteration (``WALL_RELAXATION``); here the wall measures what the liquid left. Returns
+    e_b / rho0."""
+    n = b_pair_count[b]
+    if n == 0:
+        return 0.0
+    vb = bv[b]
+    rate = float(0.0)
+    for k in range(n):
+        rate += wp.dot(vb - v[b_pair_index[b, k]], b_pair_mass_grad[b, k])
+    e = wp.max(h * rate + b_rho[b] - prm.rest_density, 0.0)
+    if e == 0.0:
+        return 0.0
+    k_b = e * b_alpha[b] / (h * h)
+    b_kappa[b] = b_kappa[b] + k_b
+    push = h * k_b / b_rho[b] * prm.rest_density * b_volume[b] / prm.mass  # b_pair_mass_grad carries the liquid's m
+    for k in range(n):
+        j = b_pair_index[b, k]
+        v[j] = v[j] + push * b_pair_mass_grad[b, k]
+    return e / prm.rest_density
+
+
+@wp.func
+def task_cell(g: GridSpec, n: int, t: int, keys: wp.array(dtype=wp.int32), b_keys: wp.array(dtype=wp.int32), cell_start: wp.array(dtype=wp.int32), cell_end: wp.array(dtype=wp.int32)) -> int:
+    """The cell item t starts in a sweep, or -1. Items: the n liquid particles in cell order (``keys``: their sorted
+    cell indices), then the wall particles in cell order (``b_keys``); the first item of each occupied cell starts
+    it, a wall item only where the cell holds no liquid."""
+    n_cells = g.nx * g.ny * g.nz
+    if t < n:
+        cell = keys[t]
+        if cell >= n_cells or (t > 0 and keys[t - 1] == cell):
+            return -1
+        return cell
+    s = t - n
+    cell = b_keys[s]
+    if cell >= n_cells or (s > 0 and b_keys[s - 1] == cell) or cell_end[cell] > cell_start[cell]:
+        return -1
+    return cell
+
+
+@wp.kernel
+def gauss_seidel_density_sweep(
+    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
+    # Model
+    prm: SPHParams,
+    g: GridSpec,
+    color: int,
+    n: int,
+    items: int,
+    threads: int,
+    b_volume: wp.array(dtype=float),
+    # State in
+    keys: wp.array(dtype=wp.int32),
+    cell_start: wp.array(dtype=wp.int32),
+    cell_end: wp.array(dtype=wp.int32),
+    b_keys: wp.array(dtype=wp.int32),
+    b_order: wp.array(dtype=wp.int32),
+    b_cell_start: wp.array(dtype=wp.int32),
+    b_cell_end: wp.array(dtype=wp.int32),
+    rho: wp.array(dtype=float),
+    alpha: wp.array(dtype=float),
+    dt: wp.array(dtype=float),
+    bv: wp.array(dtype=wp.vec3),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    b_rho: wp.array(dtype=float),
+    b_alpha: wp.array(dtype=float),
+    b_pair_count: wp.array(dtype=wp.int32),
+    b_pair_index: wp.array2d(dtype=wp.int32),
+    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    # State in/out
+    v: wp.array(dtype=wp.vec3),
+    kappa: wp.array(dtype=float),
+    b_kappa: wp.array(dtype=float),
+    solve_stats: wp.array(dtype=wp.int64),
+):
+    """One colour's part of a Gauss-Seidel sweep of the density solve: each cell of colour ``color`` relaxes its
+    liquid particles, then its wall-layer particles, one after the other (:func:`relax_liquid_density`,
+    :func:`relax_wall_density`), the cells in parallel (their particles share no neighbour, :func:`cell_color`).
+    ``threads`` threads share the ``items`` items of :func:`task_cell`, each taking every threads-th: few threads
+    on the CPU, where a thread's start-up (its copy of these arguments, about 35 ns) would cost more than the test
+    whether an item starts a cell of the colour. The result depends on neither the order of the cells nor the
+    number of threads or lanes."""
+    h = dt[0]
+    total = wp.int64(0)
+    worst = wp.int64(0)
+    for t in range(lane_item(wp.tid(), lane), items, threads):
+        cell = task_cell(g, n, t, keys, b_keys, cell_start, cell_end)
+        if cell < 0 or cell_color(g, cell) != color:
+            continue
+        for i in range(cell_start[cell], cell_end[cell]):
+            q = error_quanta(relax_liquid_density(prm, i, h, rho, alpha, bv, pair_count, pair_index, pair_mass_grad, v, kappa))
+            total += q
+            worst = wp.max(worst, q)
+        for kk in range(b_cell_start[cell], b_cell_end[cell]):
+            q = error_quanta(relax_wall_density(prm, b_order[kk], h, b_volume, bv, b_rho, b_alpha, b_pair_count, b_pair_index, b_pair_mass_grad, v, b_kappa))
+            total += q
+            worst = wp.max(worst, q)
+    if total > wp.int64(0):
+        wp.atomic_add(solve_stats, STAT_ERROR, total)
+        wp.atomic_max(solve_stats, STAT_MAX_ERROR, worst)
 
 
 @wp.func

@@ -40,14 +40,14 @@ import warp as wp
 from cosim.errors import InputError, SimulationError
 from cosim.fluid import boundary as bd
 from cosim.fluid import dfsph, wcsph
-from cosim.fluid.config import FluidConfig, PressureSolver
+from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, pair_capacity, sum_wall_wrench_chunks
 from cosim.fluid.diagnostics import (
     DIAG_INTERNAL_ENERGY, DIAG_KINETIC_ENERGY, DIAG_POTENTIAL_ENERGY, DIAG_REMOVED_ENERGY, N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, combine_lanes,
     rows_to_records,
 )
 from cosim.fluid.energy import EnergyAccount
-from cosim.fluid.lanes import Lanes, Loop, PerLane, Stage, lane_count, run_serial, together
+from cosim.fluid.lanes import LANE_CHUNK, Lanes, Loop, PerLane, Stage, lane_count, run_serial, together
 from cosim.fluid.model import FluidModel, FluidState, build_model
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
@@ -436,27 +436,10 @@ class FluidSolver:
         grid = [m.grid.cell_start, m.grid.cell_end]
         walls = [self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end]
         pairs = [self._pair_count, self._pair_index, self._pair_grad]
-        solve_pairs = [self._pair_count, self._pair_index, self._pair_mass_grad]
         b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_mass_grad]
         increments = [self._increment, self._increment_per_rho]
         stats, diag_f, diag_i = self._lane_stats, self._lane_diag_f, self._lane_diag_i
-
-        def solve(mode: int, v: wp.array, kappa: wp.array, b_kappa: wp.array) -> Loop:
-            check = self._rec(dfsph.check_convergence, 1, [prm, mode, self._row], [self._solve_stats, self._keep_going, diag_f[0], diag_i[0]])
-            return Loop(self._keep_going, (
-                launch(dfsph.apply_stiffness, n, [*increments, st.active, self._dt, *solve_pairs, self._b_increment_per_rho], [v, kappa]),
-                together(
-                    launch(
-                        dfsph.compute_solve_error, n, [prm, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *solve_pairs],
-                        [*increments, stats],
-                    ),
-                    launch(
-                        dfsph.compute_wall_solve_error, nb, [prm, mode, v, self._dt, self._bv, self._b_rho, self._b_alpha, *b_pairs],
-                        [b_kappa, self._b_increment, self._b_increment_per_rho, stats],
-                    ),
-                ),
-                self.lanes.on_lane(0, check),
-            ))
+        gauss_seidel = self.config.density_iteration is DensityIteration.GAUSS_SEIDEL
 
         return [
             launch(
@@ -474,22 +457,22 @@ class FluidSolver:
                     [self._b_rho, self._b_alpha, *b_pairs, stats, diag_i],
                 ),
                 launch(
-                    dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE), self._b_rho],
+                    dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DIVERGENCE), 0, self._b_rho],
                     [self._b_kappa_divergence, self._b_increment, self._b_increment_per_rho],
                 ),
             ),
-            solve(dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence, self._b_kappa_divergence),
+            self._jacobi_solve(st, dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence, self._b_kappa_divergence),
             together(
                 launch(
                     dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.free, st.kappa_density],
                     [self._v_star, *increments, stats, self._keep_going, diag_f],
                 ),
                 launch(
-                    dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY), self._b_rho],
+                    dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY), int(gauss_seidel), self._b_rho],
                     [self._b_kappa_density, self._b_increment, self._b_increment_per_rho],
                 ),
             ),
-            solve(dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density, self._b_kappa_density),
+            *(self._gauss_seidel_density_solve(st) if gauss_seidel else [self._jacobi_solve(st, dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density, self._b_kappa_density)]),
             launch(
                 dfsph.compute_wall_reaction, n,
                 [
@@ -502,6 +485,62 @@ class FluidSolver:
             launch(dfsph.integrate, n, [*self._integrate_model_args(), self._v_star, st.rho], [st.x, st.v, st.active, self._wall_force, self._wall_torque, diag_f, diag_i]),
             self.lanes.on_lane(0, self._solve_stats.zero_),
         ]
+
+    def _apply_stiffness(self, st: FluidState, v: wp.array, kappa: wp.array) -> Stage:
+        """The stage that applies the pending stiffness increments (a solve's warm start, or a Jacobi iteration's)."""
+        pairs = [self._pair_count, self._pair_index, self._pair_mass_grad]
+        return self.lanes.launch(
+            dfsph.apply_stiffness, self.n_particles, [self._increment, self._increment_per_rho, st.active, self._dt, *pairs, self._b_increment_per_rho], [v, kappa],
+        )
+
+    def _convergence_check(self, mode: int) -> Stage:
+        """The stage that ends a solve's iteration: its error measured, the stop decided (``check_convergence``)."""
+        check = self._rec(
+            dfsph.check_convergence, 1, [self.model.params, mode, self._row], [self._solve_stats, self._keep_going, self._lane_diag_f[0], self._lane_diag_i[0]],
+        )
+        return self.lanes.on_lane(0, check)
+
+    def _jacobi_solve(self, st: FluidState, mode: int, v: wp.array, kappa: wp.array, b_kappa: wp.array) -> Loop:
+        """A solve by Jacobi iterations (``mode``: dfsph.SOLVE_DIVERGENCE or SOLVE_DENSITY): each applies the
+        increments the last measured (the first, the warm start), then measures the liquid's and the wall layer's
+        errors and their next increments."""
+        prm, n, nb = self.model.params, self.n_particles, self.model.n_boundary
+        launch = self.lanes.launch
+        pairs = [self._pair_count, self._pair_index, self._pair_mass_grad]
+        b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_mass_grad]
+        increments = [self._increment, self._increment_per_rho]
+        return Loop(self._keep_going, (
+            self._apply_stiffness(st, v, kappa),
+            together(
+                launch(dfsph.compute_solve_error, n, [prm, mode, v, st.rho, self._alpha, st.active, self._dt, self._bv, *pairs], [*increments, self._lane_stats]),
+                launch(
+                    dfsph.compute_wall_solve_error, nb, [prm, mode, v, self._dt, self._bv, self._b_rho, self._b_alpha, *b_pairs],
+                    [b_kappa, self._b_increment, self._b_increment_per_rho, self._lane_stats],
+                ),
+            ),
+            self._convergence_check(mode),
+        ))
+
+    def _gauss_seidel_density_solve(self, st: FluidState) -> list[Stage | Loop]:
+        """The density solve by Gauss-Seidel sweeps (``cosim.fluid.dfsph.gauss_seidel_density_sweep``): the warm
+        start applied at once, then sweeps of one stage per cell colour, each sweep followed by the convergence
+        test, until it passes."""
+        m, prm, n, nb = self.model, self.model.params, self.n_particles, self.model.n_boundary
+        pairs = [self._pair_count, self._pair_index, self._pair_mass_grad]
+        b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_mass_grad]
+        threads = n + nb if self.device.is_cuda else LANE_CHUNK * self.lanes.count  # dfsph.gauss_seidel_density_sweep
+        colors = [
+            self.lanes.launch(
+                dfsph.gauss_seidel_density_sweep, threads,
+                [
+                    prm, m.grid.spec, color, n, n + nb, threads, m.b_volume, m.grid.keys, m.grid.cell_start, m.grid.cell_end, m.b_grid.keys, m.b_grid.order,
+                    m.b_grid.cell_start, m.b_grid.cell_end, st.rho, self._alpha, self._dt, self._bv, *pairs, self._b_rho, self._b_alpha, *b_pairs,
+                ],
+                [self._v_star, st.kappa_density, self._b_kappa_density, self._lane_stats],
+            )
+            for color in range(dfsph.CELL_COLORS[self.config.dim])
+        ]
+        return [self._apply_stiffness(st, self._v_star, st.kappa_density), Loop(self._keep_going, (*colors, self._convergence_check(dfsph.SOLVE_DENSITY)))]
 
     def _capture(self) -> tuple | None:
         """Each lane's graphs of both parities' substeps (DFSPH's solve loops become conditional nodes on CUDA,

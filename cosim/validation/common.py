@@ -13,7 +13,7 @@ from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
 
 # FluidConfig fields a case's numerics may override (the rest is the case's geometry, physics and solver).
-NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "density_tolerance")
+NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "density_iteration", "density_tolerance")
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import math
 
-from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
+import pytest
+
+from cosim.fluid.config import GRAVITY, DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose, rotation_y
@@ -13,14 +15,22 @@ from cosim.vessel import VesselSpec
 
 B = 0.191  # m, the seed's vessel width
 FILL = 0.1  # m
+# The solver variants the execution variants are compared under: (pressure solver, DFSPH's density iteration)
+SOLVER_VARIANTS = [
+    pytest.param(PressureSolver.WCSPH, DensityIteration.GAUSS_SEIDEL, id="wcsph"),
+    pytest.param(PressureSolver.DFSPH, DensityIteration.GAUSS_SEIDEL, id="dfsph-gauss_seidel"),
+    pytest.param(PressureSolver.DFSPH, DensityIteration.JACOBI, id="dfsph-jacobi"),
+]
 
 
-def tank(solver: PressureSolver, across: int, graphs: bool = True, threads: int = 0) -> FluidSolver:
+def tank(
+    solver: PressureSolver, across: int, graphs: bool = True, threads: int = 0, iteration: DensityIteration = DensityIteration.GAUSS_SEIDEL,
+) -> FluidSolver:
     """The tank (B wide, filled FILL deep, ``across`` particles across) on the CPU."""
     vessel = VesselSpec(name="tank", inner_width=B, inner_depth=0.1, inner_height=0.2)
     cfg = FluidConfig(
         dim=2, spacing=B / across, pressure_solver=solver, max_expected_speed=2 * math.sqrt(GRAVITY * FILL),
-        domain_min=(-0.3, -0.15, -0.1), domain_max=(0.3, 0.15, 0.4), cpu_threads=threads,
+        domain_min=(-0.3, -0.15, -0.1), domain_max=(0.3, 0.15, 0.4), cpu_threads=threads, density_iteration=iteration,
     )
     return FluidSolver(cfg, [vessel], [Pose()], fill_vessel(vessel, FILL, cfg), graphs=graphs)
 
