@@ -122,6 +122,8 @@ def test_instability_is_raised_naming_the_step_and_the_cause():
         ({"kernel": "quintic"}, "fluid.kernel"),
         ({"pressure_solver": "pcisph"}, "fluid.pressure_solver"),
         ({"density_tolerance": 0.0}, "fluid.density_tolerance"),
+        ({"density_iteration": "sor"}, "fluid.density_iteration"),
+        ({"gravity": (0.0, 0.0, 0.0)}, "fluid.gravity"),
         ({"max_solver_iterations": 1}, "fluid.max_solver_iterations"),
         ({"cfl": float("nan")}, "fluid.cfl"),
         ({"domain_min": (0.0, 0.0, 0.0), "domain_max": (0.01, 1.0, 1.0)}, "fluid.domain_max[0]"),

@@ -16,6 +16,11 @@ from cosim.checks import check_choice, check_int, check_positive, check_range, c
 from cosim.errors import InputError
 
 GRAVITY = 9.81  # m/s^2, standard gravity magnitude used across the project
+# Range of |fluid.gravity| (m/s^2): the energy guard counts the energy the numerics create in units of M g L, and the
+# time step's force criterion and the expected speeds scale with g, so a liquid without gravity has no scale; the
+# upper end is 10 g, beyond anything a pour meets.
+MIN_GRAVITY = 0.1
+MAX_GRAVITY = 10.0 * GRAVITY
 MAX_CPU_THREADS = 256  # most threads a CPU substep may be split over (FluidConfig.cpu_threads, cosim pour --threads)
 
 
@@ -140,7 +145,7 @@ class FluidConfig:
         lifting the whole liquid by the vessel's height. (0, 10]. Not zero: the symplectic step is not
         energy-exact under impulsive wall loads (a tilt starting from rest at 5 rad/s within one 2 ms interval
         creates 0.1-0.24 on coarse grids whose other measures stay clean, docs/stability.md).
-    gravity: m/s^2, world-frame gravity vector.
+    gravity: m/s^2, world-frame gravity vector; its magnitude in [0.1, 98.1].
     """
 
     dim: int = 2
@@ -222,6 +227,8 @@ class FluidConfig:
         s(self, "min_time_step", check_range("fluid.min_time_step", self.min_time_step, 0.0, 1.0e-3, "s", lo_open=True))
         s(self, "max_energy_creation", check_range("fluid.max_energy_creation", self.max_energy_creation, 0.0, 10.0, lo_open=True))
         s(self, "gravity", check_vector("fluid.gravity", self.gravity, 3))
+        if not MIN_GRAVITY <= self.gravity_magnitude <= MAX_GRAVITY:
+            raise InputError(f"fluid.gravity: magnitude must be in [{MIN_GRAVITY:g}, {MAX_GRAVITY:g}] m/s^2, got {self.gravity_magnitude:g}")
 
     # ---- derived quantities ------------------------------------------------------------------------------------
     @property
