@@ -307,6 +307,47 @@ def error_quanta(relative: float) -> wp.int64:
     return wp.int64(wp.min(relative, MAX_PARTICLE_ERROR) / ERROR_QUANTUM + 0.5)
 
 
+@wp.func
+def liquid_density_rate(
+    i: int,
+    v: wp.array(dtype=wp.vec3),
+    bv: wp.array(dtype=wp.vec3),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+) -> float:
+    """Drho_i/Dt = sum_j m (v_i - v_j) . grad W_ij + sum_b rho0 V_b (v_i - v_b) . grad W_ib over liquid particle i's
+    pair list, from the velocities as they are (kg/m^3/s)."""
+    vi = v[i]
+    rate = float(0.0)
+    for k in range(pair_count[i]):
+        j = pair_index[i, k]
+        vj = wp.vec3(0.0)
+        if j >= 0:
+            vj = v[j]
+        else:
+            vj = bv[pair_wall(j)]
+        rate += wp.dot(vi - vj, pair_mass_grad[i, k])
+    return rate
+
+
+@wp.func
+def wall_density_rate(
+    b: int,
+    v: wp.array(dtype=wp.vec3),
+    bv: wp.array(dtype=wp.vec3),
+    b_pair_count: wp.array(dtype=wp.int32),
+    b_pair_index: wp.array2d(dtype=wp.int32),
+    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+) -> float:
+    """Drho_b/Dt = sum_j m (v_b - v_j) . grad W_bj over wall-layer particle b's liquid neighbours (kg/m^3/s)."""
+    vb = bv[b]
+    rate = float(0.0)
+    for k in range(b_pair_count[b]):
+        rate += wp.dot(vb - v[b_pair_index[b, k]], b_pair_mass_grad[b, k])
+    return rate
+
+
 @wp.kernel
 def apply_stiffness(
     lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
@@ -376,17 +417,7 @@ def compute_solve_error(
         increment_per_rho[i] = 0.0
         return
     h = dt[0]
-    vi = v[i]
-    rate = float(0.0)
-    for k in range(pair_count[i]):
-        j = pair_index[i, k]
-        vj = wp.vec3(0.0)
-        if j >= 0:
-            vj = v[j]
-        else:
-            vj = bv[pair_wall(j)]
-        rate += wp.dot(vi - vj, pair_mass_grad[i, k])
-    e = h * rate
+    e = h * liquid_density_rate(i, v, bv, pair_count, pair_index, pair_mass_grad)
     if mode == SOLVE_DENSITY:
         e += rho[i] - prm.rest_density
     e = wp.max(e, 0.0)
@@ -571,11 +602,7 @@ def compute_wall_solve_error(
         b_increment_per_rho[b] = 0.0
         return
     h = dt[0]
-    vb = bv[b]
-    rate = float(0.0)
-    for k in range(n):
-        rate += wp.dot(vb - v[b_pair_index[b, k]], b_pair_mass_grad[b, k])
-    e = h * rate
+    e = h * wall_density_rate(b, v, bv, b_pair_count, b_pair_index, b_pair_mass_grad)
     if mode == SOLVE_DENSITY:
         e += b_rho[b] - prm.rest_density
     e = wp.max(e, 0.0)
@@ -617,31 +644,20 @@ def relax_liquid_density(
     increment k_i = e_i alpha_i / dt^2 that removes it, added to kappa_i, and applied at once to i and to its liquid
     neighbours (v_i -= dt (k_i / rho_i) sum_j m grad W_ij, v_j += dt (k_i / rho_i) m grad W_ij: the k_i part of the
     Jacobi step's pair force, so the momentum exchanged is the same). Returns e_i / rho0."""
-    vi = v[i]
-    rate = float(0.0)
-    n = pair_count[i]
-    for k in range(n):
-        j = pair_index[i, k]
-        vj = wp.vec3(0.0)
-        if j >= 0:
-            vj = v[j]
-        else:
-            vj = bv[pair_wall(j)]
-        rate += wp.dot(vi - vj, pair_mass_grad[i, k])
-    e = wp.max(h * rate + rho[i] - prm.rest_density, 0.0)
+    e = wp.max(h * liquid_density_rate(i, v, bv, pair_count, pair_index, pair_mass_grad) + rho[i] - prm.rest_density, 0.0)
     if e == 0.0:
         return 0.0
     k_i = e * alpha[i] / (h * h)
     kappa[i] = kappa[i] + k_i
     push = h * k_i / rho[i]
     dv = wp.vec3(0.0)
-    for k in range(n):
+    for k in range(pair_count[i]):
         j = pair_index[i, k]
         gm = pair_mass_grad[i, k]
         dv += gm
         if j >= 0:
             v[j] = v[j] + push * gm
-    v[i] = vi - push * dv
+    v[i] = v[i] - push * dv
     return e / prm.rest_density
 
 
@@ -668,11 +684,7 @@ def relax_wall_density(
     n = b_pair_count[b]
     if n == 0:
         return 0.0
-    vb = bv[b]
-    rate = float(0.0)
-    for k in range(n):
-        rate += wp.dot(vb - v[b_pair_index[b, k]], b_pair_mass_grad[b, k])
-    e = wp.max(h * rate + b_rho[b] - prm.rest_density, 0.0)
+    e = wp.max(h * wall_density_rate(b, v, bv, b_pair_count, b_pair_index, b_pair_mass_grad) + b_rho[b] - prm.rest_density, 0.0)
     if e == 0.0:
         return 0.0
     k_b = e * b_alpha[b] / (h * h)
