@@ -200,6 +200,12 @@ class FluidSolver:
             self._b_pair_count = wp.zeros(nb, dtype=wp.int32, device=d)
             self._b_pair_index = wp.zeros((nb, capacity), dtype=wp.int32, device=d)
             self._b_pair_mass_grad = wp.zeros((nb, capacity), dtype=wp.vec3, device=d)
+            if self.config.density_iteration is DensityIteration.GAUSS_SEIDEL:  # dfsph.list_sweep_cells
+                threads = self._sweep_threads()
+                per_thread = -(-(n + nb) // threads)
+                self._sweep_count = wp.zeros(threads, dtype=wp.int32, device=d)
+                self._sweep_cell = wp.zeros((threads, per_thread), dtype=wp.int32, device=d)
+                self._sweep_color = wp.zeros((threads, per_thread), dtype=wp.int32, device=d)
         self._b_active = wp.ones(nb, dtype=wp.int32, device=d)
         self._motions = wp.zeros(m.n_vessels, dtype=bd.VesselMotion, device=d)
         # the motions are written on the host through a structured numpy view (the CPU device's array itself, else a
@@ -471,6 +477,7 @@ class FluidSolver:
                     dfsph.start_wall_solve, nb, [float(dfsph.WARM_START_DENSITY), int(gauss_seidel), self._b_rho],
                     [self._b_kappa_density, self._b_increment, self._b_increment_per_rho],
                 ),
+                *([self._list_sweep_cells()] if gauss_seidel else []),
             ),
             *(self._gauss_seidel_density_solve(st) if gauss_seidel else [self._jacobi_solve(st, dfsph.SOLVE_DENSITY, self._v_star, st.kappa_density, self._b_kappa_density)]),
             launch(
@@ -521,20 +528,33 @@ class FluidSolver:
             self._convergence_check(mode),
         ))
 
+    def _sweep_threads(self) -> int:
+        """Threads of each Gauss-Seidel colour launch (``cosim.fluid.dfsph.gauss_seidel_density_sweep``): one per
+        item on CUDA, a chunk per lane on the CPU."""
+        return self.n_particles + self.model.n_boundary if self.device.is_cuda else LANE_CHUNK * self.lanes.count
+
+    def _list_sweep_cells(self) -> Stage:
+        """The launch that lists each sweep thread's cells for the substep (``cosim.fluid.dfsph.list_sweep_cells``)."""
+        m, n, threads = self.model, self.n_particles, self._sweep_threads()
+        return self.lanes.launch(
+            dfsph.list_sweep_cells, threads, [m.grid.spec, n, n + m.n_boundary, threads, m.grid.keys, m.grid.cell_start, m.grid.cell_end, m.b_grid.keys],
+            [self._sweep_count, self._sweep_cell, self._sweep_color],
+        )
+
     def _gauss_seidel_density_solve(self, st: FluidState) -> list[Stage | Loop]:
         """The density solve by Gauss-Seidel sweeps (``cosim.fluid.dfsph.gauss_seidel_density_sweep``): the warm
         start applied at once, then sweeps of one stage per cell colour, each sweep followed by the convergence
         test, until it passes."""
-        m, prm, n, nb = self.model, self.model.params, self.n_particles, self.model.n_boundary
+        m, prm = self.model, self.model.params
         pairs = [self._pair_count, self._pair_index, self._pair_mass_grad]
         b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_mass_grad]
-        threads = n + nb if self.device.is_cuda else LANE_CHUNK * self.lanes.count  # dfsph.gauss_seidel_density_sweep
+        cells = [self._sweep_count, self._sweep_cell, self._sweep_color, m.grid.cell_start, m.grid.cell_end]
         colors = [
             self.lanes.launch(
-                dfsph.gauss_seidel_density_sweep, threads,
+                dfsph.gauss_seidel_density_sweep, self._sweep_threads(),
                 [
-                    prm, m.grid.spec, color, n, n + nb, threads, m.b_volume, m.grid.keys, m.grid.cell_start, m.grid.cell_end, m.b_grid.keys, m.b_grid.order,
-                    m.b_grid.cell_start, m.b_grid.cell_end, st.rho, self._alpha, self._dt, self._bv, *pairs, self._b_rho, self._b_alpha, *b_pairs,
+                    prm, color, m.b_volume, *cells, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, st.rho, self._alpha, self._dt, self._bv, *pairs,
+                    self._b_rho, self._b_alpha, *b_pairs,
                 ],
                 [self._v_star, st.kappa_density, self._b_kappa_density, self._lane_stats],
             )
