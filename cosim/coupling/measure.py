@@ -251,6 +251,7 @@ class LiquidProbe:
         self._sums = wp.zeros((CHUNKS, _SUMS), dtype=float, device=device)
         self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
         self._crossing_x = wp.zeros(max(n_particles, 1), dtype=float, device=device)
+        self._commands: dict[tuple, wp.Launch] = {}
         spec = geo.pourer
         self._pourer_frame = PourerFrame()  # the fixed fields once; :meth:`_frame` sets the pose (warp struct fields are costly to set)
         self._pourer_frame.half_width = 0.5 * spec.inner_width
@@ -260,6 +261,20 @@ class LiquidProbe:
         self._pourer_frame.column_start = geo.column_start
         self._pourer_frame.column_width = geo.smoothing_length
         self._pourer_frame.columns = geo.columns
+
+    def _launch(self, kernel, dim: int, inputs: list, outputs: list) -> None:
+        """``wp.launch(kernel, dim, inputs, outputs)`` through a recorded launch kept per kernel and array set (the
+        solver's particle arrays alternate between two): each call packs only the arguments that are not arrays
+        (packing them all was most of the probe's host time)."""
+        key = (kernel.key, dim, *(a.ptr for a in (*inputs, *outputs) if isinstance(a, wp.array)))
+        command = self._commands.get(key)
+        if command is None:
+            command = self._commands[key] = wp.launch(kernel, dim=dim, inputs=inputs, outputs=outputs, device=self.device, record_cmd=True)
+        else:
+            for k, value in enumerate(inputs):
+                if not isinstance(value, wp.array):
+                    command.set_param_at_index(k, value)
+        command.launch()
 
     def _frame(self, pose: Pose) -> PourerFrame:
         """The pourer's frame at ``pose`` (the one struct, updated: launches copy their arguments)."""
@@ -274,7 +289,7 @@ class LiquidProbe:
     ) -> LiquidMeasurement:
         """The measurement at time ``t`` (s) with the vessels at these poses, from the particle arrays and the
         solver's count-based volume in the pourer (m^3)."""
-        geo, dx, d = self.geo, self.geo.spacing, self.device
+        geo, dx = self.geo, self.geo.spacing
         height = geo.pourer.inner_height
         frame = self._frame(pourer_pose)
         tilt = tilt_about_y(pourer_pose.rotation)
@@ -283,10 +298,8 @@ class LiquidProbe:
         self._column_top_x.fill_(LOWEST)
         self._crest_top.fill_(LOWEST)
         if self.n:
-            wp.launch(find_column_tops, dim=self.n, inputs=[frame, wp.vec3(*crest), dx, x, active],
-                      outputs=[self._column_top, self._crest_top], device=d)
-            wp.launch(find_column_top_x, dim=self.n, inputs=[frame, x, active, self._column_top],
-                      outputs=[self._column_top_x], device=d)
+            self._launch(find_column_tops, self.n, [frame, wp.vec3(*crest), dx, x, active], [self._column_top, self._crest_top])
+            self._launch(find_column_top_x, self.n, [frame, x, active, self._column_top], [self._column_top_x])
         top_z = self._column_top.numpy().astype(np.float64)[: geo.columns]
         top_x = self._column_top_x.numpy().astype(np.float64)[: geo.columns]
         c, slope, columns = free_surface_line(top_x, top_z)
@@ -303,8 +316,7 @@ class LiquidProbe:
         lip = pourer_pose.transform(geo.lip_local[None, :])[0]
         top = lip[2] + dx + max(h_q, 0.0)
         chunk = max(math.ceil(self.n / CHUNKS), 1)
-        wp.launch(sum_leaving_stream, dim=CHUNKS, inputs=[frame, wp.vec3(*lip), dx, top, self.n, chunk, x, v, active],
-                  outputs=[self._sums], device=d)
+        self._launch(sum_leaving_stream, CHUNKS, [frame, wp.vec3(*lip), dx, top, self.n, chunk, x, v, active], [self._sums])
         count, svx, svz, sx, sz = self._sums.numpy().astype(np.float64).sum(axis=0)
         if count > 0:
             v_q, v_q_z = svx / count, svz / count
@@ -336,8 +348,7 @@ class LiquidProbe:
         min_speed = MIN_FALL_SPEED_FRACTION * math.sqrt(2.0 * gravity * drop)
         self._crossing_count.zero_()
         if self.n:
-            wp.launch(collect_rim_crossing, dim=self.n, inputs=[rim_z, BAND_SPACINGS * self.geo.spacing, min_speed, x, v, active],
-                      outputs=[self._crossing_count, self._crossing_x], device=self.device)
+            self._launch(collect_rim_crossing, self.n, [rim_z, BAND_SPACINGS * self.geo.spacing, min_speed, x, v, active], [self._crossing_count, self._crossing_x])
         count = int(self._crossing_count.numpy()[0])
         if count == 0:
             return math.nan

@@ -185,6 +185,7 @@ class FluidSolver:
         self._partial_torque = wp.zeros((v_count, WRENCH_CHUNKS), dtype=wp.vec3, device=d)
         self._force_sum = wp.zeros(v_count, dtype=wp.vec3, device=d)
         self._torque_sum = wp.zeros(v_count, dtype=wp.vec3, device=d)
+        self._wrench_views = (self._force_sum.numpy(), self._torque_sum.numpy()) if d.is_cpu else None  # shared memory
         nb = m.n_boundary
         self._bx = wp.zeros(nb, dtype=wp.vec3, device=d)
         self._bv = wp.zeros(nb, dtype=wp.vec3, device=d)
@@ -242,6 +243,7 @@ class FluidSolver:
         self._diag_i = wp.zeros((lanes, self._rows_capacity, N_DIAG_INT_BASE + self.model.n_vessels), dtype=wp.int32, device=self.device)
         self._lane_diag_f = PerLane(self._diag_f[k] for k in range(lanes))
         self._lane_diag_i = PerLane(self._diag_i[k] for k in range(lanes))
+        self._diag_views = (self._diag_f.numpy(), self._diag_i.numpy()) if self.device.is_cpu else None  # shared memory
         self._ops = None
         self._graphs = None
 
@@ -327,14 +329,15 @@ class FluidSolver:
         self.substep_wall_time += time.perf_counter() - start
         if self._capture_graphs and self._graphs is None:
             self._graphs = self._capture()
-        rows_f, rows_i = combine_lanes(self._diag_f.numpy()[:, :n_sub], self._diag_i.numpy()[:, :n_sub])
+        diag_f, diag_i = self._diag_views or (self._diag_f.numpy(), self._diag_i.numpy())
+        rows_f, rows_i = combine_lanes(diag_f[:, :n_sub], diag_i[:, :n_sub])
         first = self.step_count
         t0 = self.time
         self.step_count += n_sub
         self.time += duration
         self._history.append((np.full(n_sub, dt), rows_f, rows_i))
         scale = 1.0 / n_sub
-        wrench = np.concatenate([self._force_sum.numpy(), self._torque_sum.numpy()], axis=1)[: m.n_vessels]
+        wrench = np.concatenate(self._wrench_views or (self._force_sum.numpy(), self._torque_sum.numpy()), axis=1)[: m.n_vessels]
         self._wrench = wrench.astype(np.float64) * scale
         self.energy_account.update(
             float(rows_f[-1, DIAG_KINETIC_ENERGY] + rows_f[-1, DIAG_INTERNAL_ENERGY]), float(rows_f[-1, DIAG_POTENTIAL_ENERGY]), float(rows_f[:, DIAG_REMOVED_ENERGY].sum()),

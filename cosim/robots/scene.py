@@ -299,10 +299,13 @@ class RobotScene:
         arm, m = self.arms[role], self.model
         if self._jacobian_data is None:
             self._jacobian_data = mujoco.MjData(m)
-        d = self._jacobian_data
-        d.qpos[:] = self.data.qpos
-        mujoco.mj_kinematics(m, d)
-        mujoco.mj_comPos(m, d)
+            self._jacobian_data.qpos[:] = np.nan  # no kinematics computed yet
+        d, live = self._jacobian_data, self.data
+        # the step loop asks for both arms at one configuration: its kinematics once
+        if not (np.array_equal(d.qpos, live.qpos) and np.array_equal(d.mocap_pos, live.mocap_pos) and np.array_equal(d.mocap_quat, live.mocap_quat)):
+            d.qpos[:], d.mocap_pos[:], d.mocap_quat[:] = live.qpos, live.mocap_pos, live.mocap_quat
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
         jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
         mujoco.mj_jac(m, d, jacp, jacr, d.xipos[arm.vessel_body], arm.vessel_body)
         return jacp[:, arm.dof_adr].T @ np.asarray(force, dtype=float) + jacr[:, arm.dof_adr].T @ np.asarray(torque, dtype=float)
