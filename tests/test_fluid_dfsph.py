@@ -165,6 +165,29 @@ def test_cells_of_one_colour_share_no_neighbour(dim, ny):
     assert not (reach & same & ~np.eye(len(cells), dtype=bool)).any()
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_each_occupied_cell_is_in_one_sweep_list_with_its_colour(threads):
+    """The Gauss-Seidel sweep relaxes the cells its threads listed (dfsph.list_sweep_cells): every cell that holds
+    liquid or wall particles must be listed once, under its colour, for every particle to be relaxed once a sweep."""
+    tank = VesselSpec(name="tank", inner_width=B, inner_depth=0.1, inner_height=0.2)
+    cfg = FluidConfig(
+        dim=2, spacing=B / 12, pressure_solver=PressureSolver.DFSPH, cpu_threads=threads, max_expected_speed=2 * math.sqrt(GRAVITY * FILL),
+        domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.35),
+    )
+    fluid = FluidSolver(cfg, [tank], [Pose((0.0, 0.0, 0.0), rotation_y(0.2))], fill_vessel(tank, FILL, cfg))
+    fluid.advance(0.004)
+    grid, walls = fluid.model.grid, fluid.model.b_grid
+    n_cells = grid.spec.nx * grid.spec.ny * grid.spec.nz
+    keys = np.concatenate([grid.keys.numpy(), walls.keys.numpy()])
+    occupied = np.unique(keys[keys < n_cells])
+    counts = fluid._sweep_count.numpy()
+    listed = np.concatenate([fluid._sweep_cell.numpy()[t, :c] for t, c in enumerate(counts)])
+    colors = np.concatenate([fluid._sweep_color.numpy()[t, :c] for t, c in enumerate(counts)])
+    assert len(listed) == len(occupied) and np.array_equal(np.sort(listed), occupied)
+    cx, cy, cz = listed % grid.spec.nx, (listed // grid.spec.nx) % grid.spec.ny, listed // (grid.spec.nx * grid.spec.ny)
+    np.testing.assert_array_equal(colors, cx % 3 + 3 * (cz % 3) + 9 * (cy % 3))
+
+
 @pytest.mark.parametrize("iteration", list(DensityIteration))
 def test_density_solve_exchanges_momentum_in_pairs(iteration):
     """A blob of liquid in free fall, its particles thrown at each other (no wall within reach): the solves push
