@@ -174,7 +174,8 @@ def test_each_occupied_cell_is_in_one_sweep_list_with_its_colour(threads):
         dim=2, spacing=B / 12, pressure_solver=PressureSolver.DFSPH, cpu_threads=threads, max_expected_speed=2 * math.sqrt(GRAVITY * FILL),
         domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.35),
     )
-    fluid = FluidSolver(cfg, [tank], [Pose((0.0, 0.0, 0.0), rotation_y(0.2))], fill_vessel(tank, FILL, cfg))
+    fluid = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, FILL, cfg))
+    fluid.set_vessel_poses([Pose((0.0, 0.0, 0.0), rotation_y(0.05))])
     fluid.advance(0.004)
     grid, walls = fluid.model.grid, fluid.model.b_grid
     n_cells = grid.spec.nx * grid.spec.ny * grid.spec.nz
