@@ -100,7 +100,9 @@ class PourController:
         self._first_t = math.nan
         self._initial_volume = math.nan
         self._outflow_rate = 0.0  # m^3/s, filtered
-        self._h_q = math.nan  # m, h_q filtered like the outflow rate, for the after-flow prediction
+        # m, the head over the crest as the weir law sees it (max(h_q, 0): a negative head pours nothing), filtered like
+        # the outflow rate, for the after-flow prediction, which scales that rate by (head / this)^(3/2)
+        self._h_q = math.nan
         self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
         self._last_poured = 0.0
         self._sigma_prev = 0.0
@@ -159,7 +161,7 @@ class PourController:
             rate = (m.poured_volume - self._last_poured) / (m.t - self._last_t)
             gain = min((m.t - self._last_t) / OUTFLOW_FILTER_TIME, 1.0)
             self._outflow_rate += gain * (rate - self._outflow_rate)
-            self._h_q += gain * (m.h_q - self._h_q)
+            self._h_q += gain * (max(m.h_q, 0.0) - self._h_q)
         self._last_t, self._last_poured = m.t, m.poured_volume
 
         for _ in Phase:  # a step may pass several phases; each at most once
@@ -187,7 +189,7 @@ class PourController:
     # ---- bookkeeping ------------------------------------------------------------------------------------------
     def _begin(self, m: LiquidMeasurement) -> None:
         self._first_t = m.t
-        self._h_q = m.h_q
+        self._h_q = max(m.h_q, 0.0)
         self._initial_volume = m.volume_in_pourer + m.poured_volume
         if not self._initial_volume > 0.0:
             raise MeasurementError("measurement.volume_in_pourer: the pourer is empty at the first step")

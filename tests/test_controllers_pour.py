@@ -1,5 +1,6 @@
 """The pour state machine in closed loop with the model plant (pendulum + box + weir), and its contracts."""
 
+import csv
 import dataclasses
 import math
 import subprocess
@@ -21,7 +22,7 @@ from controllers import (
     SimConfig,
     SimMode,
 )
-from controllers.geometry import static_tilt_for_h_q
+from controllers.geometry import VesselGeometry, static_tilt_for_h_q
 from controllers.model_plant import ModelPlant, ModelPlantConfig, Trace, run_closed_loop
 from controllers.slosh_induction import excitation_duration
 
@@ -111,6 +112,25 @@ def test_partial_pour_reaches_its_target_and_holds_h_q() -> None:
         t_cfs = next(tr.t for tr in controller.transitions if tr.target is Phase.CFS)
         steady = (phases == Phase.CFS) & (trace.t > t_cfs + CFS_TRANSIENT)
         assert np.all(np.abs(trace.series("h_q")[steady] - config.cfs.h_q_ref) <= H_Q_TOL)
+
+
+def test_partial_pour_does_not_stop_as_the_head_first_rises() -> None:
+    """Regression, from a coupled SPH pour (50 %, start delay 0.35 s; its measurements in tests/data): CFS began as
+    the slosh spilled over the crest. The head's filter had been fed the negative heads before, so it stood just
+    above zero while the filtered outflow rate did not, and the after-flow, which scales that rate by (head /
+    filtered head)^(3/2), came out as the whole vessel (3064 mL): the pour stopped with 14 mL poured. Replayed
+    from those measurements the controller must still be in CFS."""
+    config = PourConfig(
+        vessel=VesselGeometry(0.191, 0.191, 0.01790625, 0.1), fill_depth=0.16115624999999997,
+        catcher=CatcherConfig(home_x=0.2), start_time=0.35, target_volume=0.0015390421875,
+        cfs=CfsConfig(h_q_ref=0.014921875, max_tilt=1.75),
+    )
+    controller = PourController(config)
+    with open(Path(__file__).parent / "data" / "sph_partial_pour_cfs_start.csv", newline="") as f:
+        for row in csv.DictReader(f):
+            controller.step(LiquidMeasurement(**{k: float(v) for k, v in row.items()}))
+    assert [tr.target for tr in controller.transitions][-1] is Phase.CFS  # entered at 1.89 s
+    assert controller.phase is Phase.CFS
 
 
 def test_final_stage_lowers_the_head_before_a_partial_pour_stops() -> None:
