@@ -445,7 +445,7 @@ class FluidSolver:
         grid = [m.grid.cell_start, m.grid.cell_end]
         walls = [self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end]
         pairs = [self._pair_count, self._pair_index, self._pair_grad]
-        b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_mass_grad]
+        _, b_pairs = self._solve_pairs()
         increments = [self._increment, self._increment_per_rho]
         stats, diag_f, diag_i = self._lane_stats, self._lane_diag_f, self._lane_diag_i
         gauss_seidel = self.config.density_iteration is DensityIteration.GAUSS_SEIDEL
@@ -496,9 +496,17 @@ class FluidSolver:
             self.lanes.on_lane(0, self._solve_stats.zero_),
         ]
 
+    def _solve_pairs(self) -> tuple[list, list]:
+        """The pair lists the DFSPH solves loop over, as kernel arguments: the liquid's (count, index, mass-weighted
+        kernel gradient) and the wall layer's."""
+        return (
+            [self._pair_count, self._pair_index, self._pair_mass_grad],
+            [self._b_pair_count, self._b_pair_index, self._b_pair_mass_grad],
+        )
+
     def _apply_stiffness(self, st: FluidState, v: wp.array, kappa: wp.array) -> Stage:
         """The stage that applies the pending stiffness increments (a solve's warm start, or a Jacobi iteration's)."""
-        pairs = [self._pair_count, self._pair_index, self._pair_mass_grad]
+        pairs, _ = self._solve_pairs()
         return self.lanes.launch(
             dfsph.apply_stiffness, self.n_particles, [self._increment, self._increment_per_rho, st.active, self._dt, *pairs, self._b_increment_per_rho], [v, kappa],
         )
@@ -516,8 +524,7 @@ class FluidSolver:
         errors and their next increments."""
         prm, n, nb = self.model.params, self.n_particles, self.model.n_boundary
         launch = self.lanes.launch
-        pairs = [self._pair_count, self._pair_index, self._pair_mass_grad]
-        b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_mass_grad]
+        pairs, b_pairs = self._solve_pairs()
         increments = [self._increment, self._increment_per_rho]
         return Loop(self._keep_going, (
             self._apply_stiffness(st, v, kappa),
@@ -549,8 +556,7 @@ class FluidSolver:
         start applied at once, then sweeps of one stage per cell colour, each sweep followed by the convergence
         test, until it passes."""
         m, prm = self.model, self.model.params
-        pairs = [self._pair_count, self._pair_index, self._pair_mass_grad]
-        b_pairs = [self._b_pair_count, self._b_pair_index, self._b_pair_mass_grad]
+        pairs, b_pairs = self._solve_pairs()
         cells = [self._sweep_count, self._sweep_cell, self._sweep_color, m.grid.cell_start, m.grid.cell_end]
         colors = [
             self.lanes.launch(
