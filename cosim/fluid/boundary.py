@@ -223,7 +223,10 @@ def slab_entry(q_old: wp.vec3, q_new: wp.vec3, lo: wp.vec3, hi: wp.vec3, dim: in
                     axis = a
                     side = wp.where(d > 0.0, -1.0, 1.0)
                 t_exit = wp.min(t_exit, wp.max(t1, t2))
-        if axis < 0 or t_enter > t_exit or t_enter > 1.0 or t_exit < 0.0:
+        # The path meets the closed slab on [t_enter, t_exit]; it enters the open slab only if that span has length
+        # and reaches past t = 0: a path leaving a face it starts on (t_exit = 0), as liquid resting on a wall does
+        # in float32 now and then, or grazing an edge (t_enter = t_exit) does not enter.
+        if axis < 0 or t_enter >= t_exit or t_enter > 1.0 or t_exit <= 0.0:
             return q_new, no_hit, 0.0, 0
     q = q_new
     normal = wp.vec3(0.0)
