@@ -12,3 +12,8 @@ class InputError(ValueError):
 
 class SimulationError(RuntimeError):
     """A simulation that broke while running (non-finite values, a wall breached, ...)."""
+
+
+def count_of(count: int, noun: str) -> str:
+    """A count in a message: '1 particle', '3 particles' (nouns with a plain plural)."""
+    return f"{count} {noun}{'' if count == 1 else 's'}"

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from cosim.errors import InputError
+from cosim.errors import InputError, count_of
 from cosim.fluid.config import FluidConfig, KernelType
 from cosim.fluid.runtime import cuda_available
 from cosim.fluid.seeding import ParticleSet, fill_vessel, liquid_block
@@ -111,6 +111,12 @@ def test_instability_is_raised_naming_the_step_and_the_cause():
             solver.advance(0.01)
     assert isinstance(err.value.step, int) and err.value.time > 0.0
     assert str(err.value).startswith(f"SPH step {err.value.step} ") and "compression" in str(err.value)
+
+
+def test_instability_messages_count_in_words():
+    # the pour at start delay 0.25 s stopped with "1 particles inside a vessel wall" (README, Pour results)
+    assert count_of(1, "particle") == "1 particle"
+    assert count_of(0, "particle") == "0 particles" and count_of(40, "particle") == "40 particles"
 
 
 @pytest.mark.parametrize(

@@ -37,7 +37,7 @@ from typing import Callable, Sequence
 import numpy as np
 import warp as wp
 
-from cosim.errors import InputError, SimulationError
+from cosim.errors import InputError, SimulationError, count_of
 from cosim.fluid import boundary as bd
 from cosim.fluid import dfsph, wcsph
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
@@ -606,9 +606,9 @@ class FluidSolver:
         ):  # the usual interval, found in one pass
             return
         checks = [
-            (rows_i[:, 0] > 0, lambda s: f"{rows_i[s, 0]} particles with a non-finite position, velocity or density"),
-            (rows_i[:, 1] > 0, lambda s: f"{rows_i[s, 1]} particles inside a vessel wall (deeper than {cfg.max_wall_penetration:g} dx)"),
-            (rows_i[:, 6] > 0, lambda s: f"{rows_i[s, 6]} particles with more neighbours than the pair list holds (over-compressed)"),
+            (rows_i[:, 0] > 0, lambda s: f"{count_of(rows_i[s, 0], 'particle')} with a non-finite position, velocity or density"),
+            (rows_i[:, 1] > 0, lambda s: f"{count_of(rows_i[s, 1], 'particle')} inside a vessel wall (deeper than {cfg.max_wall_penetration:g} dx)"),
+            (rows_i[:, 6] > 0, lambda s: f"{count_of(rows_i[s, 6], 'particle')} with more neighbours than the pair list holds (over-compressed)"),
             (
                 rows_f[:, 4] > cfg.max_density_error,
                 lambda s: f"compression {rows_f[s, 4]:.3f} exceeds fluid.max_density_error = {cfg.max_density_error:g}",

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from enum import Enum
 
+from cosim.errors import count_of
 from cosim.fluid.config import FluidConfig
 from cosim.stress.runner import Measurement
 
@@ -40,9 +41,9 @@ def garbage_reasons(m: Measurement) -> list[str]:
     """What makes ``m`` garbage (empty: nothing)."""
     reasons = []
     if m.nonfinite > 0:
-        reasons.append(f"{m.nonfinite} particles with non-finite values")
+        reasons.append(f"{count_of(m.nonfinite, 'particle')} with non-finite values")
     if m.leaked > 0:
-        reasons.append(f"{m.leaked} particles leaked (inside {m.worst_inside}, through {m.worst_through}, "
+        reasons.append(f"{count_of(m.leaked, 'particle')} leaked (inside {m.worst_inside}, through {m.worst_through}, "
                        f"escaped {m.worst_escaped} at worst)")
     if not m.max_density_error <= DENSITY_ERROR_BOUND:  # NaN counts as past the bound
         reasons.append(f"density error {m.max_density_error:.3g} > {DENSITY_ERROR_BOUND:g}")
