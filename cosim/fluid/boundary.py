@@ -243,7 +243,14 @@ def slab_entry(q_old: wp.vec3, q_new: wp.vec3, lo: wp.vec3, hi: wp.vec3, dim: in
 
 @wp.func
 def box_slab(index: int, geo: VesselGeometry):
-    """(lo, hi) of a box vessel's wall slab in the vessel frame: 0 floor, 1 +x, 2 -x, 3 +y, 4 -y."""
+    """(lo, hi) of a box vessel's wall slab in the vessel frame: 0 floor, 1 +x, 2 -x, 3 +y, 4 -y.
+
+    The walls are the outer box [-b-t, b+t] x [-d-t, d+t] x [-t, h] less the cavity [-b, b] x [-d, d] x [0, h]; each
+    slab spans the outer box on every axis but its own, so the slabs overlap at the corners and every point strictly
+    inside the walls is strictly inside some slab. Slabs that merely abut would share faces inside the walls, which
+    both take for outside: a path lying in such a face's plane (along the floor's plane under a side wall) would
+    pass into the wall unseen.
+    """
     b = geo.half_width
     d = geo.half_depth
     t = geo.thickness
@@ -251,12 +258,12 @@ def box_slab(index: int, geo: VesselGeometry):
     if index == 0:
         return wp.vec3(-b - t, -d - t, -t), wp.vec3(b + t, d + t, 0.0)
     if index == 1:
-        return wp.vec3(b, -d - t, 0.0), wp.vec3(b + t, d + t, h)
+        return wp.vec3(b, -d - t, -t), wp.vec3(b + t, d + t, h)
     if index == 2:
-        return wp.vec3(-b - t, -d - t, 0.0), wp.vec3(-b, d + t, h)
+        return wp.vec3(-b - t, -d - t, -t), wp.vec3(-b, d + t, h)
     if index == 3:
-        return wp.vec3(-b, d, 0.0), wp.vec3(b, d + t, h)
-    return wp.vec3(-b, -d - t, 0.0), wp.vec3(b, -d, h)
+        return wp.vec3(-b - t, d, -t), wp.vec3(b + t, d + t, h)
+    return wp.vec3(-b - t, -d - t, -t), wp.vec3(b + t, -d, h)
 
 
 @wp.func
