@@ -99,7 +99,7 @@ def test_guard_lets_a_particle_leave_a_wall_face_it_rests_on(dim):
     # A particle resting exactly on a face (bitwise, as liquid lying on a wall does now and then in float32) and
     # moving off it touches the slab only at the start of its path. Before this test the guard took that for an
     # entry and put the particle on the wall's far side: the default pour at start delay 0.25 s stopped with a
-    # "breach" one wall thickness deep (README, Known limitations, until 2026-12-03).
+    # "breach" one wall thickness deep (README, Pour results).
     b, t = np.float32(0.1), np.float32(0.01)
     inner, outer = float(b), float(b + t)
     paths = [
