@@ -58,9 +58,13 @@ def test_kernel_has_compact_support_and_decreases(kernel):
     assert np.all(dw <= 0.0)
 
 
+# The guard tests' vessel (m), float32 as the guard holds it: half width b, half depth d, wall thickness t, height h.
+B, D, T, H = np.float32(0.1), np.float32(0.05), np.float32(0.01), np.float32(0.2)
+
+
 def _box(shape=SHAPE_BOX):
     g = VesselGeometry()
-    g.shape, g.half_width, g.half_depth, g.height, g.thickness = shape, 0.1, 0.05, 0.2, 0.01
+    g.shape, g.half_width, g.half_depth, g.height, g.thickness = shape, float(B), float(D), float(H), float(T)
     g.com = wp.vec3(0.0, 0.0, 0.05)
     return g
 
@@ -100,8 +104,7 @@ def test_guard_lets_a_particle_leave_a_wall_face_it_rests_on(dim):
     # moving off it touches the slab only at the start of its path. Before this test the guard took that for an
     # entry and put the particle on the wall's far side: the default pour at start delay 0.25 s stopped with a
     # "breach" one wall thickness deep (README, Pour results).
-    b, t = np.float32(0.1), np.float32(0.01)
-    inner, outer = float(b), float(b + t)
+    inner, outer = float(B), float(B + T)
     paths = [
         ((inner, 0.0, 0.1), (inner - 4e-7, 0.0, 0.1)),  # on the inner face, back into the liquid
         ((inner, 0.0, 0.1), (inner - 4e-7, 0.0, 0.1003)),  # the same, sliding up the wall
@@ -125,15 +128,14 @@ def _in_walls(points, shape, dim, tol=0.0):
     inside the outer solid (box (-b-t, b+t) x (-d-t, d+t) x (-t, h), or the cylinder r < b + t, -t < z < h),
     outside the closed cavity ([-b, b] x [-d, d] x [0, h], or r <= b, 0 <= z <= h); ``tol`` shrinks the solid.
     The y axis is ignored in 2-D, where a cylinder is its box section."""
-    f = np.float32
-    b, d, t, h = float(f(0.1)), float(f(0.05)), float(f(0.01)), float(f(0.2))
+    b, d, t, h = float(B), float(D), float(T), float(H)
+    outer_x, outer_y = float(B + T), float(D + T)  # summed in float32, as cosim.fluid.boundary.box_slab does
     z = points[..., 2]
     if shape == SHAPE_CYLINDER and dim == 3:
         r = np.hypot(points[..., 0], points[..., 1])
-        return (r < b + t - tol) & (z > -t + tol) & (z < h - tol) & ~((r <= b + tol) & (z >= -tol))
-    outer = np.array([f(0.1) + f(0.01), f(0.05) + f(0.01)], np.float64)
+        return (r < outer_x - tol) & (z > -t + tol) & (z < h - tol) & ~((r <= b + tol) & (z >= -tol))
     x, y = np.abs(points[..., 0]), np.abs(points[..., 1]) if dim == 3 else np.zeros_like(z)
-    in_outer = (x < outer[0] - tol) & (y < outer[1] - tol) & (z > -t + tol) & (z < h - tol)
+    in_outer = (x < outer_x - tol) & (y < outer_y - tol) & (z > -t + tol) & (z < h - tol)
     in_cavity = (x <= b + tol) & (y <= d + tol) & (z >= -tol) & (z <= h + tol)
     return in_outer & ~in_cavity
 
@@ -150,21 +152,19 @@ def test_guard_against_sampled_paths_near_the_walls(shape, dim):
     # the slabs overlapped, a path lying in the plane of a face two slabs shared (along the floor's plane under a
     # side wall) passed into the wall, and an edge start could end inside the neighbouring slab.
     rng = np.random.default_rng(7)
-    f = np.float32
-    b, d, t, h = f(0.1), f(0.05), f(0.01), f(0.2)
     n = 20000
     z = rng.uniform(-0.025, 0.215, n)
     on_z = rng.random(n) < 0.4
-    z[on_z] = rng.choice(np.array([-t, 0.0, h], np.float64), size=on_z.sum())
+    z[on_z] = rng.choice(np.array([-T, 0.0, H], np.float64), size=on_z.sum())
     if shape == SHAPE_CYLINDER:
         radius, angle = rng.uniform(0.0, 0.125, n), rng.uniform(0.0, 2.0 * np.pi, n)
         on_face = rng.random(n) < 0.4
-        radius[on_face] = rng.choice(np.array([b, b + t], np.float64), size=on_face.sum())
+        radius[on_face] = rng.choice(np.array([B, B + T], np.float64), size=on_face.sum())
         angle[rng.random(n) < 0.3] = 0.0
         q_old = np.stack([radius * np.cos(angle), radius * np.sin(angle), z], axis=1)
     else:
         q_old = np.stack([rng.uniform(-0.125, 0.125, n), rng.uniform(-0.075, 0.075, n), z], axis=1)
-        for a, planes in ((0, [-b - t, -b, b, b + t]), (1, [-d - t, -d, d, d + t])):
+        for a, planes in ((0, [-B - T, -B, B, B + T]), (1, [-D - T, -D, D, D + T])):
             on_face = rng.random(n) < 0.4
             q_old[on_face, a] = rng.choice(np.array(planes, np.float64), size=on_face.sum())
     step = rng.uniform(-0.004, 0.004, size=(n, 3)) * (rng.random((n, 3)) > 0.3)
