@@ -44,12 +44,18 @@ DEFAULT_RECORDINGS = Path("recordings")
 VERSIONED_PACKAGES = ("cosim", "warp-lang", "mujoco", "numpy", "control", "ruckig", "rerun-sdk")
 
 
+def cfs_head_reference(scene: PourScene, spacing: float) -> float:
+    """m, the liquid height over the crest CFS holds: the scene's ``cfs.h_q_ref``, at least
+    ``controller.stream_particles`` particle spacings (``spacing``, m) so that the stream is resolved."""
+    return max(scene.controller.cfs.h_q_ref, scene.controller.stream_particles_in(scene.fluid.dim) * spacing)
+
+
 def _controller_config(scene: PourScene, spacing: float):
     """``pour_config`` callback of :func:`build_pour`: the scene's controller settings on the simulated geometry."""
     c = scene.controller
+    h_q_ref = cfs_head_reference(scene, spacing)
 
     def make(geometry: VesselGeometry, catcher: CatcherConfig, fill: float, volume: float) -> PourConfig:
-        h_q_ref = max(c.cfs.h_q_ref, c.stream_particles * spacing)
         catcher = replace(
             catcher, travel_min=-c.catcher.travel, travel_max=c.catcher.travel, max_speed=c.catcher.max_speed,
             max_accel=c.catcher.max_accel, discharge_coefficient=c.catcher.discharge_coefficient,
@@ -218,6 +224,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
             fluid_threads=pour.fluid.lanes.count,
             dim=pour.fluid.config.dim,
             particle_spacing=pour.fluid.config.spacing,
+            cfs_head_reference=pour.controller.config.cfs.h_q_ref,
             trajectory={
                 "duration": float(trajectory.time[-1]),
                 "samples": int(len(trajectory.time)),

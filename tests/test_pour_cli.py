@@ -135,6 +135,7 @@ def test_same_scene_twice_gives_byte_identical_trajectories(tmp_path):
         ("[liquid]\nfill_depth = 0.5\n", "liquid.fill_depth"),
         ("[liquid]\nfill_depth = nan\n", "liquid.fill_depth"),
         ("[controller.cfs]\nh_q_ref = 1.0\n", "cfs.h_q_ref"),
+        ("[controller]\nstream_particles = 11.0\n", "controller.stream_particles"),
         ("[fluid]\nmax_tension = -1.0\n", "fluid.max_tension"),
         ("[fluid]\nfree_artificial_viscosity = 2.0\n", "fluid.free_artificial_viscosity"),
         ("device = 'tpu'\n", "scene.device"),
@@ -191,3 +192,30 @@ def test_a_section_changes_only_its_own_keys_of_the_scene_default(tmp_path, toml
     assert scene.coupling.max_duration == default.coupling.max_duration == 60.0
     assert scene.logging.recording.particle_rate_hz == default.logging.recording.particle_rate_hz == 30.0
     assert scene != default
+
+
+@pytest.mark.parametrize(
+    "toml, dim, across, head_in_spacings",
+    [
+        ("", 2, 32, 2.5),  # the default scene: 2.5 dx = 14.9 mm, over the seed's 5 mm
+        ("[fluid]\ndim = 3\nparticles_across = 16\n", 3, 16, 1.0),  # 3-D: one spacing, 11.9 mm
+        ("[fluid]\ndim = 3\nparticles_across = 16\n[controller]\nstream_particles = 2.5\n", 3, 16, 2.5),
+        ("[controller]\nstream_particles = 1.5\n", 2, 32, 1.5),
+    ],
+)
+def test_cfs_head_floor_is_stream_particles_spacings_by_dimension_unless_set(tmp_path, toml, dim, across, head_in_spacings):
+    from cosim.pour_run import cfs_head_reference
+
+    path = tmp_path / "scene.toml"
+    path.write_text(toml)
+    scene = load_scene(path)
+    spacing = 0.191 / across  # the default pourer's inner width over the particles across
+    assert scene.fluid.dim == dim
+    assert cfs_head_reference(scene, spacing) == pytest.approx(head_in_spacings * spacing, rel=1e-12)
+    fine = 0.191 / 100  # a fine 3-D liquid: the seed's own h_q_ref (5 mm) is the larger
+    assert cfs_head_reference(scene, fine) == scene.controller.cfs.h_q_ref == 0.005
+
+
+def test_scene_dump_leaves_stream_particles_unset_so_that_changing_dim_keeps_its_default(capsys):
+    assert main(["scene", "--dump"]) == 0
+    assert "# stream_particles = (not set)" in capsys.readouterr().out

@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 from cosim.bench.config import BenchCase, BenchConfig
 from cosim.fluid.config import KernelType, PressureSolver
 from cosim.fluid.runtime import cuda_available
-from cosim.pour_scene import FluidSettings
+from cosim.pour_scene import STREAM_PARTICLES, FluidSettings
 
 POUR_SECONDS = 3.0  # s simulated per pour row
 REFERENCE_ACROSS = 48  # particles across the pourer of the reference pour (1.5 x the default scene's 32)
@@ -121,10 +121,13 @@ def _skip_options(device: str) -> list[SkipOption]:
     def opt(cfg: BenchConfig, key: str, value) -> BenchConfig:
         return replace(cfg, options=cfg.options + ((key, value),))
 
-    flat = replace(at[16], length=DIM_PAIR_SECONDS)
+    # both at the 2-D CFS head, so that the pair differs only in the liquid's dimension, not in the controller's
+    # setting that follows it (pour_scene.STREAM_PARTICLES)
+    flat = opt(replace(at[16], length=DIM_PAIR_SECONDS), "controller.stream_particles", STREAM_PARTICLES[2])
     full_stop = replace(at[24], length=FULL_POUR_SECONDS)
     return [
-        SkipOption("2-D liquid in the pour plane", "fluid.dim = 2 (full: 3)", flat, replace(flat, dim=3)),
+        SkipOption("2-D liquid in the pour plane", f"fluid.dim = 2 (full: 3; both at controller.stream_particles = {STREAM_PARTICLES[2]:g})",
+                   flat, replace(flat, dim=3)),
         SkipOption("SIM only when the fill needs it", "controller.sim.mode = auto (full: always)", at[24],
                    opt(at[24], "controller.sim.mode", "always")),
         SkipOption("one-way coupling", "coupling.coupling = one_way (full: two_way)",
