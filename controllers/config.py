@@ -88,6 +88,9 @@ class ApproachConfig:
         check_range("approach.max_accel", self.max_accel, 0.0, 20.0, "rad/s^2", lo_open=True)
 
 
+CFS_MAX_HEAD = 0.05  # m, the largest liquid height over the crest CFS accepts as its reference
+
+
 @dataclass(frozen=True)
 class CfsConfig:
     """Constant-flow stage (seed Sec. 3.2).
@@ -118,7 +121,7 @@ class CfsConfig:
     final_stage_time: float = 0.8
 
     def __post_init__(self) -> None:
-        check_range("cfs.h_q_ref", self.h_q_ref, 0.001, 0.05, "m")
+        check_range("cfs.h_q_ref", self.h_q_ref, 0.001, CFS_MAX_HEAD, "m")
         check_range("cfs.time_constant", self.time_constant, 0.01, 10.0, "s")
         check_range("cfs.max_tilt_rate", self.max_tilt_rate, 0.0, 2.0, "rad/s", lo_open=True)
         check_range("cfs.max_tilt", self.max_tilt, 0.0, 2.5, "rad", lo_open=True)

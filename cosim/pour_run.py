@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from controllers.config import CatcherConfig, PourConfig
+from controllers.config import CFS_MAX_HEAD, CatcherConfig, PourConfig
 from controllers.geometry import VesselGeometry
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour, build_pour
@@ -46,8 +46,10 @@ VERSIONED_PACKAGES = ("cosim", "warp-lang", "mujoco", "numpy", "control", "rucki
 
 def cfs_head_reference(scene: PourScene, spacing: float) -> float:
     """m, the liquid height over the crest CFS holds: the scene's ``cfs.h_q_ref``, at least
-    ``controller.stream_particles`` particle spacings (``spacing``, m) so that the stream is resolved."""
-    return max(scene.controller.cfs.h_q_ref, scene.controller.stream_particles_in(scene.fluid.dim) * spacing)
+    ``controller.stream_particles`` particle spacings (``spacing``, m) so that the stream is resolved, but at most
+    ``CFS_MAX_HEAD`` (0.05 m; 2.1 spacings at the coarsest resolution, 8 across)."""
+    floor = scene.controller.stream_particles_in(scene.fluid.dim) * spacing
+    return max(scene.controller.cfs.h_q_ref, min(floor, CFS_MAX_HEAD))
 
 
 def _controller_config(scene: PourScene, spacing: float):

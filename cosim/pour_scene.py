@@ -154,9 +154,9 @@ STREAM_PARTICLES = {2: 2.5, 3: 1.0}
 class ControllerSettings:
     """control_rate: Hz, rate of the pour controller. [20, 500]
     stream_particles: the CFS liquid height over the crest is at least this many particle spacings, so that the
-      stream is resolved (the seed holds it near the smoothing length); a partial pour's final stage holds
-      cfs.final_head_fraction of it; not set: 2.5 in 2-D, 1.0 in 3-D (a 3-D sheet spreads sideways off the lip
-      under its head, README Pour results). [0, 10]
+      stream is resolved (the seed holds it near the smoothing length), up to 0.05 m (cfs.h_q_ref's limit); a
+      partial pour's final stage holds cfs.final_head_fraction of it; not set: 2.5 in 2-D, 1.0 in 3-D (a 3-D sheet
+      spreads sideways off the lip under its head, README Pour results). [0, 10]
     sim: slosh induction (seed Fig. 7).
     approach: tilt toward the crest without SIM.
     cfs: constant-flow stage (seed Sec. 3.2).

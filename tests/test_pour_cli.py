@@ -9,6 +9,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from controllers.config import CFS_MAX_HEAD
 from cosim.cli.main import main
 from cosim.frames import tilt_about_y
 from cosim.io.pour_series import read_series_csv
@@ -57,6 +58,7 @@ def test_outputs_and_summary(run):
     for key in ("initial_volume", "poured_volume", "spilled_volume", "phases", "sim_time", "wall_time", "real_time_factor", "device", "versions"):
         assert key in summary
     assert summary["initial_volume"] > 0 and summary["sim_time"] == pytest.approx(0.8)
+    assert summary["cfs_head_reference"] == pytest.approx(2.5 * summary["particle_spacing"])  # 2-D, 10 across: 48 mm
     assert [p["phase"] for p in summary["phases"]][0] == "idle"
     assert "landing" in summary
     series = read_series_csv(run / "series.csv")
@@ -219,3 +221,14 @@ def test_cfs_head_floor_is_stream_particles_spacings_by_dimension_unless_set(tmp
 def test_scene_dump_leaves_stream_particles_unset_so_that_changing_dim_keeps_its_default(capsys):
     assert main(["scene", "--dump"]) == 0
     assert "# stream_particles = (not set)" in capsys.readouterr().out
+
+
+def test_coarsest_resolution_pours_with_the_head_floor_capped_at_the_cfs_limit(tmp_path):
+    # 8 across: 2.5 spacings of 23.9 mm would be a 60 mm head, over cfs.h_q_ref's 0.05 m limit (the pour used to
+    # stop there with an error about cfs.h_q_ref, a key the scene did not set)
+    scene = tmp_path / "coarse.toml"
+    scene.write_text('name = "coarse"\n[fluid]\nparticles_across = 8\n[logging]\nenabled = false\n')
+    out = tmp_path / "coarse"
+    assert main(["pour", str(scene), "--out", str(out), "--quiet", "--duration", "0.05"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["cfs_head_reference"] == CFS_MAX_HEAD < 2.5 * summary["particle_spacing"]
