@@ -9,7 +9,7 @@ report, DIR/device_check.md, is printed at the end:
    (:data:`AGREEMENT_INTERVALS` intervals of 4 ms), WCSPH and DFSPH, 2-D and 3-D; the largest particle position
    difference in particle spacings and the largest wrench difference over the liquid's weight; the device run
    with its substeps replayed as captured graphs against launched one by one (and why capture failed, if it did).
-2. validation: the hydrostatic tank (0.5 s) and the slosh case (2 periods) on both: every metric side by side.
+2. validation: the hydrostatic tank (0.5 s) and the slosh case (:data:`SLOSH_PERIODS` periods) on both: every metric side by side.
 3. throughput: ``cosim.fluid.benchmark`` on the device (issue 7's sizes: 2-D 10k, 3-D 100k and 1M particles,
    both solvers, warp's ``example_sph`` beside the 3-D rows), and the 2-D row again without graph replay.
 4. pour: the coupled pour (robots, controllers, trajectory generation, no recording) on the device: the default
@@ -49,6 +49,9 @@ AGREEMENT_INTERVAL = 0.004  # s
 # s simulated and timed per pour, by dimension (after the warm-up): the 3-D pour at 112k particles plans 30,000
 # WCSPH substeps per simulated second (3,000 DFSPH), 15 s at 1 ms a substep
 POUR_SECONDS = {2: 2.0, 3: 0.5}
+# slosh periods run (the frequency is measured from a quarter period after the pulse: at 2 the window held too few
+# zero crossings and gave nan)
+SLOSH_PERIODS = 3.0
 POUR_WARM_UP = 0.05  # s simulated before timing: compiles the kernels, captures the graphs
 POUR_3D_ACROSS = 64  # particles across the pourer of the 3-D pour: 111,936 particles
 # seconds each check may take on the device machine: together within one 600 s call of the device tool
@@ -130,7 +133,7 @@ def check_validation(device: str, quick: bool) -> list[dict]:
 
     runs = (
         ("hydrostatic", hydrostatic.run, lambda d: hydrostatic.Params(device=d, duration=0.05 if quick else 0.5, spacing=0.191 / 16 if quick else None)),
-        ("slosh", slosh.run, lambda d: slosh.Params(device=d, periods=0.5 if quick else 2.0, spacing=0.191 / 16 if quick else None)),
+        ("slosh", slosh.run, lambda d: slosh.Params(device=d, periods=0.5 if quick else SLOSH_PERIODS, spacing=0.191 / 16 if quick else None)),
     )
     rows = []
     for name, run, params in runs:
@@ -218,6 +221,13 @@ def _pour_table(rows: list[dict]) -> list[str]:
 
 
 # ---- driver -----------------------------------------------------------------------------------------------
+def _text(output: bytes | str | None) -> str:
+    """A timed-out child's captured output as text (``subprocess`` hands it back as bytes, or None)."""
+    if isinstance(output, bytes):
+        return output.decode(errors="replace")
+    return output or ""
+
+
 def _run_one(check: str, device: str, quick: bool, out: Path) -> list[dict]:
     if check == "agreement":
         return check_agreement(device, quick)
@@ -273,8 +283,9 @@ def main(argv: list[str] | None = None) -> int:
             status = "ok" if done.returncode == 0 else f"failed (exit {done.returncode})"
             error = done.stderr.strip().splitlines()[-1] if done.returncode and done.stderr.strip() else ""
             write_text_atomic(args.out / f"{check}.log", done.stdout + done.stderr)
-        except subprocess.TimeoutExpired:
+        except subprocess.TimeoutExpired as timed_out:  # keep what the check printed before its limit
             status, error = "timed out", f"the {TIME_LIMITS[check]} s limit"
+            write_text_atomic(args.out / f"{check}.log", _text(timed_out.stdout) + _text(timed_out.stderr))
         result = {"status": status, "wall_s": time.perf_counter() - start, "error": error}
         if status == "ok":
             result["rows"] = json.loads((args.out / f"{check}.json").read_text())
