@@ -41,11 +41,9 @@ from cosim.vessel import VesselSpec
 TANK_ASPECT = 1.0  # the liquid block is as tall as it is wide
 
 
-def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, graphs: bool = True, threads: int = 0) -> tuple[float, float, int, float, int]:
-    """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s, threads) of our
-    solver on a resting liquid block of ~n particles, timed over intervals of ``steps`` WCSPH substeps after a
-    settling interval of the same length (kernel compilation, DFSPH's cold start and the CUDA graph capture
-    excluded)."""
+def resting_block(n: int, dim: int, device: str, steps: int, solver: PressureSolver, graphs: bool = True, threads: int = 0) -> tuple[FluidSolver, float]:
+    """The benchmark's liquid: a resting block of ~n particles in a tank, and the interval (s) of ``steps`` WCSPH
+    substeps that every solver is timed over."""
     width = 0.2
     depth = width if dim == 3 else 0.1
     cells = n ** (1.0 / dim)
@@ -58,7 +56,15 @@ def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: Press
     )
     block = liquid_block((-0.5 * width, -0.5 * depth, 0.0), (0.5 * width, 0.5 * depth, width * TANK_ASPECT), cfg)
     fluid = FluidSolver(cfg, [tank], [Pose()], block, device=device, graphs=graphs)
-    interval = steps * cfg.cfl * cfg.smoothing_length / cfg.sound_speed * 0.999
+    return fluid, steps * cfg.cfl * cfg.smoothing_length / cfg.sound_speed * 0.999
+
+
+def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, graphs: bool = True, threads: int = 0) -> tuple[float, float, int, float, int]:
+    """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s, threads) of our
+    solver on a resting liquid block of ~n particles, timed over intervals of ``steps`` WCSPH substeps after a
+    settling interval of the same length (kernel compilation, DFSPH's cold start and the CUDA graph capture
+    excluded)."""
+    fluid, interval = resting_block(n, dim, device, steps, solver, graphs, threads)
     fluid.advance(interval)  # warm-up: compiles, records, settles
     rates, speeds, dts = [], [], []
     for _ in range(repeats):
