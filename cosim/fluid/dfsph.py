@@ -89,6 +89,7 @@ from cosim.fluid.lanes import lane_item
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
+    diag_slot,
     add_wall_density,
     add_wall_reaction,
     finish_particle,
@@ -289,7 +290,7 @@ def compute_density_factor(
                         pair_mass_grad[i, count] = gm
                     count += 1
     if count > capacity:
-        wp.atomic_add(diag_i, row[0], DIAG_PAIR_OVERFLOW, 1)
+        wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
     density = bound_or_free_density(prm, vessels, motions, free_liquid, i, xi, density / prm.lattice_density, free, rest_offset)
     denominator = wp.max(wp.dot(grad_sum, grad_sum) + grad_sq, MIN_FACTOR_DENOMINATOR * prm.lattice_factor_denominator)
@@ -298,8 +299,8 @@ def compute_density_factor(
     increment[i] = warm
     increment_per_rho[i] = warm / density
     compression = wp.max(density - prm.rest_density, 0.0) / prm.rest_density
-    wp.atomic_max(diag_f, row[0], DIAG_MAX_DENSITY_ERROR, compression)
-    wp.atomic_max(diag_f, row[0], DIAG_MAX_COMPRESSION, compression)
+    wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_DENSITY_ERROR, compression)
+    wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_COMPRESSION, compression)
 
 
 @wp.func
@@ -468,7 +469,7 @@ def check_convergence(
         it_col = DIAG_DENSITY_ITERATIONS
     unconverged = error > tolerance or worst > MAX_PARTICLE_RESIDUAL
     keep_going[0] = wp.where(unconverged and iterations < wp.int64(prm.max_iterations), 1, 0)
-    s = row[0]
+    s = row[0] * prm.diag_replicas  # replica 0 of the substep's row
     diag_f[s, err_col] = error
     diag_i[s, it_col] = int(iterations)
 
@@ -538,7 +539,7 @@ def compute_wall_density_factor(
     if count == 0:
         return
     if count > capacity:
-        wp.atomic_add(diag_i, row[0], DIAG_PAIR_OVERFLOW, 1)
+        wp.atomic_add(diag_i, diag_slot(prm, row[0], b), DIAG_PAIR_OVERFLOW, 1)
     b_pair_count[b] = wp.min(count, capacity)
     density = density / prm.lattice_density
     b_rho[b] = density
@@ -879,7 +880,7 @@ def compute_nonpressure(
     v_star[i] = vi + dt[0] * a
     increment[i] = warm
     increment_per_rho[i] = warm / rhoi
-    wp.atomic_max(diag_f, row[0], DIAG_MAX_ACCEL, wp.length(a))
+    wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_ACCEL, wp.length(a))
 
 
 @wp.kernel
@@ -980,6 +981,6 @@ def integrate(
     x_old = x[i]
     vi = v_star[i]
     finish_particle(
-        prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, row[0], i, x_old, x_old + dt[0] * vi, vi, rho[i], dt[0],
+        prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, diag_slot(prm, row[0], i), i, x_old, x_old + dt[0] * vi, vi, rho[i], dt[0],
         x, v, active, wall_force, wall_torque, diag_f, diag_i,
     )

@@ -39,6 +39,15 @@ N_DIAG_INT_BASE = 7
 LANE_MAX_FIELDS = (DIAG_MAX_SPEED, DIAG_MAX_ACCEL, DIAG_MAX_DENSITY_ERROR, DIAG_MAX_COMPRESSION)
 
 
+def replicas_as_lanes(rows: np.ndarray, substeps: int, replicas: int) -> np.ndarray:
+    """The first ``substeps`` rows of every lane from an array (lanes, substeps x replicas, fields) whose rows are
+    replicated (``cosim.fluid.device_layout``), as (lanes x replicas, substeps, fields): each replica a lane of its
+    own for :func:`combine_lanes` (lane-major; with one replica, the rows themselves)."""
+    lanes, fields = rows.shape[0], rows.shape[2]
+    first = rows[:, : substeps * replicas].reshape(lanes, substeps, replicas, fields)
+    return first.transpose(0, 2, 1, 3).reshape(lanes * replicas, substeps, fields)
+
+
 def combine_lanes(lanes_f: np.ndarray, lanes_i: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The rows of all lanes (``cosim.fluid.lanes``; arrays (lanes, substeps, fields)) as one row per substep:
     maxima by the maximum, the rest summed over the lanes in lane order."""

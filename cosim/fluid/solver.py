@@ -41,9 +41,10 @@ from cosim.errors import InputError, SimulationError, count_of
 from cosim.fluid import boundary as bd
 from cosim.fluid import dfsph, wcsph
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
+from cosim.fluid.device_layout import DeviceLayout, layout_for, pair_table, reduction_levels
 from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, pair_capacity, sum_wall_wrench_chunks
 from cosim.fluid.diagnostics import (
-    DIAG_INTERNAL_ENERGY, DIAG_KINETIC_ENERGY, DIAG_POTENTIAL_ENERGY, DIAG_REMOVED_ENERGY, N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, combine_lanes,
+    DIAG_INTERNAL_ENERGY, DIAG_KINETIC_ENERGY, DIAG_POTENTIAL_ENERGY, DIAG_REMOVED_ENERGY, N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, combine_lanes, replicas_as_lanes,
     rows_to_records,
 )
 from cosim.fluid.energy import EnergyAccount
@@ -54,7 +55,6 @@ from cosim.fluid.seeding import ParticleSet
 from cosim.frames import Pose, rotation_vector, rotation_y, tilt_about_y, vector_norm
 from cosim.vessel import VesselSpec
 
-WRENCH_CHUNKS = 64  # first-level chunks of the fixed-order wrench reduction
 FORCE_CFL = 0.25  # Monaghan's force criterion dt <= 0.25 sqrt(h / a_max)
 VISCOUS_CFL = 0.125  # viscous criterion dt <= 0.125 h^2 / nu
 GUARD_MARGIN = 0.01  # the guard puts a particle this many dx outside the wall face it crossed
@@ -112,6 +112,7 @@ class FluidSolver:
         particles: ParticleSet,
         device: str = "cpu",
         graphs: bool = True,
+        layout: DeviceLayout | None = None,
     ):
         if len(vessels) != len(poses):
             raise InputError(f"fluid: {len(vessels)} vessels but {len(poses)} poses")
@@ -121,8 +122,9 @@ class FluidSolver:
             raise InputError("fluid.domain_min[1]..domain_max[1]: must contain y = 0 (the pour plane) in 2-D")
         self.config = config
         self.device = resolve_device(device)
+        self.layout = layout or layout_for(self.device)
         self.n_particles = len(particles)
-        self.model: FluidModel = build_model(config, tuple(vessels), self.n_particles, self.device)
+        self.model: FluidModel = build_model(config, tuple(vessels), self.n_particles, self.device, self.layout.diag_replicas)
         self.lanes = Lanes(lane_count(config.cpu_threads, self.n_particles, self.device), self.device)
         self.time = 0.0
         self.step_count = 0
@@ -174,15 +176,19 @@ class FluidSolver:
         self._lane_stats = PerLane(self._solve_stats[k] for k in range(self.lanes.count))
         capacity = pair_capacity(self.config.dim, self.config.smoothing_ratio)
         self._pair_count = wp.zeros(n, dtype=wp.int32, device=d)
-        self._pair_index = wp.zeros((n, capacity), dtype=wp.int32, device=d)
-        self._pair_grad = wp.zeros((n, capacity), dtype=wp.vec3, device=d)
+        by_column = self.layout.pairs_by_column
+        self._pair_index = pair_table(n, capacity, wp.int32, d, by_column)
+        self._pair_grad = pair_table(n, capacity, wp.vec3, d, by_column)
         dfsph_only = self.config.pressure_solver is PressureSolver.DFSPH
-        self._pair_mass_grad = wp.zeros((n, capacity), dtype=wp.vec3, device=d) if dfsph_only else None
+        self._pair_mass_grad = pair_table(n, capacity, wp.vec3, d, by_column) if dfsph_only else None
         self._keep_going = wp.zeros(1, dtype=wp.int32, device=d)
         self._wall_force = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
         self._wall_torque = wp.zeros((v_count, n), dtype=wp.vec3, device=d)
-        self._partial_force = wp.zeros((v_count, WRENCH_CHUNKS), dtype=wp.vec3, device=d)
-        self._partial_torque = wp.zeros((v_count, WRENCH_CHUNKS), dtype=wp.vec3, device=d)
+        self._wrench_levels = reduction_levels(n, self.layout.interleaved_reduction)
+        self._partial_wrench = [
+            (wp.zeros((v_count, level.chunks), dtype=wp.vec3, device=d), wp.zeros((v_count, level.chunks), dtype=wp.vec3, device=d))
+            for level in self._wrench_levels
+        ]
         self._force_sum = wp.zeros(v_count, dtype=wp.vec3, device=d)
         self._torque_sum = wp.zeros(v_count, dtype=wp.vec3, device=d)
         self._wrench_views = (self._force_sum.numpy(), self._torque_sum.numpy()) if d.is_cpu else None  # shared memory
@@ -199,8 +205,8 @@ class FluidSolver:
             self._b_kappa_density = wp.zeros(nb, dtype=float, device=d)
             self._b_kappa_divergence = wp.zeros(nb, dtype=float, device=d)
             self._b_pair_count = wp.zeros(nb, dtype=wp.int32, device=d)
-            self._b_pair_index = wp.zeros((nb, capacity), dtype=wp.int32, device=d)
-            self._b_pair_mass_grad = wp.zeros((nb, capacity), dtype=wp.vec3, device=d)
+            self._b_pair_index = pair_table(nb, capacity, wp.int32, d, by_column)
+            self._b_pair_mass_grad = pair_table(nb, capacity, wp.vec3, d, by_column)
             if self.config.density_iteration is DensityIteration.GAUSS_SEIDEL:  # dfsph.list_sweep_cells
                 threads = self._sweep_threads()
                 per_thread = -(-(n + nb) // threads)
@@ -238,9 +244,9 @@ class FluidSolver:
         if n <= self._rows_capacity:
             return
         self._rows_capacity = max(n, 2 * self._rows_capacity)
-        lanes = self.lanes.count
-        self._diag_f = wp.zeros((lanes, self._rows_capacity, N_DIAG_FLOAT), dtype=float, device=self.device)
-        self._diag_i = wp.zeros((lanes, self._rows_capacity, N_DIAG_INT_BASE + self.model.n_vessels), dtype=wp.int32, device=self.device)
+        lanes, slots = self.lanes.count, self._rows_capacity * self.layout.diag_replicas
+        self._diag_f = wp.zeros((lanes, slots, N_DIAG_FLOAT), dtype=float, device=self.device)
+        self._diag_i = wp.zeros((lanes, slots, N_DIAG_INT_BASE + self.model.n_vessels), dtype=wp.int32, device=self.device)
         self._lane_diag_f = PerLane(self._diag_f[k] for k in range(lanes))
         self._lane_diag_i = PerLane(self._diag_i[k] for k in range(lanes))
         self._diag_views = (self._diag_f.numpy(), self._diag_i.numpy()) if self.device.is_cpu else None  # shared memory
@@ -330,7 +336,7 @@ class FluidSolver:
         if self._capture_graphs and self._graphs is None:
             self._graphs = self._capture()
         diag_f, diag_i = self._diag_views or (self._diag_f.numpy(), self._diag_i.numpy())
-        rows_f, rows_i = combine_lanes(diag_f[:, :n_sub], diag_i[:, :n_sub])
+        rows_f, rows_i = combine_lanes(*(replicas_as_lanes(a, n_sub, self.layout.diag_replicas) for a in (diag_f, diag_i)))
         first = self.step_count
         t0 = self.time
         self.step_count += n_sub
@@ -377,9 +383,12 @@ class FluidSolver:
             stages += self._wcsph_commands(dst)
         tail = []
         if nv:
-            chunk = math.ceil(n / WRENCH_CHUNKS)
-            tail.append(self._rec(sum_wall_wrench_chunks, (nv, WRENCH_CHUNKS), [n, chunk, self._wall_force, self._wall_torque], [self._partial_force, self._partial_torque]))
-            tail.append(self._rec(accumulate_wall_wrench, nv, [WRENCH_CHUNKS, self._partial_force, self._partial_torque], [self._force_sum, self._torque_sum]))
+            source, length = (self._wall_force, self._wall_torque), n
+            for level, partial in zip(self._wrench_levels, self._partial_wrench):
+                bounds = [level.length, level.first_stride, level.item_stride, level.items]
+                tail.append(self._rec(sum_wall_wrench_chunks, (nv, level.chunks), [*bounds, *source], partial))
+                source, length = partial, level.chunks
+            tail.append(self._rec(accumulate_wall_wrench, nv, [length, *source], [self._force_sum, self._torque_sum]))
         tail.append(self._rec(next_substep, 1, [self._row]))
         stages.append(lanes.on_lane(0, *tail))
         return stages

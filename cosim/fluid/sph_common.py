@@ -222,6 +222,13 @@ def finish_particle(
     return 1
 
 
+@wp.func
+def diag_slot(prm: SPHParams, row: int, i: int) -> int:
+    """The diagnostics row particle ``i`` writes for substep ``row``: its replica of that row
+    (``cosim.fluid.device_layout``; one replica on the CPU: the row itself)."""
+    return row * prm.diag_replicas + i % prm.diag_replicas
+
+
 @wp.kernel
 def gather_particles(
     lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
@@ -265,17 +272,24 @@ def gather_particles(
 @wp.kernel
 def sum_wall_wrench_chunks(
     n: int,
-    chunk: int,
+    first_stride: int,
+    item_stride: int,
+    items: int,
     wall_force: wp.array2d(dtype=wp.vec3),
     wall_torque: wp.array2d(dtype=wp.vec3),
     partial_force: wp.array2d(dtype=wp.vec3),
     partial_torque: wp.array2d(dtype=wp.vec3),
 ):
-    """First level of the fixed-order reduction: chunk c of vessel k summed sequentially."""
+    """One level of the fixed-order reduction of ``n`` items per vessel: chunk c of vessel k sums the items
+    c * first_stride + j * item_stride, j = 0, 1, ... below ``items`` and ``n``, in order
+    (``cosim.fluid.device_layout.ReductionLevel``)."""
     k, c = wp.tid()
     f = wp.vec3(0.0)
     t = wp.vec3(0.0)
-    for i in range(c * chunk, wp.min((c + 1) * chunk, n)):
+    for j in range(items):
+        i = c * first_stride + j * item_stride
+        if i >= n:
+            break
         f += wall_force[k, i]
         t += wall_torque[k, i]
     partial_force[k, c] = f

@@ -36,6 +36,7 @@ from cosim.fluid.lanes import lane_item
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
+    diag_slot,
     add_wall_density,
     add_wall_reaction,
     finish_particle,
@@ -258,7 +259,7 @@ def compute_forces(
                     a += ab
                     add_wall_reaction(prm, vessels, motions, b_vessel[b], i, xb, ab, wall_force, wall_torque)
     if count > capacity:
-        wp.atomic_add(diag_i, row[0], DIAG_PAIR_OVERFLOW, 1)
+        wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
     a += prm.gravity
     acc[i] = a
@@ -268,7 +269,7 @@ def compute_forces(
     if wp.determinant(moment) > RENORMALISATION_MIN_DET:
         grad = wp.inverse(moment) @ gsum
     rho_grad[i] = grad
-    wp.atomic_max(diag_f, row[0], DIAG_MAX_ACCEL, wp.length(a))
+    wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_ACCEL, wp.length(a))
 
 
 @wp.kernel
@@ -357,7 +358,7 @@ def integrate(
     i = lane_item(wp.tid(), lane)
     if active[i] == 0:
         return
-    s = row[0]
+    s = diag_slot(prm, row[0], i)
     h = dt[0]
     x_old = x[i]
     vi = v[i] + h * acc[i]

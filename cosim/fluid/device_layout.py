@@ -1,0 +1,86 @@
+"""How the solver lays out its neighbour-pair tables and its reductions for the kind of device it runs on.
+
+The CPU runs a particle kernel as one loop per lane (``cosim.fluid.lanes``): a particle's data should be contiguous
+for the cache. CUDA runs a thread per particle in warps of 32 that load together: the same field of 32 neighbouring
+particles should be contiguous (coalesced loads), and no one address should take an atomic from every particle.
+The first profile on an H200 (``python -m cosim.bench.kernel_profile``, 3-D WCSPH at 1M particles, 21.6 ms a
+substep) found all three costs: the pair loops reading rows of the pair tables (compute_density_rate 4.1 ms), the
+wrench reduction's 64 sequential chunks (4.8 ms) and integrate's atomics on one diagnostics row (4.4 ms).
+
+- Pair tables (n x capacity, indexed ``[i, k]``): a row per particle on the CPU; on CUDA stored slot-major
+  (capacity x n) and passed transposed, so ``[i, k]`` of 32 consecutive particles is 32 consecutive addresses. The
+  kernels are the same: a warp array's strides carry the layout.
+- The wall wrench (a sum over every particle per vessel, in a fixed order): on the CPU :data:`WRENCH_CHUNKS`
+  contiguous chunks; on CUDA levels of chunks of :data:`REDUCTION_ITEMS` interleaved items (chunk c sums items c,
+  c + chunks, ...: consecutive threads read consecutive addresses), until few enough partial sums remain.
+- Diagnostics rows: on CUDA each substep's row is replicated :data:`CUDA_DIAG_REPLICAS` times and particle i
+  writes replica i mod replicas, so each address takes 1/replicas of the atomics; the host combines the replicas
+  as it combines the lanes (maxima by the maximum, the rest summed).
+
+The particle state is the same bit for bit under either layout; the wrench and the energy sums add the same terms
+in another order (tests/test_fluid_device_layout.py).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import warp as wp
+
+WRENCH_CHUNKS = 64  # CPU: contiguous first-level chunks of the fixed-order wrench reduction
+REDUCTION_ITEMS = 64  # CUDA: items one thread sums per level of the interleaved reduction
+CUDA_DIAG_REPLICAS = 64  # CUDA: replicas of each diagnostics row (atomics per address divided by this)
+
+
+@dataclass(frozen=True)
+class DeviceLayout:
+    """pairs_by_column: pair tables slot-major (CUDA) instead of particle-major. interleaved_reduction: the
+    wrench reduced in interleaved levels (CUDA) instead of contiguous chunks. diag_replicas: copies of each
+    diagnostics row the particles spread their atomics over."""
+
+    pairs_by_column: bool
+    interleaved_reduction: bool
+    diag_replicas: int
+
+
+CPU_LAYOUT = DeviceLayout(pairs_by_column=False, interleaved_reduction=False, diag_replicas=1)
+CUDA_LAYOUT = DeviceLayout(pairs_by_column=True, interleaved_reduction=True, diag_replicas=CUDA_DIAG_REPLICAS)
+
+
+def layout_for(device) -> DeviceLayout:
+    """The layout for a warp device."""
+    return CUDA_LAYOUT if device.is_cuda else CPU_LAYOUT
+
+
+def pair_table(rows: int, capacity: int, dtype, device, by_column: bool) -> wp.array:
+    """A zeroed ``rows x capacity`` table indexed ``[row, slot]``, stored slot-major when ``by_column``."""
+    if by_column:
+        return wp.zeros((capacity, rows), dtype=dtype, device=device).transpose()
+    return wp.zeros((rows, capacity), dtype=dtype, device=device)
+
+
+@dataclass(frozen=True)
+class ReductionLevel:
+    """One level: ``chunks`` partial sums of a list of ``length`` items; chunk c sums the items
+    c * first_stride + j * item_stride for j < items (those below ``length``), in that order."""
+
+    length: int
+    chunks: int
+    first_stride: int
+    item_stride: int
+    items: int
+
+
+def reduction_levels(n: int, interleaved: bool) -> list[ReductionLevel]:
+    """The levels that reduce ``n`` items to at most :data:`WRENCH_CHUNKS` (contiguous) or
+    :data:`REDUCTION_ITEMS` (interleaved) partial sums, which a last pass adds in order."""
+    if not interleaved:
+        chunk = math.ceil(n / WRENCH_CHUNKS)
+        return [ReductionLevel(n, WRENCH_CHUNKS, chunk, 1, chunk)]
+    levels, length = [], n
+    while length > REDUCTION_ITEMS:
+        chunks = math.ceil(length / REDUCTION_ITEMS)
+        levels.append(ReductionLevel(length, chunks, 1, chunks, REDUCTION_ITEMS))
+        length = chunks
+    return levels
