@@ -11,7 +11,8 @@ report, DIR/device_check.md, is printed at the end:
    with its substeps replayed as captured graphs against launched one by one (and why capture failed, if it did).
 2. validation: the hydrostatic tank (0.5 s) and the slosh case (:data:`SLOSH_PERIODS` periods) on both: every metric side by side.
 3. throughput: ``cosim.fluid.benchmark`` on the device (issue 7's sizes: 2-D 10k, 3-D 100k and 1M particles,
-   both solvers, warp's ``example_sph`` beside the 3-D rows), and the 2-D row again without graph replay.
+   both solvers, warp's ``example_sph`` beside the 3-D rows; DFSPH again with the Jacobi density iteration), and
+   the 2-D rows again without graph replay.
 4. pour: the coupled pour (robots, controllers, trajectory generation, no recording) on the device: the default
    2-D scene (its own solver, DFSPH with Gauss-Seidel density sweeps), and the 3-D one at 64 across (~112k
    particles) under WCSPH and DFSPH with the Jacobi density solve (the GPU's choice for large scenes: a Gauss-Seidel
@@ -164,6 +165,7 @@ def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
     table.unlink(missing_ok=True)  # the benchmark appends: start this run's table afresh
     common = ["--device", device, "--solvers", "wcsph", "dfsph", "--out", str(table)]
     benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *common])
+    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *common[:2], "--solvers", "dfsph", "--density-iteration", "jacobi", *common[-2:]])
     benchmark.main(["--counts2d", *counts2d, "--counts3d", "--no-graphs", *common])
     return [{"table": table.read_text()}]
 

@@ -1,10 +1,10 @@
 """Where a substep's device time goes: every kernel and memory operation of the fluid benchmark's resting block,
 timed by warp's CUDA activity timing (a profile, not a benchmark: launches run one by one so each is timed).
 
-    python -m cosim.bench.kernel_profile [--device cuda] [--cases 3:1000000:wcsph 2:10000:dfsph] [--steps 20]
+    python -m cosim.bench.kernel_profile [--device cuda] [--cases 3:1000000:wcsph 2:10000:dfsph:jacobi] [--steps 20]
                                          [--top 12] [--out DIR]
 
-For each case (dim:particles:solver) the block of ``cosim.fluid.benchmark`` settles for one interval of ``steps``
+For each case (dim:particles:solver, and for DFSPH optionally :gauss_seidel or :jacobi, its density iteration) the block of ``cosim.fluid.benchmark`` settles for one interval of ``steps``
 WCSPH substeps, then one more interval is timed: the wall time, the sum of the device activities (their
 difference is the host's launch and synchronisation cost), and the ``top`` activities by total time, with their
 count and milliseconds per substep. On the CPU warp times nothing per kernel: only the wall time is reported.
@@ -22,19 +22,19 @@ import warp as wp
 
 from cosim.atomic_files import write_text_atomic
 from cosim.fluid.benchmark import resting_block
-from cosim.fluid.config import PressureSolver
+from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.runtime import resolve_device
 
 
-def parse_case(text: str) -> tuple[int, int, PressureSolver]:
-    """``dim:particles:solver`` as (dim, particles, solver)."""
-    dim, n, solver = text.split(":")
-    return int(dim), int(n), PressureSolver(solver)
+def parse_case(text: str) -> tuple[int, int, PressureSolver, DensityIteration]:
+    """``dim:particles:solver[:iteration]`` as (dim, particles, solver, DFSPH's density iteration)."""
+    dim, n, solver, *iteration = text.split(":")
+    return int(dim), int(n), PressureSolver(solver), DensityIteration(iteration[0]) if iteration else FluidConfig.density_iteration
 
 
-def profile_case(dim: int, n: int, solver: PressureSolver, device: str, steps: int, top: int) -> list[str]:
+def profile_case(dim: int, n: int, solver: PressureSolver, iteration: DensityIteration, device: str, steps: int, top: int) -> list[str]:
     """The case's lines of the report: a heading, the wall and device totals, the table of the top activities."""
-    fluid, interval = resting_block(n, dim, device, steps, solver, graphs=False)
+    fluid, interval = resting_block(n, dim, device, steps, solver, graphs=False, iteration=iteration)
     fluid.advance(interval)  # compiles, settles
     timed = fluid.device.is_cuda
     if timed:
@@ -51,7 +51,7 @@ def profile_case(dim: int, n: int, solver: PressureSolver, device: str, steps: i
     device_ms = sum(total.values())
     sub = report.substeps
     lines = [
-        f"## {dim}-D, {fluid.n_particles} particles, {solver.value}, {fluid.device}",
+        f"## {dim}-D, {fluid.n_particles} particles, {solver.value}{f' ({iteration.value})' if solver is PressureSolver.DFSPH else ''}, {fluid.device}",
         "",
         f"{sub} substeps: wall {wall_ms:.2f} ms ({wall_ms / sub:.3f} ms a substep), device activities {device_ms:.2f} ms "
         f"({device_ms / sub:.3f} ms a substep, {len(results)} activities, {len(results) / sub:.0f} a substep).",
@@ -68,7 +68,7 @@ def profile_case(dim: int, n: int, solver: PressureSolver, device: str, steps: i
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--device", default="cuda")
-    p.add_argument("--cases", nargs="*", default=["3:1000000:wcsph", "3:1000000:dfsph", "2:10000:wcsph", "2:10000:dfsph"],
+    p.add_argument("--cases", nargs="*", default=["3:1000000:wcsph", "3:1000000:dfsph:jacobi", "3:1000000:dfsph:gauss_seidel", "2:10000:wcsph", "2:10000:dfsph:jacobi", "2:10000:dfsph:gauss_seidel"],
                    help="dim:particles:solver, one profile each")
     p.add_argument("--steps", type=int, default=20, help="WCSPH substeps per interval (the benchmark's)")
     p.add_argument("--top", type=int, default=12, help="activities listed per case")
@@ -77,8 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     device = str(resolve_device(args.device))
     lines = [f"# Kernel profile ({device})", ""]
     for case in args.cases:
-        dim, n, solver = parse_case(case)
-        case_lines = profile_case(dim, n, solver, device, args.steps, args.top)
+        case_lines = profile_case(*parse_case(case), device, args.steps, args.top)
         print("\n".join(case_lines), flush=True)
         lines += case_lines
     args.out.mkdir(parents=True, exist_ok=True)

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import warp as wp
 
-from cosim.fluid.config import FluidConfig, PressureSolver
+from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import liquid_block
 from cosim.fluid.solver import FluidSolver
@@ -41,9 +41,12 @@ from cosim.vessel import VesselSpec
 TANK_ASPECT = 1.0  # the liquid block is as tall as it is wide
 
 
-def resting_block(n: int, dim: int, device: str, steps: int, solver: PressureSolver, graphs: bool = True, threads: int = 0) -> tuple[FluidSolver, float]:
+def resting_block(
+    n: int, dim: int, device: str, steps: int, solver: PressureSolver, graphs: bool = True, threads: int = 0,
+    iteration: DensityIteration = FluidConfig.density_iteration,
+) -> tuple[FluidSolver, float]:
     """The benchmark's liquid: a resting block of ~n particles in a tank, and the interval (s) of ``steps`` WCSPH
-    substeps that every solver is timed over."""
+    substeps that every solver is timed over (``iteration``: DFSPH's density iteration)."""
     width = 0.2
     depth = width if dim == 3 else 0.1
     cells = n ** (1.0 / dim)
@@ -51,7 +54,7 @@ def resting_block(n: int, dim: int, device: str, steps: int, solver: PressureSol
     tank = VesselSpec(name="tank", inner_width=width, inner_depth=depth, inner_height=1.5 * width)
     m = 0.1 * width
     cfg = FluidConfig(
-        dim=dim, spacing=dx, max_expected_speed=2 * math.sqrt(9.81 * width), pressure_solver=solver, cpu_threads=threads,
+        dim=dim, spacing=dx, max_expected_speed=2 * math.sqrt(9.81 * width), pressure_solver=solver, cpu_threads=threads, density_iteration=iteration,
         domain_min=(-0.5 * width - m, -0.5 * depth - m, -m), domain_max=(0.5 * width + m, 0.5 * depth + m, 1.5 * width + m),
     )
     block = liquid_block((-0.5 * width, -0.5 * depth, 0.0), (0.5 * width, 0.5 * depth, width * TANK_ASPECT), cfg)
@@ -59,12 +62,14 @@ def resting_block(n: int, dim: int, device: str, steps: int, solver: PressureSol
     return fluid, steps * cfg.cfl * cfg.smoothing_length / cfg.sound_speed * 0.999
 
 
-def _ours(n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, graphs: bool = True, threads: int = 0) -> tuple[float, float, int, float, int]:
+def _ours(
+    n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, graphs: bool, threads: int, iteration: DensityIteration,
+) -> tuple[float, float, int, float, int]:
     """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s, threads) of our
     solver on a resting liquid block of ~n particles, timed over intervals of ``steps`` WCSPH substeps after a
     settling interval of the same length (kernel compilation, DFSPH's cold start and the CUDA graph capture
     excluded)."""
-    fluid, interval = resting_block(n, dim, device, steps, solver, graphs, threads)
+    fluid, interval = resting_block(n, dim, device, steps, solver, graphs, threads, iteration)
     fluid.advance(interval)  # warm-up: compiles, records, settles
     rates, speeds, dts = [], [], []
     for _ in range(repeats):
@@ -134,6 +139,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--solvers", nargs="*", choices=[s.value for s in PressureSolver], default=[s.value for s in PressureSolver])
     p.add_argument("--threads", type=int, nargs="*", default=[0], help="CPU threads of the solver, one row each (0: one per core)")
+    p.add_argument("--density-iteration", choices=[i.value for i in DensityIteration], default=FluidConfig.density_iteration.value,
+                   help="DFSPH's density iteration (jacobi: every particle at once, the GPU's choice for large liquids)")
     p.add_argument("--no-graphs", action="store_true", help="run a substep's launches one by one instead of replaying its captured graph")
     p.add_argument("--out", type=Path, default=None, help="append the table to this Markdown file")
     args = p.parse_args(argv)
@@ -144,7 +151,9 @@ def main(argv: list[str] | None = None) -> int:
             theirs = float("nan")
             for name in args.solvers:
                 for threads in args.threads:
-                    ours, sim_rate, actual, dt, used = _ours(n, dim, str(device), args.steps, args.repeats, PressureSolver(name), not args.no_graphs, threads)
+                    ours, sim_rate, actual, dt, used = _ours(
+                        n, dim, str(device), args.steps, args.repeats, PressureSolver(name), not args.no_graphs, threads, DensityIteration(args.density_iteration),
+                    )
                     if dim == 3 and math.isnan(theirs):
                         theirs = _example_sph(actual, str(device), args.steps, args.repeats)
                     rows.append((dim, actual, name, used, ours, sim_rate, dt, theirs))
@@ -160,7 +169,7 @@ def main(argv: list[str] | None = None) -> int:
         f"Machine: {_machine()}. Versions: Python {platform.python_version()}, warp {wp.__version__}, numpy {np.__version__}.\n"
         f"Command: `python -m cosim.fluid.benchmark --device {args.device} --counts2d {' '.join(map(str, args.counts2d))} "
         f"--counts3d {' '.join(map(str, args.counts3d))} --solvers {' '.join(args.solvers)} --threads {' '.join(map(str, args.threads))} "
-        f"--steps {args.steps} --repeats {args.repeats}"
+        f"--steps {args.steps} --repeats {args.repeats} --density-iteration {args.density_iteration}"
         f"{' --no-graphs' if args.no_graphs else ''}`. "
         f"Median of {args.repeats} intervals of {args.steps} WCSPH substeps' simulated time after a settling interval; one step "
         "is the full substep (walls, neighbour sort and reorder, the pressure solver's stages, integration, wrench "

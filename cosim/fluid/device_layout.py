@@ -13,7 +13,7 @@ wrench reduction's 64 sequential chunks (4.8 ms) and integrate's atomics on one 
 - The wall wrench (a sum over every particle per vessel, in a fixed order): on the CPU :data:`WRENCH_CHUNKS`
   contiguous chunks; on CUDA levels of chunks of :data:`REDUCTION_ITEMS` interleaved items (chunk c sums items c,
   c + chunks, ...: consecutive threads read consecutive addresses), until few enough partial sums remain.
-- Diagnostics rows: on CUDA each substep's row is replicated :data:`CUDA_DIAG_REPLICAS` times and particle i
+- Diagnostics rows: on CUDA each substep's row is replicated :data:`CUDA_ATOMIC_REPLICAS` times and particle i
   writes replica i mod replicas, so each address takes 1/replicas of the atomics; the host combines the replicas
   as it combines the lanes (maxima by the maximum, the rest summed).
 
@@ -30,22 +30,22 @@ import warp as wp
 
 WRENCH_CHUNKS = 64  # CPU: contiguous first-level chunks of the fixed-order wrench reduction
 REDUCTION_ITEMS = 64  # CUDA: items one thread sums per level of the interleaved reduction
-CUDA_DIAG_REPLICAS = 64  # CUDA: replicas of each diagnostics row (atomics per address divided by this)
+CUDA_ATOMIC_REPLICAS = 64  # CUDA: replicas of each diagnostics row (atomics per address divided by this)
 
 
 @dataclass(frozen=True)
 class DeviceLayout:
     """pairs_by_column: pair tables slot-major (CUDA) instead of particle-major. interleaved_reduction: the
-    wrench reduced in interleaved levels (CUDA) instead of contiguous chunks. diag_replicas: copies of each
+    wrench reduced in interleaved levels (CUDA) instead of contiguous chunks. atomic_replicas: copies of each
     diagnostics row the particles spread their atomics over."""
 
     pairs_by_column: bool
     interleaved_reduction: bool
-    diag_replicas: int
+    atomic_replicas: int
 
 
-CPU_LAYOUT = DeviceLayout(pairs_by_column=False, interleaved_reduction=False, diag_replicas=1)
-CUDA_LAYOUT = DeviceLayout(pairs_by_column=True, interleaved_reduction=True, diag_replicas=CUDA_DIAG_REPLICAS)
+CPU_LAYOUT = DeviceLayout(pairs_by_column=False, interleaved_reduction=False, atomic_replicas=1)
+CUDA_LAYOUT = DeviceLayout(pairs_by_column=True, interleaved_reduction=True, atomic_replicas=CUDA_ATOMIC_REPLICAS)
 
 
 def layout_for(device) -> DeviceLayout:

@@ -153,6 +153,14 @@ STATS_ROW_STRIDE = 16
 
 
 @wp.func
+def stat_slot(prm: SPHParams, item: int, field: int) -> int:
+    """Where ``item`` adds to ``field`` in its lane's row of solve_stats: its replica's copy (replicas padded to
+    :data:`STATS_ROW_STRIDE`; ``cosim.fluid.device_layout``: one replica on the CPU, the row itself). The fields
+    are integers, so the sums are the same in any order and for any number of replicas."""
+    return (item % prm.atomic_replicas) * STATS_ROW_STRIDE + field
+
+
+@wp.func
 def bound_or_free_density(
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -246,7 +254,7 @@ def compute_density_factor(
         increment[i] = 0.0
         increment_per_rho[i] = 0.0
         return
-    wp.atomic_add(solve_stats, STAT_COUNT, wp.int64(1))
+    wp.atomic_add(solve_stats, stat_slot(prm, i, STAT_COUNT), wp.int64(1))
     xi = x[i]
     support2 = prm.support * prm.support
     density = prm.mass * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
@@ -427,8 +435,8 @@ def compute_solve_error(
     increment[i] = k_i
     increment_per_rho[i] = k_i / rho[i]
     quanta = error_quanta(e / prm.rest_density)
-    wp.atomic_add(solve_stats, STAT_ERROR, quanta)
-    wp.atomic_max(solve_stats, STAT_MAX_ERROR, quanta)
+    wp.atomic_add(solve_stats, stat_slot(prm, i, STAT_ERROR), quanta)
+    wp.atomic_max(solve_stats, stat_slot(prm, i, STAT_MAX_ERROR), quanta)
 
 
 @wp.kernel
@@ -469,7 +477,7 @@ def check_convergence(
         it_col = DIAG_DENSITY_ITERATIONS
     unconverged = error > tolerance or worst > MAX_PARTICLE_RESIDUAL
     keep_going[0] = wp.where(unconverged and iterations < wp.int64(prm.max_iterations), 1, 0)
-    s = row[0] * prm.diag_replicas  # replica 0 of the substep's row
+    s = row[0] * prm.atomic_replicas  # replica 0 of the substep's row
     diag_f[s, err_col] = error
     diag_i[s, it_col] = int(iterations)
 
@@ -544,7 +552,7 @@ def compute_wall_density_factor(
     density = density / prm.lattice_density
     b_rho[b] = density
     b_alpha[b] = density / wp.max(grad_sq, MIN_FACTOR_DENOMINATOR * prm.lattice_factor_denominator)
-    wp.atomic_add(solve_stats, STAT_COUNT, wp.int64(1))
+    wp.atomic_add(solve_stats, stat_slot(prm, b, STAT_COUNT), wp.int64(1))
 
 
 @wp.kernel
@@ -612,8 +620,8 @@ def compute_wall_solve_error(
     b_increment[b] = k_b
     b_increment_per_rho[b] = k_b / b_rho[b]
     quanta = error_quanta(e / prm.rest_density)
-    wp.atomic_add(solve_stats, STAT_ERROR, quanta)
-    wp.atomic_max(solve_stats, STAT_MAX_ERROR, quanta)
+    wp.atomic_add(solve_stats, stat_slot(prm, b, STAT_ERROR), quanta)
+    wp.atomic_max(solve_stats, stat_slot(prm, b, STAT_MAX_ERROR), quanta)
 
 
 @wp.func
@@ -806,8 +814,8 @@ def gauss_seidel_density_sweep(
             total += q
             worst = wp.max(worst, q)
     if total > wp.int64(0):
-        wp.atomic_add(solve_stats, STAT_ERROR, total)
-        wp.atomic_max(solve_stats, STAT_MAX_ERROR, worst)
+        wp.atomic_add(solve_stats, stat_slot(prm, thread, STAT_ERROR), total)
+        wp.atomic_max(solve_stats, stat_slot(prm, thread, STAT_MAX_ERROR), worst)
 
 
 @wp.func

@@ -66,7 +66,7 @@ def _geometry(spec: VesselSpec, wall_thickness: float) -> VesselGeometry:
     return geo
 
 
-def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: int, device, diag_replicas: int = 1) -> FluidModel:
+def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: int, device, atomic_replicas: int = 1) -> FluidModel:
     """Fill the walls with dummy particles and allocate the static arrays."""
     walls = [sample_vessel_walls(s, cfg.spacing, cfg.support_radius, cfg.dim) for s in specs]
     samples = [w[0] for w in walls]
@@ -80,7 +80,7 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
     return FluidModel(
         config=cfg,
         device=device,
-        params=make_params(cfg, len(specs), diag_replicas),
+        params=make_params(cfg, len(specs), atomic_replicas),
         vessel_specs=tuple(specs),
         vessels=wp.array([_geometry(s, t) for s, t in zip(specs, thickness)], dtype=VesselGeometry, device=device),
         b_local=wp.array(b_local.astype(np.float32), dtype=wp.vec3, device=device),

@@ -26,7 +26,7 @@ class SPHParams:
     lattice over rho0 (DFSPH and WCSPH's free liquid divide their summation density by it, so the liquid as seeded
     is at rest density) and ``lattice_factor_denominator``, sum_j |m grad W|^2 of a particle inside that lattice
     (kg^2/m^(2 dim + 2)), the scale below which DFSPH does not let a factor's denominator fall; ``jacobi_relaxation``
-    the factor (<= 1) DFSPH's Jacobi increments are scaled by (:data:`JACOBI_GAIN_LIMIT`); ``diag_replicas`` the copies
+    the factor (<= 1) DFSPH's Jacobi increments are scaled by (:data:`JACOBI_GAIN_LIMIT`); ``atomic_replicas`` the copies
     of each diagnostics row the particles spread their atomics over (``cosim.fluid.device_layout``)."""
 
     dim: int
@@ -56,10 +56,10 @@ class SPHParams:
     lattice_density: float
     lattice_factor_denominator: float
     jacobi_relaxation: float
-    diag_replicas: int
+    atomic_replicas: int
 
 
-def make_params(cfg: FluidConfig, n_vessels: int, diag_replicas: int = 1) -> SPHParams:
+def make_params(cfg: FluidConfig, n_vessels: int, atomic_replicas: int = 1) -> SPHParams:
     p = SPHParams()
     h = cfg.smoothing_length
     p.dim = cfg.dim
@@ -90,5 +90,5 @@ def make_params(cfg: FluidConfig, n_vessels: int, diag_replicas: int = 1) -> SPH
     p.lattice_density = lattice_kernel_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim)
     p.lattice_factor_denominator = lattice_gradient_square_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim) * (cfg.particle_mass / cfg.spacing ** (cfg.dim + 1)) ** 2
     p.jacobi_relaxation = min(1.0, JACOBI_GAIN_LIMIT / lattice_jacobi_gain(cfg.kernel, cfg.smoothing_ratio, cfg.dim))
-    p.diag_replicas = diag_replicas
+    p.atomic_replicas = atomic_replicas
     return p

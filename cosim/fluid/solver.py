@@ -124,7 +124,7 @@ class FluidSolver:
         self.device = resolve_device(device)
         self.layout = layout or layout_for(self.device)
         self.n_particles = len(particles)
-        self.model: FluidModel = build_model(config, tuple(vessels), self.n_particles, self.device, self.layout.diag_replicas)
+        self.model: FluidModel = build_model(config, tuple(vessels), self.n_particles, self.device, self.layout.atomic_replicas)
         self.lanes = Lanes(lane_count(config.cpu_threads, self.n_particles, self.device), self.device)
         self.time = 0.0
         self.step_count = 0
@@ -172,8 +172,9 @@ class FluidSolver:
         self._alpha = wp.zeros(n, dtype=float, device=d)
         self._increment = wp.zeros(n, dtype=float, device=d)
         self._increment_per_rho = wp.zeros(n, dtype=float, device=d)
-        self._solve_stats = wp.zeros((self.lanes.count, dfsph.STATS_ROW_STRIDE), dtype=wp.int64, device=d)
-        self._lane_stats = PerLane(self._solve_stats[k] for k in range(self.lanes.count))
+        replicas = self.layout.atomic_replicas  # rows per lane (check_convergence sums every row)
+        self._solve_stats = wp.zeros((self.lanes.count * replicas, dfsph.STATS_ROW_STRIDE), dtype=wp.int64, device=d)
+        self._lane_stats = PerLane(self._solve_stats[k * replicas : (k + 1) * replicas].flatten() for k in range(self.lanes.count))
         capacity = pair_capacity(self.config.dim, self.config.smoothing_ratio)
         self._pair_count = wp.zeros(n, dtype=wp.int32, device=d)
         by_column = self.layout.pairs_by_column
@@ -244,7 +245,7 @@ class FluidSolver:
         if n <= self._rows_capacity:
             return
         self._rows_capacity = max(n, 2 * self._rows_capacity)
-        lanes, slots = self.lanes.count, self._rows_capacity * self.layout.diag_replicas
+        lanes, slots = self.lanes.count, self._rows_capacity * self.layout.atomic_replicas
         self._diag_f = wp.zeros((lanes, slots, N_DIAG_FLOAT), dtype=float, device=self.device)
         self._diag_i = wp.zeros((lanes, slots, N_DIAG_INT_BASE + self.model.n_vessels), dtype=wp.int32, device=self.device)
         self._lane_diag_f = PerLane(self._diag_f[k] for k in range(lanes))
@@ -336,7 +337,7 @@ class FluidSolver:
         if self._capture_graphs and self._graphs is None:
             self._graphs = self._capture()
         diag_f, diag_i = self._diag_views or (self._diag_f.numpy(), self._diag_i.numpy())
-        rows_f, rows_i = combine_lanes(*(replicas_as_lanes(a, n_sub, self.layout.diag_replicas) for a in (diag_f, diag_i)))
+        rows_f, rows_i = combine_lanes(*(replicas_as_lanes(a, n_sub, self.layout.atomic_replicas) for a in (diag_f, diag_i)))
         first = self.step_count
         t0 = self.time
         self.step_count += n_sub

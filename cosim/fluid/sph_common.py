@@ -226,7 +226,7 @@ def finish_particle(
 def diag_slot(prm: SPHParams, row: int, i: int) -> int:
     """The diagnostics row particle ``i`` writes for substep ``row``: its replica of that row
     (``cosim.fluid.device_layout``; one replica on the CPU: the row itself)."""
-    return row * prm.diag_replicas + i % prm.diag_replicas
+    return row * prm.atomic_replicas + i % prm.atomic_replicas
 
 
 @wp.kernel
