@@ -13,9 +13,10 @@ wrench reduction's 64 sequential chunks (4.8 ms) and integrate's atomics on one 
 - The wall wrench (a sum over every particle per vessel, in a fixed order): on the CPU :data:`WRENCH_CHUNKS`
   contiguous chunks; on CUDA levels of chunks of :data:`REDUCTION_ITEMS` interleaved items (chunk c sums items c,
   c + chunks, ...: consecutive threads read consecutive addresses), until few enough partial sums remain.
-- Diagnostics rows: on CUDA each substep's row is replicated :data:`CUDA_ATOMIC_REPLICAS` times and particle i
-  writes replica i mod replicas, so each address takes 1/replicas of the atomics; the host combines the replicas
-  as it combines the lanes (maxima by the maximum, the rest summed).
+- Accumulators every particle adds to atomically (each substep's diagnostics row, DFSPH's solve statistics): on
+  CUDA replicated :data:`CUDA_ATOMIC_REPLICAS` times, particle i adding to replica i mod replicas, so each address
+  takes 1/replicas of the atomics; the replicas are combined as the lanes are (maxima by the maximum, the rest
+  summed: on the host for the diagnostics, in ``dfsph.check_convergence`` for the statistics, integers there).
 
 The particle state is the same bit for bit under either layout; the wrench and the energy sums add the same terms
 in another order (tests/test_fluid_device_layout.py).
@@ -30,14 +31,14 @@ import warp as wp
 
 WRENCH_CHUNKS = 64  # CPU: contiguous first-level chunks of the fixed-order wrench reduction
 REDUCTION_ITEMS = 64  # CUDA: items one thread sums per level of the interleaved reduction
-CUDA_ATOMIC_REPLICAS = 64  # CUDA: replicas of each diagnostics row (atomics per address divided by this)
+CUDA_ATOMIC_REPLICAS = 64  # CUDA: replicas of each accumulator (atomics per address divided by this)
 
 
 @dataclass(frozen=True)
 class DeviceLayout:
     """pairs_by_column: pair tables slot-major (CUDA) instead of particle-major. interleaved_reduction: the
     wrench reduced in interleaved levels (CUDA) instead of contiguous chunks. atomic_replicas: copies of each
-    diagnostics row the particles spread their atomics over."""
+    accumulator (diagnostics row, solve statistics) the particles spread their atomics over."""
 
     pairs_by_column: bool
     interleaved_reduction: bool
