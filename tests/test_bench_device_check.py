@@ -47,3 +47,11 @@ def test_a_check_past_its_limit_is_reported_with_what_it_printed(tmp_path, monke
     assert device_check.main(["--device", "cpu", "--quick", "--only", "agreement", "--out", str(tmp_path)]) == 1
     assert "timed out after" in (tmp_path / "device_check.md").read_text()
     assert (tmp_path / "agreement.log").exists()
+
+
+def test_the_profile_check_reports_each_case(tmp_path):
+    # on the CPU warp times no kernel: each case reports its substeps and wall time (the CUDA run adds the table)
+    assert device_check.main(["--device", "cpu", "--quick", "--only", "profile", "--out", str(tmp_path)]) == 0
+    report = (tmp_path / "device_check.md").read_text()
+    assert "### 3-D, 1872 particles, wcsph, cpu" in report and "### 2-D, 484 particles, dfsph (jacobi), cpu" in report
+    assert "# Kernel profile" not in report  # the profile's own title is dropped inside the report

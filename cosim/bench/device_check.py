@@ -21,9 +21,11 @@ report, DIR/device_check.md, is printed at the end:
    MuJoCo step split into the substeps and the rest (``cosim.bench.host_overhead``: the rest bounds the real-time
    factor), and the particle-substeps per second real time would take (particles x substeps per simulated
    second: what the device must sustain, besides the host's share).
+5. profile: ``cosim.bench.kernel_profile``, each kernel's device time in a substep of the benchmark's block (its
+   default cases: 3-D at 1M and 2-D at 10k particles, WCSPH and DFSPH with either density iteration).
 
-Sized to finish within one 600 s call of the device tool (:data:`TIME_LIMITS`); the warp install the GPU machine
-needs first is in ``../shared/gpu/README.md``. Written without a GPU at hand: never run on one yet.
+Sized to finish within one 600 s call of the device tool (:data:`TIME_LIMITS`; on the H200 on 2026-12-04 the first
+four took 53, 35, 8 and 91 s); the warp install the GPU machine needs first is in ``../shared/gpu/README.md``.
 
 ``--quick`` runs every check at small sizes (on the CPU too): a dry run of the machinery, numbers meaningless.
 Needs warp, mujoco, ruckig and control; not rerun-sdk or tqdm (the GPU machine's staged packages,
@@ -56,7 +58,7 @@ SLOSH_PERIODS = 3.0
 POUR_WARM_UP = 0.05  # s simulated before timing: compiles the kernels, captures the graphs
 POUR_3D_ACROSS = 64  # particles across the pourer of the 3-D pour: 111,936 particles
 # seconds each check may take on the device machine: together within one 600 s call of the device tool
-TIME_LIMITS = {"agreement": 90, "validation": 120, "throughput": 180, "pour": 180}
+TIME_LIMITS = {"agreement": 90, "validation": 90, "throughput": 120, "pour": 180, "profile": 90}
 CHECKS = tuple(TIME_LIMITS)
 
 
@@ -222,6 +224,16 @@ def _pour_table(rows: list[dict]) -> list[str]:
     return out
 
 
+# ---- profile ----------------------------------------------------------------------------------------------
+def check_profile(device: str, quick: bool, out: Path) -> list[dict]:
+    from cosim.bench import kernel_profile
+
+    cases = ["3:2000:wcsph", "2:500:dfsph:jacobi"] if quick else []
+    kernel_profile.main(["--device", device, "--out", str(out), *(["--cases", *cases] if cases else [])])
+    body = (out / "kernel_profile.md").read_text().split("\n", 1)[1]  # without its title: the report has one
+    return [{"table": body.replace("\n## ", "\n### ")}]
+
+
 # ---- driver -----------------------------------------------------------------------------------------------
 def _text(output: bytes | str | None) -> str:
     """A timed-out child's captured output as text (``subprocess`` hands it back as bytes, or None)."""
@@ -237,6 +249,8 @@ def _run_one(check: str, device: str, quick: bool, out: Path) -> list[dict]:
         return check_validation(device, quick)
     if check == "throughput":
         return check_throughput(device, quick, out)
+    if check == "profile":
+        return check_profile(device, quick, out)
     return check_pour(device, quick)
 
 
@@ -251,7 +265,7 @@ def _report(results: dict[str, dict], device: str, quick: bool) -> str:
             lines.append("not run")
         elif r["status"] != "ok":
             lines.append(f"{r['status']} after {r['wall_s']:.0f} s: {r.get('error', '')}")
-        elif check == "throughput":
+        elif check in ("throughput", "profile"):
             lines.append(r["rows"][0]["table"].strip())
         else:
             lines += tables[check](r["rows"])

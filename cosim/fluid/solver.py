@@ -101,6 +101,8 @@ class FluidSolver:
         captured after the first interval, which runs the operations one by one and so compiles the kernels and
         sizes the sort's scratch memory); the operations one by one where capture fails
         (:attr:`graph_capture_error` says why) or when False.
+      layout: how the pair tables, the wrench reduction and the atomic accumulators are laid out
+        (:mod:`cosim.fluid.device_layout`); None: the device kind's own. The particles are the same under any.
     In 2-D, vessel poses are projected onto the pour plane (rotation about y, translation in x-z, y = 0).
     """
 
@@ -336,7 +338,8 @@ class FluidSolver:
         self.substep_wall_time += time.perf_counter() - start
         if self._capture_graphs and self._graphs is None:
             self._graphs = self._capture()
-        diag_f, diag_i = self._diag_views or (self._diag_f.numpy(), self._diag_i.numpy())
+        used = n_sub * self.layout.atomic_replicas  # rows written this interval (the device's copy: read only those)
+        diag_f, diag_i = self._diag_views or (self._diag_f[:, :used].numpy(), self._diag_i[:, :used].numpy())
         rows_f, rows_i = combine_lanes(*(replicas_as_lanes(a, n_sub, self.layout.atomic_replicas) for a in (diag_f, diag_i)))
         first = self.step_count
         t0 = self.time
