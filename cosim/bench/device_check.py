@@ -22,7 +22,9 @@ report, DIR/device_check.md, is printed at the end:
    after a warm-up that compiles the kernels and captures the graphs; real-time factor, the wall time per 2 ms
    MuJoCo step split into the substeps and the rest (``cosim.bench.host_overhead``: the rest bounds the real-time
    factor), and the particle-substeps per second real time would take (particles x substeps per simulated
-   second: what the device must sustain, besides the host's share).
+   second: what the device must sustain, besides the host's share); and where the 2-D pour's host time goes
+   (cProfile, OUT/pour_host_profile.txt: the rest of the loop took 2.0 to 2.5 ms per 2 ms step on the H200's
+   machine, 0.9 to 1.6 on the 2-core CPU).
 5. profile: ``cosim.bench.kernel_profile``, each kernel's device time in a substep of the benchmark's block (its
    default cases: 3-D at 1M and 2-D at 10k particles, WCSPH and DFSPH with either density iteration).
 
@@ -58,6 +60,8 @@ POUR_SECONDS = {2: 2.0, 3: 0.5}
 # zero crossings and gave nan)
 SLOSH_PERIODS = 3.0
 POUR_WARM_UP = 0.05  # s simulated before timing: compiles the kernels, captures the graphs
+HOST_PROFILE_SECONDS = 0.5  # s of the 2-D pour simulated under cProfile (its host side: pour_host_profile.txt)
+HOST_PROFILE_LINES = 30  # functions listed
 POUR_3D_ACROSS = 64  # particles across the pourer of the 3-D pour: 111,936 particles
 # seconds each check may take on the device machine: together within one 600 s call of the device tool
 TIME_LIMITS = {"agreement": 90, "validation": 90, "throughput": 120, "pour": 180, "profile": 90}
@@ -182,16 +186,13 @@ def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
 
 
 # ---- pour -------------------------------------------------------------------------------------------------
-def _pour(device: str, dim: int, across: int, seconds: float, solver: str | None = None, iteration: str | None = None) -> dict:
-    """The pour row: ``solver`` None runs the default scene's pressure solver, ``iteration`` None DFSPH's default
-    density iteration."""
+def _warm_pour(device: str, dim: int, across: int, seconds: float, solver: str, iteration: str):
+    """The default scene at this liquid, no recording, stepped through :data:`POUR_WARM_UP` (compiled, captured),
+    with room for ``seconds`` more."""
     from cosim.bench.host_overhead import time_steps
     from cosim.coupling.settings import CouplingSettings
     from cosim.pour_run import prepare
     from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene
-
-    solver = solver or FluidSettings().pressure_solver.value
-    iteration = iteration or FluidSettings().density_iteration.value
 
     scene = PourScene(
         device=device, fluid=replace(FluidSettings(), dim=dim, particles_across=across, pressure_solver=solver, density_iteration=iteration),
@@ -199,6 +200,18 @@ def _pour(device: str, dim: int, across: int, seconds: float, solver: str | None
     )
     pour = prepare(scene)
     time_steps(pour, POUR_WARM_UP)
+    return pour
+
+
+def _pour(device: str, dim: int, across: int, seconds: float, solver: str | None = None, iteration: str | None = None) -> dict:
+    """The pour row: ``solver`` None runs the default scene's pressure solver, ``iteration`` None DFSPH's default
+    density iteration."""
+    from cosim.bench.host_overhead import time_steps
+    from cosim.pour_scene import FluidSettings
+
+    solver = solver or FluidSettings().pressure_solver.value
+    iteration = iteration or FluidSettings().density_iteration.value
+    pour = _warm_pour(device, dim, across, seconds, solver, iteration)
     substeps0 = pour.fluid.step_count
     split = time_steps(pour, seconds)
     return {
@@ -209,14 +222,36 @@ def _pour(device: str, dim: int, across: int, seconds: float, solver: str | None
     }
 
 
-def check_pour(device: str, quick: bool) -> list[dict]:
+def profile_host(device: str, seconds: float, out: Path) -> None:
+    """Where the default 2-D pour's host time goes on ``device``: ``seconds`` simulated under cProfile after the
+    warm-up, the functions by their own time, written to OUT/pour_host_profile.txt (the profiler slows the Python
+    side, so the shares, not the times, are the result)."""
+    import cProfile
+    import io
+    import pstats
+
+    from cosim.bench.host_overhead import time_steps
+    from cosim.pour_scene import FluidSettings
+
+    pour = _warm_pour(device, 2, FluidSettings().particles_across, seconds, FluidSettings().pressure_solver.value, FluidSettings().density_iteration.value)
+    profiler = cProfile.Profile()
+    profiler.runcall(time_steps, pour, seconds)
+    text = io.StringIO()
+    pstats.Stats(profiler, stream=text).sort_stats("tottime").print_stats(HOST_PROFILE_LINES)
+    write_text_atomic(out / "pour_host_profile.txt", text.getvalue())
+
+
+def check_pour(device: str, quick: bool, out: Path) -> list[dict]:
     if quick:
-        return [_pour(device, 2, 32, 0.05), _pour(device, 3, 12, 0.05, "wcsph"), _pour(device, 3, 12, 0.05, "dfsph", "jacobi")]
-    return [
-        _pour(device, 2, 32, POUR_SECONDS[2]),
-        _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "wcsph"),
-        _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "dfsph", "jacobi"),
-    ]
+        rows = [_pour(device, 2, 32, 0.05), _pour(device, 3, 12, 0.05, "wcsph"), _pour(device, 3, 12, 0.05, "dfsph", "jacobi")]
+    else:
+        rows = [
+            _pour(device, 2, 32, POUR_SECONDS[2]),
+            _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "wcsph"),
+            _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "dfsph", "jacobi"),
+        ]
+    profile_host(device, 0.05 if quick else HOST_PROFILE_SECONDS, out)
+    return rows
 
 
 def _pour_table(rows: list[dict]) -> list[str]:
@@ -260,7 +295,7 @@ def _run_one(check: str, device: str, quick: bool, out: Path) -> list[dict]:
         return check_throughput(device, quick, out)
     if check == "profile":
         return check_profile(device, quick, out)
-    return check_pour(device, quick)
+    return check_pour(device, quick, out)
 
 
 def _report(results: dict[str, dict], device: str, quick: bool) -> str:
