@@ -178,10 +178,11 @@ def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
     counts2d, counts3d = (["500"], ["2000"]) if quick else (["10000"], ["100000", "1000000"])
     table = out / "throughput.md"
     table.unlink(missing_ok=True)  # the benchmark appends: start this run's table afresh
-    common = ["--device", device, "--solvers", "wcsph", "dfsph", "--out", str(table)]
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *common])
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *common[:2], "--solvers", "dfsph", "--density-iteration", "jacobi", *common[-2:]])
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", "--no-graphs", *common])
+    where = ["--device", device, "--out", str(table)]
+    both = ["--solvers", "wcsph", "dfsph"]
+    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *both, *where])
+    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, "--solvers", "dfsph", "--density-iteration", "jacobi", *where])
+    benchmark.main(["--counts2d", *counts2d, "--counts3d", "--no-graphs", *both, *where])
     return [{"table": table.read_text()}]
 
 
