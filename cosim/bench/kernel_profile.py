@@ -4,8 +4,8 @@ timed by warp's CUDA activity timing (a profile, not a benchmark: launches run o
     python -m cosim.bench.kernel_profile [--device cuda] [--cases 3:1000000:wcsph 2:10000:dfsph:jacobi] [--steps 20]
                                          [--top 12] [--out DIR]
 
-For each case (dim:particles:solver, and for DFSPH optionally :gauss_seidel or :jacobi, its density iteration) the block of ``cosim.fluid.benchmark`` settles for one interval of ``steps``
-WCSPH substeps, then one more interval is timed: the wall time, the sum of the device activities (their
+For each case (dim:particles:solver, for DFSPH optionally :gauss_seidel or :jacobi, its density iteration) the
+block of ``cosim.fluid.benchmark`` settles for one interval of ``steps`` WCSPH substeps, then one more is timed: the wall time, the sum of the device activities (their
 difference is the host's launch and synchronisation cost), and the ``top`` activities by total time, with their
 count and milliseconds per substep. On the CPU warp times nothing per kernel: only the wall time is reported.
 Writes DIR/kernel_profile.md (atomically) besides printing it.
@@ -24,6 +24,9 @@ from cosim.atomic_files import write_text_atomic
 from cosim.fluid.benchmark import resting_block
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.runtime import resolve_device
+
+# issue 7's sizes (3-D 1M, 2-D 10k), each solver, DFSPH with either density iteration
+DEFAULT_CASES = [f"{size}:{solver}" for size in ("3:1000000", "2:10000") for solver in ("wcsph", "dfsph:jacobi", "dfsph:gauss_seidel")]
 
 
 def parse_case(text: str) -> tuple[int, int, PressureSolver, DensityIteration]:
@@ -68,8 +71,7 @@ def profile_case(dim: int, n: int, solver: PressureSolver, iteration: DensityIte
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--device", default="cuda")
-    p.add_argument("--cases", nargs="*", default=["3:1000000:wcsph", "3:1000000:dfsph:jacobi", "3:1000000:dfsph:gauss_seidel", "2:10000:wcsph", "2:10000:dfsph:jacobi", "2:10000:dfsph:gauss_seidel"],
-                   help="dim:particles:solver, one profile each")
+    p.add_argument("--cases", nargs="*", default=DEFAULT_CASES, help="dim:particles:solver[:iteration], one profile each")
     p.add_argument("--steps", type=int, default=20, help="WCSPH substeps per interval (the benchmark's)")
     p.add_argument("--top", type=int, default=12, help="activities listed per case")
     p.add_argument("--out", type=Path, default=Path("recordings") / "kernel_profile")

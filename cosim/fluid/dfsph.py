@@ -89,9 +89,9 @@ from cosim.fluid.lanes import lane_item
 from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
-    diag_slot,
     add_wall_density,
     add_wall_reaction,
+    diag_slot,
     finish_particle,
     inside_any_vessel,
     kernel_gradient,
