@@ -167,7 +167,8 @@ class _SignalLogger:
             self.rec.log_phase(t, step, self.phase, reason)
 
 
-def _versions() -> dict[str, str]:
+def package_versions() -> dict[str, str]:
+    """Python's version and each of :data:`VERSIONED_PACKAGES`' installed version ('not installed' where absent)."""
     out = {"python": platform.python_version()}
     for name in VERSIONED_PACKAGES:
         try:
@@ -235,7 +236,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
                 "max_target_error_rad": {r.value: pour.generators[r].max_target_error for r in ROLES},
                 "clamped_targets": {r.value: pour.generators[r].clamped_targets for r in ROLES},
             },
-            versions=_versions(),
+            versions=package_versions(),
             outputs=sorted(p.name for p in work.iterdir()) + ["summary.json"],
             scene=json.loads(json.dumps(asdict(scene), default=lambda o: getattr(o, "value", str(o)))),
         )

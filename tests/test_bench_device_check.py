@@ -1,6 +1,6 @@
 """The prepared device check (cosim.bench.device_check): its machinery, run on the CPU at its quick sizes."""
 
-from cosim.bench import device_check
+from cosim.bench import device_check, host_overhead
 from cosim.pour_scene import FluidSettings
 
 
@@ -28,7 +28,7 @@ def test_a_failing_check_is_reported_and_sets_the_exit_status(tmp_path):
 
 
 def test_pour_rows_split_the_wall_time_into_substeps_and_the_rest():
-    row = device_check._pour("cpu", 2, 12, 0.02)
+    row = host_overhead.pour_rate("cpu", 2, 12, 0.02)
     assert row["particles"] > 0 and row["sph_substeps"] > 0 and row["graphs"] == "captured"
     steps = round(row["simulated_s"] / 0.002)  # 2 ms MuJoCo steps
     assert 0.0 < row["substeps_ms_per_step"] and 0.0 < row["host_ms_per_step"]

@@ -44,7 +44,6 @@ import math
 import subprocess
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -59,7 +58,6 @@ POUR_SECONDS = {2: 2.0, 3: 0.5}
 # slosh periods run (the frequency is measured from a quarter period after the pulse: at 2 the window held too few
 # zero crossings and gave nan)
 SLOSH_PERIODS = 3.0
-POUR_WARM_UP = 0.05  # s simulated before timing: compiles the kernels, captures the graphs
 HOST_PROFILE_SECONDS = 0.5  # s of the 2-D pour simulated under cProfile (its host side: pour_host_profile.txt)
 HOST_PROFILE_LINES = 30  # functions listed
 POUR_3D_ACROSS = 64  # particles across the pourer of the 3-D pour: 111,936 particles
@@ -68,16 +66,11 @@ TIME_LIMITS = {"agreement": 90, "validation": 90, "throughput": 120, "pour": 180
 CHECKS = tuple(TIME_LIMITS)
 
 
-def _capture_status(fluid) -> str:
-    """How the solver ran its substeps: replayed graphs (CUDA graphs, or warp's CPU operation stream), or
-    launches one by one because capture failed (and why)."""
-    return fluid.graph_capture_error or "captured"
-
-
 # ---- agreement --------------------------------------------------------------------------------------------
 def _tank_run(device: str, solver: str, dim: int, across: int, graphs: bool, nudge: bool = False) -> dict:
     """A tank of liquid tilted and shaken for AGREEMENT_INTERVALS intervals: positions, wrenches, substeps.
     ``nudge``: every initial coordinate moved one float32 ulp up (the run's sensitivity to its last bit)."""
+    from cosim.bench.host_overhead import capture_status
     from cosim.fluid.config import FluidConfig
     from cosim.fluid.seeding import fill_vessel
     from cosim.fluid.solver import FluidSolver
@@ -101,7 +94,7 @@ def _tank_run(device: str, solver: str, dim: int, across: int, graphs: bool, nud
     weight = fluid.n_particles * cfg.particle_mass * cfg.out_of_plane_scale * 9.81
     return {
         "x": fluid.positions(), "wrench": fluid.vessel_wrenches(), "steps": fluid.step_count, "spacing": cfg.spacing,
-        "weight": weight, "particles": fluid.n_particles, "graphs": _capture_status(fluid),
+        "weight": weight, "particles": fluid.n_particles, "graphs": capture_status(fluid),
     }
 
 
@@ -187,42 +180,6 @@ def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
 
 
 # ---- pour -------------------------------------------------------------------------------------------------
-def _warm_pour(device: str, dim: int, across: int, seconds: float, solver: str, iteration: str):
-    """The default scene at this liquid, no recording, stepped through :data:`POUR_WARM_UP` (compiled, captured),
-    with room for ``seconds`` more."""
-    from cosim.bench.host_overhead import time_steps
-    from cosim.coupling.settings import CouplingSettings
-    from cosim.pour_run import prepare
-    from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene
-
-    scene = PourScene(
-        device=device, fluid=replace(FluidSettings(), dim=dim, particles_across=across, pressure_solver=solver, density_iteration=iteration),
-        coupling=CouplingSettings(max_duration=POUR_WARM_UP + seconds), logging=LoggingSettings(enabled=False),
-    )
-    pour = prepare(scene)
-    time_steps(pour, POUR_WARM_UP)
-    return pour
-
-
-def _pour(device: str, dim: int, across: int, seconds: float, solver: str | None = None, iteration: str | None = None) -> dict:
-    """The pour row: ``solver`` None runs the default scene's pressure solver, ``iteration`` None DFSPH's default
-    density iteration."""
-    from cosim.bench.host_overhead import time_steps
-    from cosim.pour_scene import FluidSettings
-
-    solver = solver or FluidSettings().pressure_solver.value
-    iteration = iteration or FluidSettings().density_iteration.value
-    pour = _warm_pour(device, dim, across, seconds, solver, iteration)
-    substeps0 = pour.fluid.step_count
-    split = time_steps(pour, seconds)
-    return {
-        "dim": dim, "across": across, "solver": solver if solver == "wcsph" else f"{solver} ({iteration})", "particles": split.particles, "simulated_s": seconds, "wall_s": split.wall_s,
-        "real_time_factor": seconds / split.wall_s, "sph_substeps": pour.fluid.step_count - substeps0,
-        "substeps_ms_per_step": split.substep_ms_per_step, "host_ms_per_step": split.host_ms_per_step,
-        "graphs": _capture_status(pour.fluid),
-    }
-
-
 def profile_host(device: str, seconds: float, out: Path) -> None:
     """Where the default 2-D pour's host time goes on ``device``: ``seconds`` simulated under cProfile after the
     warm-up, the functions by their own time, written to OUT/pour_host_profile.txt (the profiler slows the Python
@@ -231,10 +188,10 @@ def profile_host(device: str, seconds: float, out: Path) -> None:
     import io
     import pstats
 
-    from cosim.bench.host_overhead import time_steps
+    from cosim.bench.host_overhead import time_steps, warm_pour
     from cosim.pour_scene import FluidSettings
 
-    pour = _warm_pour(device, 2, FluidSettings().particles_across, seconds, FluidSettings().pressure_solver.value, FluidSettings().density_iteration.value)
+    pour = warm_pour(device, 2, FluidSettings().particles_across, seconds, FluidSettings().pressure_solver.value, FluidSettings().density_iteration.value)
     profiler = cProfile.Profile()
     profiler.runcall(time_steps, pour, seconds)
     text = io.StringIO()
@@ -243,13 +200,15 @@ def profile_host(device: str, seconds: float, out: Path) -> None:
 
 
 def check_pour(device: str, quick: bool, out: Path) -> list[dict]:
+    from cosim.bench.host_overhead import pour_rate
+
     if quick:
-        rows = [_pour(device, 2, 32, 0.05), _pour(device, 3, 12, 0.05, "wcsph"), _pour(device, 3, 12, 0.05, "dfsph", "jacobi")]
+        rows = [pour_rate(device, 2, 32, 0.05), pour_rate(device, 3, 12, 0.05, "wcsph"), pour_rate(device, 3, 12, 0.05, "dfsph", "jacobi")]
     else:
         rows = [
-            _pour(device, 2, 32, POUR_SECONDS[2]),
-            _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "wcsph"),
-            _pour(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "dfsph", "jacobi"),
+            pour_rate(device, 2, 32, POUR_SECONDS[2]),
+            pour_rate(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "wcsph"),
+            pour_rate(device, 3, POUR_3D_ACROSS, POUR_SECONDS[3], "dfsph", "jacobi"),
         ]
     profile_host(device, 0.05 if quick else HOST_PROFILE_SECONDS, out)
     return rows

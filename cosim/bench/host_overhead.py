@@ -25,11 +25,14 @@ import statistics
 import sys
 
 from cosim.coupling.loop import CoupledPour
+from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
-from cosim.fluid.benchmark import _machine
+from cosim.fluid.benchmark import machine_description
 from cosim.fluid.config import PressureSolver
 from cosim.pour_run import prepare
-from cosim.pour_scene import PourScene, load_scene
+from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene, load_scene
+
+POUR_WARM_UP = 0.05  # s simulated before a timed pour: compiles the kernels, captures the graphs
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,6 +62,42 @@ def time_steps(pour: CoupledPour, duration: float) -> HostSplit:
     while pour.time < end - 1e-12:
         pour.step()
     return HostSplit(pour.fluid.n_particles, pour.steps - steps, pour.dt, pour.wall_time - wall, pour.fluid.substep_wall_time - substeps)
+
+
+def capture_status(fluid) -> str:
+    """How the solver ran its substeps: replayed graphs (CUDA graphs, or warp's CPU operation stream), or
+    launches one by one because capture failed (and why)."""
+    return fluid.graph_capture_error or "captured"
+
+
+def warm_pour(device: str, dim: int, across: int, seconds: float, solver: str, iteration: str) -> CoupledPour:
+    """The default scene with this liquid (``solver``: pressure solver, ``iteration``: DFSPH's density iteration),
+    no recording, stepped through :data:`POUR_WARM_UP` (kernels compiled, graphs captured), with room for
+    ``seconds`` more."""
+    scene = PourScene(
+        device=device, fluid=dataclasses.replace(FluidSettings(), dim=dim, particles_across=across, pressure_solver=solver, density_iteration=iteration),
+        coupling=CouplingSettings(max_duration=POUR_WARM_UP + seconds), logging=LoggingSettings(enabled=False),
+    )
+    pour = prepare(scene)
+    time_steps(pour, POUR_WARM_UP)
+    return pour
+
+
+def pour_rate(device: str, dim: int, across: int, seconds: float, solver: str | None = None, iteration: str | None = None) -> dict:
+    """``seconds`` of the default scene's pour timed after :func:`warm_pour` (``solver`` None: the default scene's
+    pressure solver, ``iteration`` None: its density iteration): real-time factor, SPH substeps, and the wall time
+    per MuJoCo step split into the substeps and the rest (ms)."""
+    solver = solver or FluidSettings().pressure_solver.value
+    iteration = iteration or FluidSettings().density_iteration.value
+    pour = warm_pour(device, dim, across, seconds, solver, iteration)
+    substeps0 = pour.fluid.step_count
+    split = time_steps(pour, seconds)
+    return {
+        "dim": dim, "across": across, "solver": solver if solver == "wcsph" else f"{solver} ({iteration})", "particles": split.particles,
+        "simulated_s": seconds, "wall_s": split.wall_s, "real_time_factor": seconds / split.wall_s,
+        "sph_substeps": pour.fluid.step_count - substeps0, "substeps_ms_per_step": split.substep_ms_per_step,
+        "host_ms_per_step": split.host_ms_per_step, "graphs": capture_status(pour.fluid),
+    }
 
 
 def time_pour(scene: PourScene, duration: float) -> HostSplit:
@@ -93,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    print(f"Machine: {_machine()}. Command: python -m cosim.bench.host_overhead {' '.join(argv if argv is not None else sys.argv[1:])}")
+    print(f"Machine: {machine_description()}. Command: python -m cosim.bench.host_overhead {' '.join(argv if argv is not None else sys.argv[1:])}")
     print(f"{args.duration:g} s of the pour per run, {args.repeats} runs per row; ms per MuJoCo step, medians.\n")
     print("| solver | across | particles | steps | wall ms/step | substeps ms/step | host ms/step | real-time factor the host allows |")
     print("|---|---|---|---|---|---|---|---|")

@@ -29,7 +29,7 @@ from cosim.bench.report import update_document
 from cosim.bench.run import warm_up
 from cosim.bench.runners import run_config
 from cosim.errors import InputError
-from cosim.fluid.benchmark import _machine
+from cosim.fluid.benchmark import machine_description
 
 BEGIN = "<!-- cosim.bench.interleave: generated, begin -->"
 END = "<!-- cosim.bench.interleave: generated, end -->"
@@ -65,7 +65,7 @@ def table(timings: list[PairTiming], repeats: int, command: str) -> str:
     lines = [
         f"### Skip options timed side by side ({now})",
         "",
-        f"Machine: {_machine()}. "
+        f"Machine: {machine_description()}. "
         f"Command: `{command}`. Each pair's runs alternate in ABBA order, {repeats} runs a side; wall s per "
         "simulated s, median (every run in order).",
         "",

@@ -41,14 +41,14 @@ def register(subparsers) -> None:
 
 
 def _header(command: str, code_versions: dict) -> str:
-    from cosim.fluid.benchmark import _machine
+    from cosim.fluid.benchmark import machine_description
     from cosim.fluid.runtime import cuda_available
-    from cosim.pour_run import _versions
+    from cosim.pour_run import package_versions
 
-    versions = ", ".join(f"{k} {v}" for k, v in _versions().items() if k != "cosim")
+    versions = ", ".join(f"{k} {v}" for k, v in package_versions().items() if k != "cosim")
     cuda = "a CUDA device is present: cuda rows included" if cuda_available() else "no CUDA device here: CPU rows only"
     return (f"## Wall time against error ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
-            f"Machine: {_machine()}; {cuda}. Versions: {versions}.\n"
+            f"Machine: {machine_description()}; {cuda}. Versions: {versions}.\n"
             f"Command: `{command}`. Code versions (cosim.bench.cache.code_version): "
             f"{', '.join(f'{k.value} {v}' for k, v in code_versions.items())}.\n")
 

@@ -15,8 +15,6 @@ import sys
 import warnings
 from pathlib import Path
 
-from rerun.chunk import RrdReader
-
 from cosim.errors import InputError
 
 RECORDING_NAME = "pour.rrd"
@@ -42,6 +40,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def recording_path(run_arg: str) -> Path:
     """The .rrd file RUN designates, checked to be a readable Rerun recording (else InputError)."""
+    # imported here: the other subcommands run where rerun-sdk is not installed (the GPU machine, README)
+    from rerun.chunk import RrdReader
+
     path = Path(run_arg).expanduser()
     if path.is_dir():
         path = path / RECORDING_NAME

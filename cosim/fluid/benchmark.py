@@ -62,7 +62,7 @@ def resting_block(
     return fluid, steps * cfg.cfl * cfg.smoothing_length / cfg.sound_speed * 0.999
 
 
-def _ours(
+def solver_throughput(
     n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, graphs: bool, threads: int, iteration: DensityIteration,
 ) -> tuple[float, float, int, float, int]:
     """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s, threads) of our
@@ -84,7 +84,7 @@ def _ours(
     return statistics.median(rates), statistics.median(speeds), fluid.n_particles, statistics.mean(dts), fluid.lanes.count
 
 
-def _example_sph(n: int, device: str, steps: int, repeats: int) -> float:
+def example_sph_throughput(n: int, device: str, steps: int, repeats: int) -> float:
     """Median particle-steps/s of warp's bundled example_sph re-sized to n particles."""
     from warp.examples.core import example_sph
 
@@ -116,7 +116,8 @@ def _example_sph(n: int, device: str, steps: int, repeats: int) -> float:
     return statistics.median(rates)
 
 
-def _machine() -> str:
+def machine_description() -> str:
+    """The CPU's model name, its logical core count and the operating system, for a benchmark's header."""
     cpu = platform.processor() or "unknown CPU"
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -151,11 +152,11 @@ def main(argv: list[str] | None = None) -> int:
             theirs = float("nan")
             for name in args.solvers:
                 for threads in args.threads:
-                    ours, sim_rate, actual, dt, used = _ours(
+                    ours, sim_rate, actual, dt, used = solver_throughput(
                         n, dim, str(device), args.steps, args.repeats, PressureSolver(name), not args.no_graphs, threads, DensityIteration(args.density_iteration),
                     )
                     if dim == 3 and math.isnan(theirs):
-                        theirs = _example_sph(actual, str(device), args.steps, args.repeats)
+                        theirs = example_sph_throughput(actual, str(device), args.steps, args.repeats)
                     rows.append((dim, actual, name, used, ours, sim_rate, dt, theirs))
                     print(f"{dim}-D {actual:>8d} particles {name} {used} threads: {ours / 1e6:8.3f} M particle-steps/s, dt {dt * 1e6:8.1f} us, "
                           f"{sim_rate:8.4f} simulated s per wall s" + (f"   example_sph {theirs / 1e6:8.3f} M" if dim == 3 else ""), flush=True)
@@ -166,7 +167,7 @@ def main(argv: list[str] | None = None) -> int:
         table.append(f"| {dim}-D | {n} | {name} | {used} | {ours / 1e6:.3f} | {ours / n:.0f} | {dt * 1e6:.1f} | {sim_rate:.4f} | {ex} |")
     header = (
         f"\n## Fluid step throughput, {device} ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
-        f"Machine: {_machine()}. Versions: Python {platform.python_version()}, warp {wp.__version__}, numpy {np.__version__}.\n"
+        f"Machine: {machine_description()}. Versions: Python {platform.python_version()}, warp {wp.__version__}, numpy {np.__version__}.\n"
         f"Command: `python -m cosim.fluid.benchmark --device {args.device} --counts2d {' '.join(map(str, args.counts2d))} "
         f"--counts3d {' '.join(map(str, args.counts3d))} --solvers {' '.join(args.solvers)} --threads {' '.join(map(str, args.threads))} "
         f"--steps {args.steps} --repeats {args.repeats} --density-iteration {args.density_iteration}"
