@@ -189,14 +189,14 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
     os.chmod(work, 0o777 & ~umask)  # mkdtemp makes it private; the run folder gets the usual permissions
     recorder = None
     try:
-        # imported here: prepare() and a pour without its recording need neither rerun-sdk nor tqdm (the GPU
-        # machine's staged packages hold neither, cosim.bench.device_check)
+        # imported here: prepare() needs neither rerun-sdk nor tqdm, and a pour without its recording needs no
+        # rerun-sdk (the GPU machine has no rerun-sdk; README, "On a GPU")
         from tqdm import tqdm
-
-        from cosim.io.recording import PourRecorder
 
         callbacks = []
         if scene.logging.enabled:
+            from cosim.io.recording import PourRecorder
+
             recorder = PourRecorder(work / "pour.rrd", pour.scene.model, scene.logging.recording, particle_radius=0.5 * pour.fluid.config.spacing)
             callbacks.append(_SignalLogger(pour, recorder))
         bar = tqdm(total=round(scene.coupling.max_duration, 3), unit="s sim", disable=not progress, mininterval=1.0,

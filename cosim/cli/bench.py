@@ -8,6 +8,11 @@ per case (``bench_<case>.png``) to ``--out``; with ``--docs FILE`` it also rewri
 Markdown file and puts the plots beside it. Results are cached per configuration under ``--cache`` (key: the
 configuration and the simulation code's version), so a rerun, or a run after an interruption, only computes what
 is missing.
+
+``--plan targets`` measures issue 7's speed targets instead (:mod:`cosim.bench.targets`: the 3-D throughput at 1M
+particles beside warp's example_sph, the 2-D steps per second at 10k, the 3-D pour's real-time factor, all on a CUDA
+device when one is present; the default pour's wall time on the CPU), afresh each time, into ``targets.md`` and
+``targets.json``; with ``--docs`` it rewrites that file's block for this machine's kind (cpu or cuda).
 """
 
 from __future__ import annotations
@@ -25,13 +30,14 @@ from cosim.bench.run import run_plan
 from cosim.errors import InputError
 
 DEFAULT_OUT = Path("recordings") / "bench"
-PLANS = ("full", "smoke")
+PLANS = ("full", "smoke", "targets")
 
 
 def register(subparsers) -> None:
     p = subparsers.add_parser("bench", help="wall time against error: resolutions, numerics, skip options (CSV, PNG, Markdown)",
                               description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--plan", default="full", help=f"which configurations: {' or '.join(PLANS)} (smoke: seconds, for checks; default full)")
+    p.add_argument("--plan", default="full", help="which configurations: full (default), smoke (seconds, for checks) or targets (issue 7's speed targets on "
+                   "this machine's devices, measured afresh: no cache)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for bench.csv, bench.md and the plots (default {DEFAULT_OUT})")
     p.add_argument("--cache", type=Path, help="result cache folder (default OUT/cache)")
     p.add_argument("--docs", type=Path, help="also rewrite the generated part of this Markdown file (e.g. docs/benchmarks.md), plots beside it")
@@ -40,17 +46,41 @@ def register(subparsers) -> None:
     p.set_defaults(func=run)
 
 
-def _header(command: str, code_versions: dict) -> str:
+def _machine_line() -> str:
+    """'Machine: ...; CUDA .... Versions: ...' for a report's header."""
     from cosim.fluid.benchmark import machine_description
     from cosim.fluid.runtime import cuda_available
     from cosim.pour_run import package_versions
 
     versions = ", ".join(f"{k} {v}" for k, v in package_versions().items() if k != "cosim")
     cuda = "a CUDA device is present: cuda rows included" if cuda_available() else "no CUDA device here: CPU rows only"
-    return (f"## Wall time against error ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
-            f"Machine: {machine_description()}; {cuda}. Versions: {versions}.\n"
+    return f"Machine: {machine_description()}; {cuda}. Versions: {versions}."
+
+
+def _header(command: str, code_versions: dict) -> str:
+    return (f"## Wall time against error ({datetime.now(timezone.utc):%Y-%m-%d})\n\n{_machine_line()}\n"
             f"Command: `{command}`. Code versions (cosim.bench.cache.code_version): "
             f"{', '.join(f'{k.value} {v}' for k, v in code_versions.items())}.\n")
+
+
+def _run_targets(args) -> int:
+    """``--plan targets``: issue 7's speed targets measured on this machine (:mod:`cosim.bench.targets`)."""
+    from cosim.bench.targets import measure_all, write_report
+    from cosim.fluid.runtime import cuda_available
+
+    cuda = "cuda" if cuda_available() else None
+    measurements = measure_all(cuda=cuda)
+    command = "cosim bench --plan targets" + (f" --docs {args.docs}" if args.docs else "")
+    header = (f"### Speed targets, {'cuda' if cuda else 'cpu'} ({datetime.now(timezone.utc):%Y-%m-%d})\n\n{_machine_line()}\n"
+              f"Command: `{command}` (cosim.bench.targets: what each row measures).")
+    text = write_report(measurements, header, args.out)
+    if args.docs is not None:
+        kind = "cuda" if cuda else "cpu"
+        update_document(args.docs, text, f"<!-- cosim bench targets, {kind}: generated, begin -->",
+                        f"<!-- cosim bench targets, {kind}: generated, end -->")
+    print(text)
+    print(f"wrote {args.out / 'targets.md'} and {args.out / 'targets.json'}" + (f"; updated {args.docs}" if args.docs else ""))
+    return 1 if any(m.failed for m in measurements) else 0
 
 
 def run(args) -> int:
@@ -60,6 +90,8 @@ def run(args) -> int:
         raise InputError(f"--docs: must be a Markdown file (.md), got {args.docs}")
     if args.out.exists() and not args.out.is_dir():
         raise InputError(f"--out: {args.out} exists and is not a folder")
+    if args.plan == "targets":
+        return _run_targets(args)
     plan = build_plan(args.plan)
     cache = ResultCache(args.cache or args.out / "cache")
     outcome = run_plan(plan, cache, fresh=args.fresh, progress=not args.quiet)

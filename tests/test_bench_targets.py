@@ -1,0 +1,78 @@
+"""Issue 7's speed targets (cosim.bench.targets, ``cosim bench --plan targets``): the verdicts, every measurement's
+path at small sizes on the CPU (numbers meaningless there), and the report the command writes."""
+
+import json
+
+import pytest
+
+from cosim.bench import targets
+from cosim.bench.targets import DEFAULT_POUR, POUR_3D, STEPS_2D, THROUGHPUT_3D, Measurement, TargetSizes
+from cosim.cli.main import main
+
+# seconds of CPU: the measurements' machinery, not their numbers
+SMALL = TargetSizes(throughput_3d=2000, throughput_2d=300, steps=4, repeats=1, pour_3d_across=12, pour_3d_seconds=0.02,
+                    default_pour_repeats=1, default_pour_duration=0.04)
+
+
+def test_verdicts_compare_with_the_threshold_in_the_targets_direction():
+    assert Measurement(THROUGHPUT_3D, 1.0, "").verdict == "met"  # at least 1.0 G: the threshold itself meets it
+    assert Measurement(THROUGHPUT_3D, 0.25, "").verdict == "missed, 4 x"
+    assert Measurement(DEFAULT_POUR, 60.0, "").verdict == "met"  # at most 60 s
+    assert Measurement(DEFAULT_POUR, 90.0, "").verdict == "missed, 1.5 x"
+    assert Measurement(STEPS_2D, None, "no CUDA device on this machine").verdict == "not measured"
+    assert Measurement(POUR_3D, None, "RuntimeError: x", failed=True).verdict == "failed"
+
+
+@pytest.fixture(scope="module")
+def measured():
+    # the CUDA targets' measurements run on the CPU here: the same code path a CUDA device takes
+    return {m.target: m for m in targets.measure_all(SMALL, cuda="cpu")}
+
+
+def test_every_measurement_runs_and_reports_its_figure(measured):
+    assert list(measured) == list(targets.TARGETS)
+    assert all(not m.failed and m.value > 0.0 for m in measured.values()), [m.detail for m in measured.values()]
+    assert "example_sph at the same count" in measured[THROUGHPUT_3D].detail
+    assert "wcsph:" in measured[STEPS_2D].detail and "dfsph:" in measured[STEPS_2D].detail
+    assert "the rest (host)" in measured[POUR_3D].detail
+    # the default pour ran as a user runs it, to its --duration: 0.04 s simulated
+    assert "0.04 s simulated" in measured[DEFAULT_POUR].detail
+
+
+def test_without_cuda_the_cuda_targets_are_listed_not_measured(monkeypatch):
+    monkeypatch.setitem(targets.MEASURES, DEFAULT_POUR, lambda device, sizes: (12.5, f"on {device}"))
+    rows = targets.measure_all(SMALL, cuda=None)
+    assert [m.verdict for m in rows] == ["not measured"] * 3 + ["met"]
+    assert rows[-1].detail == "on cpu"
+
+
+def test_a_failing_measurement_is_a_row_and_the_others_still_run(monkeypatch):
+    def broken(device, sizes):
+        raise RuntimeError("out of memory\nsecond line")
+
+    monkeypatch.setitem(targets.MEASURES, DEFAULT_POUR, broken)
+    rows = targets.measure_all(SMALL, cuda=None)
+    assert rows[-1].failed and rows[-1].detail == "RuntimeError: out of memory"
+
+
+def test_cosim_bench_targets_writes_the_report_and_the_docs_block(tmp_path, monkeypatch, capsys):
+    rows = [Measurement(THROUGHPUT_3D, None, "no CUDA device on this machine"), Measurement(DEFAULT_POUR, 42.0, "runs: 42.0 s")]
+    monkeypatch.setattr(targets, "measure_all", lambda cuda=None: rows)
+    monkeypatch.setattr("cosim.fluid.runtime.cuda_available", lambda: False)
+    docs = tmp_path / "bench.md"
+    docs.write_text("# B\n\nkept\n<!-- cosim bench targets, cpu: generated, begin -->\nthe previous run\n<!-- cosim bench targets, cpu: generated, end -->\ntail\n")
+    out = tmp_path / "out"
+    assert main(["bench", "--plan", "targets", "--out", str(out), "--docs", str(docs)]) == 0
+    text = docs.read_text()
+    assert "kept" in text and "tail" in text and "the previous run" not in text
+    assert "| default pour, `cosim pour --no-log`, compiled kernels cached | cpu | <= 60 s wall | 42 s wall | met | runs: 42.0 s |" in text
+    assert "| not measured | no CUDA device on this machine |" in text
+    assert "Command: `cosim bench --plan targets --docs" in text
+    saved = json.loads((out / "targets.json").read_text())
+    assert [r["verdict"] for r in saved] == ["not measured", "met"] and saved[1]["value"] == 42.0
+    assert (out / "targets.md").read_text() in capsys.readouterr().out
+
+
+def test_a_failed_target_sets_the_exit_status(tmp_path, monkeypatch):
+    monkeypatch.setattr(targets, "measure_all", lambda cuda=None: [Measurement(DEFAULT_POUR, None, "RuntimeError: x", failed=True)])
+    assert main(["bench", "--plan", "targets", "--out", str(tmp_path)]) == 1
