@@ -18,6 +18,7 @@ import tempfile
 from dataclasses import asdict, replace
 from datetime import datetime, timezone
 from importlib import metadata
+from importlib.util import find_spec
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -180,6 +181,9 @@ def package_versions() -> dict[str, str]:
 
 def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -> tuple[Path, dict]:
     """Run ``scene`` and write its outputs; returns (run folder, summary)."""
+    if scene.logging.enabled and find_spec("rerun") is None:
+        raise InputError("logging.enabled: the Rerun recording needs rerun-sdk, which is not installed "
+                         "(install it, or run without the recording: --no-log or logging.enabled = false)")
     final = destination(out, scene.name)
     pour = prepare(scene)
     final.parent.mkdir(parents=True, exist_ok=True)
@@ -190,7 +194,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
     recorder = None
     try:
         # imported here: prepare() needs neither rerun-sdk nor tqdm, and a pour without its recording needs no
-        # rerun-sdk (the GPU machine has no rerun-sdk; README, "On a GPU")
+        # rerun-sdk (the GPU machine has none; README, Speed)
         from tqdm import tqdm
 
         callbacks = []

@@ -165,6 +165,20 @@ def test_unreadable_scene_file_and_busy_output_folder(tmp_path, capsys):
     assert (busy / "x").read_text() == "earlier run"
 
 
+def test_a_recording_without_rerun_sdk_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, monkeypatch):
+    # as on the GPU machine, which has no rerun-sdk: the pour with its recording is refused before anything runs,
+    # the message saying how to run it without the recording (which needs no rerun-sdk)
+    import cosim.pour_run
+
+    real = cosim.pour_run.find_spec
+    monkeypatch.setattr(cosim.pour_run, "find_spec", lambda name: None if name == "rerun" else real(name))
+    out = tmp_path / "out"
+    assert main(["pour", "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "logging.enabled" in err[0] and "--no-log" in err[0]
+    assert not out.exists() and not list(tmp_path.glob(".out*"))
+
+
 def test_scene_dump_round_trips(tmp_path, capsys):
     assert main(["scene", "--dump"]) == 0
     text = capsys.readouterr().out
