@@ -50,14 +50,20 @@ def test_a_failing_measurement_is_a_row_and_the_others_still_run(monkeypatch):
     def broken(device, sizes):
         raise RuntimeError("out of memory\nsecond line")
 
-    monkeypatch.setitem(targets.MEASURES, DEFAULT_POUR, broken)
-    rows = targets.measure_all(SMALL, cuda=None)
-    assert rows[-1].failed and rows[-1].detail == "RuntimeError: out of memory"
+    for target in targets.TARGETS:
+        monkeypatch.setitem(targets.MEASURES, target, lambda device, sizes: (1e9, f"on {device}"))
+    monkeypatch.setitem(targets.MEASURES, STEPS_2D, broken)
+    seen = []
+    rows = targets.measure_all(SMALL, cuda="cuda:3", on_row=lambda so_far: seen.append([m.verdict for m in so_far]))
+    assert rows[1].failed and rows[1].detail == "RuntimeError: out of memory"
+    assert [m.detail for m in rows] == ["on cuda:3", "RuntimeError: out of memory", "on cuda:3", "on cpu"]  # all ran
+    # the report can be rewritten after every row: a run stopped part-way keeps what it measured
+    assert seen == [["met"], ["met", "failed"], ["met", "failed", "met"], ["met", "failed", "met", "missed, 1.67e+07 x"]]
 
 
 def test_cosim_bench_targets_writes_the_report_and_the_docs_block(tmp_path, monkeypatch, capsys):
     rows = [Measurement(THROUGHPUT_3D, None, "no CUDA device on this machine"), Measurement(DEFAULT_POUR, 42.0, "runs: 42.0 s")]
-    monkeypatch.setattr(targets, "measure_all", lambda cuda=None: rows)
+    monkeypatch.setattr(targets, "measure_all", lambda cuda=None, on_row=None: rows)
     monkeypatch.setattr("cosim.fluid.runtime.cuda_available", lambda: False)
     docs = tmp_path / "bench.md"
     docs.write_text("# B\n\nkept\n<!-- cosim bench targets, cpu: generated, begin -->\nthe previous run\n<!-- cosim bench targets, cpu: generated, end -->\ntail\n")
@@ -74,5 +80,5 @@ def test_cosim_bench_targets_writes_the_report_and_the_docs_block(tmp_path, monk
 
 
 def test_a_failed_target_sets_the_exit_status(tmp_path, monkeypatch):
-    monkeypatch.setattr(targets, "measure_all", lambda cuda=None: [Measurement(DEFAULT_POUR, None, "RuntimeError: x", failed=True)])
+    monkeypatch.setattr(targets, "measure_all", lambda cuda=None, on_row=None: [Measurement(DEFAULT_POUR, None, "RuntimeError: x", failed=True)])
     assert main(["bench", "--plan", "targets", "--out", str(tmp_path)]) == 1

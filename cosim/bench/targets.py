@@ -173,21 +173,27 @@ MEASURES: dict[Target, Callable[[str, TargetSizes], tuple[float, str]]] = {
 }
 
 
-def measure_all(sizes: TargetSizes = TargetSizes(), cuda: str | None = None) -> list[Measurement]:
-    """Every target: the CUDA ones on ``cuda`` (None: not measured), the CPU one on the CPU."""
-    out = []
+def _measure(target: Target, device: str | None, sizes: TargetSizes) -> Measurement:
+    if device is None:
+        return Measurement(target, None, "no CUDA device on this machine")
+    try:
+        value, detail = MEASURES[target](device, sizes)
+    except Exception as exc:  # a broken measurement is a row of the report, not the end of the others
+        message = str(exc).strip().splitlines()
+        return Measurement(target, None, f"{type(exc).__name__}: {message[0] if message else ''}", failed=True)
+    return Measurement(target, value, detail)
+
+
+def measure_all(sizes: TargetSizes = TargetSizes(), cuda: str | None = None,
+                on_row: Callable[[list[Measurement]], None] | None = None) -> list[Measurement]:
+    """Every target: the CUDA ones on ``cuda`` (None: not measured), the CPU one on the CPU. ``on_row`` is called
+    with the rows so far after each one (the command rewrites its report, so that a run stopped part-way, e.g. at
+    the device tool's time limit, leaves the targets it measured)."""
+    out: list[Measurement] = []
     for target in TARGETS:
-        device = cuda if target.device == "cuda" else "cpu"
-        if device is None:
-            out.append(Measurement(target, None, "no CUDA device on this machine"))
-            continue
-        try:
-            value, detail = MEASURES[target](device, sizes)
-        except Exception as exc:  # a broken measurement is a row of the report, not the end of the others
-            message = str(exc).strip().splitlines()
-            out.append(Measurement(target, None, f"{type(exc).__name__}: {message[0] if message else ''}", failed=True))
-            continue
-        out.append(Measurement(target, value, detail))
+        out.append(_measure(target, cuda if target.device == "cuda" else "cpu", sizes))
+        if on_row is not None:
+            on_row(out)
     return out
 
 
