@@ -10,7 +10,7 @@ from dataclasses import replace
 from cosim.bench.cache import ResultCache
 from cosim.bench.config import BenchCase, BenchConfig
 from cosim.bench.pareto import pareto_front
-from cosim.bench.plan import build_plan
+from cosim.bench.plan import FULL_AXES, SMOOTHING_RATIO_LEVELS, build_plan
 from cosim.bench.pour_compare import compare_pours
 from cosim.bench.report import CSV_COLUMNS, GENERATED_BEGIN, GENERATED_END, build_rows, markdown, rows_csv, update_document
 from cosim.bench.run import run_plan
@@ -67,7 +67,8 @@ def test_cache_key_covers_every_parameter_and_the_code_version():
                 BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, cfl=0.3), BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, kernel="cubic_spline"),
                 BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, dim=3), BenchConfig(BenchCase.SLOSH, 20, 1.0),
                 BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="dfsph"),
-                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="dfsph", density_tolerance=1e-4)]
+                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="dfsph", density_tolerance=1e-4),
+                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, smoothing_ratio=1.3)]
     keys = {a.key("v1"), a.key("v2"), *(v.key("v1") for v in variants)}
     assert len(keys) == 2 + len(variants)
     assert a.key("v1") == BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0).key("v1")
@@ -113,6 +114,28 @@ def test_a_density_tolerance_reaches_the_pour_scene_and_the_validation_numerics(
     hydro = BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="dfsph", density_tolerance=1e-5)
     assert dict(numerics(hydro))["density_tolerance"] == 1e-5
     assert "density_tolerance" not in dict(numerics(replace(hydro, density_tolerance=None)))
+
+
+def test_every_case_has_rows_at_the_other_smoothing_ratios_at_its_axes_resolution():
+    plan = build_plan("full")
+    for case in plan.defaults:
+        rows = [c for c in plan.rows if c.case is case and c.smoothing_ratio is not None]
+        assert [c.smoothing_ratio for c in rows] == list(SMOOTHING_RATIO_LEVELS)
+        axes = FULL_AXES[case]
+        assert all(c.particles_across == (axes.axes_at or axes.resolutions[-1]) for c in rows)
+        # one axis at a time: everything else is the default numerics
+        assert all(replace(c, smoothing_ratio=None) in plan.rows for c in rows)
+
+
+def test_a_smoothing_ratio_reaches_the_pour_scene_and_the_validation_numerics():
+    cfg = BenchConfig(BenchCase.POUR, 20, 2.0, smoothing_ratio=1.3)
+    assert pour_scene(cfg).fluid.fluid_config(0.1).smoothing_ratio == 1.3
+    assert cfg.label.endswith("h/dx1.3")
+    hydro = BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, smoothing_ratio=1.8)
+    assert dict(numerics(hydro))["smoothing_ratio"] == 1.8
+    assert "smoothing_ratio" not in dict(numerics(replace(hydro, smoothing_ratio=None)))
+    with pytest.raises(InputError, match="smoothing_ratio"):
+        BenchConfig(BenchCase.SLOSH, 20, 1.0, smoothing_ratio=3.0)
 
 
 def test_update_document_keeps_the_text_around_the_generated_block(tmp_path):

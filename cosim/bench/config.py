@@ -47,6 +47,7 @@ class BenchConfig:
         sorted by key; only for the pour.
     density_tolerance: DFSPH's density-solve tolerance (``FluidConfig.density_tolerance``); None: the solver's
         default. Only with DFSPH. (0, 0.05]
+    smoothing_ratio: h / dx (``FluidConfig.smoothing_ratio``); None: the default. [1.0, 2.5]
     """
 
     case: BenchCase
@@ -59,6 +60,7 @@ class BenchConfig:
     device: str = "cpu"
     options: tuple[tuple[str, OptionValue], ...] = ()
     density_tolerance: float | None = None
+    smoothing_ratio: float | None = None
 
     def __post_init__(self) -> None:
         s = object.__setattr__
@@ -77,6 +79,8 @@ class BenchConfig:
             check_range("density_tolerance", self.density_tolerance, 0.0, 0.05, lo_open=True)
             if self.pressure_solver is not PressureSolver.DFSPH:
                 raise InputError(f"density_tolerance: applies to the dfsph solver only, not to {self.pressure_solver.value}")
+        if self.smoothing_ratio is not None:
+            check_range("smoothing_ratio", self.smoothing_ratio, 1.0, 2.5)
 
     def to_json(self) -> dict:
         """Plain JSON values (enums by value)."""
@@ -84,6 +88,7 @@ class BenchConfig:
             "case": self.case.value, "particles_across": self.particles_across, "length": self.length, "dim": self.dim,
             "kernel": self.kernel.value, "cfl": self.cfl, "pressure_solver": self.pressure_solver.value,
             "device": self.device, "options": [list(o) for o in self.options], "density_tolerance": self.density_tolerance,
+            "smoothing_ratio": self.smoothing_ratio,
         }
 
     def key(self, code_version: str) -> str:
@@ -94,10 +99,12 @@ class BenchConfig:
     @property
     def label(self) -> str:
         """Short human name, e.g. 'pour 2-D 32 wendland_c2 cfl0.25 wcsph cpu coupling=one_way' (DFSPH rows with their
-        own density tolerance: ' tol1e-05' after the device)."""
+        own density tolerance: ' tol1e-05' after the device; rows with their own smoothing ratio: ' h/dx1.3')."""
         parts = [self.case.value, f"{self.dim}-D", str(self.particles_across), self.kernel.value, f"cfl{self.cfl:g}",
                  self.pressure_solver.value, self.device]
         if self.density_tolerance is not None:
             parts.append(f"tol{self.density_tolerance:g}")
+        if self.smoothing_ratio is not None:
+            parts.append(f"h/dx{self.smoothing_ratio:g}")
         parts += [f"{k.rsplit('.', 1)[-1]}={v}" for k, v in self.options]
         return " ".join(parts)

@@ -1,7 +1,7 @@
 """Which configurations the benchmark runs: axes around the default scene's settings, not hand-written rows.
 
 Per case: a resolution sweep at the default numerics, then one axis at a time at the case's default resolution
-(the pour: at 24 across) (every other kernel, the CFL levels), and every other pressure solver over the whole
+(the pour: at 24 across) (every other kernel, the CFL levels, the smoothing ratios h / dx), and every other pressure solver over the whole
 resolution sweep (to compare the solvers at equal error); on every device present. The pour adds a
 fine reference (:data:`REFERENCE_ACROSS`, :data:`REFERENCE_SOLVER`) that its resolution and numerics rows are compared with, and the skip
 options: pairs of runs that differ only in what a scene may skip, the second doing the full work.
@@ -30,6 +30,10 @@ CFL_LEVELS = (0.15, 0.4)  # besides the default 0.25 (the stress matrix goes to 
 # DFSPH's density-solve tolerance besides the default (Gauss-Seidel's 1.5e-4), at each case's default resolution: its
 # iterations are about half of a DFSPH substep, so it is the solver's own speed-against-error knob
 DENSITY_TOLERANCE_LEVELS = (5.0e-5, 1.0e-4, 3.0e-4)
+# h / dx besides the default 1.5 (FluidConfig.smoothing_ratio), at each case's default resolution: fewer neighbours per
+# particle (in 3-D the pair work of a substep goes as the cube of the ratio) against the kernel's accuracy; a smaller
+# ratio also shortens the time step, a larger one lengthens it
+SMOOTHING_RATIO_LEVELS = (1.3, 1.8)
 # s, max_duration of the early-stop pair at 24 across (the pour is done at about 14 s; the run without the early stop
 # goes on to this; the default scene's 60 s would cost 2.5 x more)
 FULL_POUR_SECONDS = 24.0
@@ -107,6 +111,7 @@ def _axis_rows(case: BenchCase, axes: CaseAxes, device: str) -> list[BenchConfig
     rows = [replace(base, particles_across=n) for n in axes.resolutions]
     rows += [replace(base, kernel=k) for k in KernelType if k is not base.kernel]
     rows += [replace(base, cfl=c) for c in axes.cfl_levels if c != base.cfl]
+    rows += [replace(base, smoothing_ratio=r) for r in SMOOTHING_RATIO_LEVELS]
     if base.pressure_solver is PressureSolver.DFSPH:
         rows += [replace(base, particles_across=axes.resolutions[-1], density_tolerance=t) for t in DENSITY_TOLERANCE_LEVELS]
     # every other pressure solver over the whole resolution sweep, so the two can be compared at equal error

@@ -140,7 +140,7 @@ def _describe(cfg: BenchConfig, default: BenchConfig) -> str:
     diffs = []
     if cfg.particles_across != default.particles_across:
         diffs.append(f"{cfg.particles_across} across")
-    for name in ("dim", "kernel", "cfl", "pressure_solver", "density_tolerance", "device"):
+    for name in ("dim", "kernel", "cfl", "pressure_solver", "density_tolerance", "smoothing_ratio", "device"):
         a, b = getattr(cfg, name), getattr(default, name)
         if a != b:
             diffs.append(f"{name} {getattr(a, 'value', a)}")

@@ -37,7 +37,8 @@ TRAJECTORY_KEEP_HZ = 100.0
 def numerics(cfg: BenchConfig) -> tuple[tuple[str, Any], ...]:
     """The configuration's numerical settings as FluidConfig overrides (``FluidCaseParams.numerics``)."""
     tolerance = () if cfg.density_tolerance is None else (("density_tolerance", cfg.density_tolerance),)
-    return (("kernel", cfg.kernel), ("cfl", cfg.cfl), *tolerance)
+    ratio = () if cfg.smoothing_ratio is None else (("smoothing_ratio", cfg.smoothing_ratio),)
+    return (("kernel", cfg.kernel), ("cfl", cfg.cfl), *tolerance, *ratio)
 
 
 def case_width(cfg: BenchConfig) -> float:
@@ -97,6 +98,8 @@ def pour_scene(cfg: BenchConfig) -> PourScene:
     }
     if cfg.density_tolerance is not None:
         table["fluid"]["density_tolerance"] = cfg.density_tolerance
+    if cfg.smoothing_ratio is not None:
+        table["fluid"]["smoothing_ratio"] = cfg.smoothing_ratio
     for key, value in cfg.options:
         *path, leaf = key.split(".")
         node = table
