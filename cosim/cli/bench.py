@@ -69,13 +69,13 @@ def _run_targets(args) -> int:
     from cosim.fluid.runtime import cuda_available
 
     cuda = "cuda" if cuda_available() else None
+    kind = "cuda" if cuda else "cpu"  # the docs block this machine rewrites
     command = "cosim bench --plan targets" + (f" --docs {args.docs}" if args.docs else "")
-    header = (f"### Speed targets, {'cuda' if cuda else 'cpu'} ({datetime.now(timezone.utc):%Y-%m-%d})\n\n{_machine_line()}\n"
+    header = (f"### Speed targets, {kind} ({datetime.now(timezone.utc):%Y-%m-%d})\n\n{_machine_line()}\n"
               f"Command: `{command}` (cosim.bench.targets: what each row measures).")
     measurements = measure_all(cuda=cuda, on_row=lambda rows: write_report(rows, header, args.out))
     text = write_report(measurements, header, args.out)
     if args.docs is not None:
-        kind = "cuda" if cuda else "cpu"
         update_document(args.docs, text, f"<!-- cosim bench targets, {kind}: generated, begin -->",
                         f"<!-- cosim bench targets, {kind}: generated, end -->")
     print(text)
