@@ -31,7 +31,7 @@ from cosim.vessel import VesselSpec
 MIN_FIT_COLUMNS = 3  # the contract: fewer columns than this and theta1 = tilt
 CHUNKS = 64  # fixed-order reduction of the leaving stream: per-chunk sums, then the chunks in order
 LOWEST = -1.0e30  # "no particle" for the maxima
-_SUMS = 5  # per chunk: count, sum vx, sum vz, sum x, sum z of the leaving particles
+STREAM_SUM_COLUMNS = 5  # per chunk: count, sum vx, sum vz, sum x, sum z of the leaving particles
 
 
 @dataclass(frozen=True)
@@ -248,7 +248,7 @@ class LiquidProbe:
         self._column_top = wp.zeros(cols, dtype=float, device=device)
         self._column_top_x = wp.zeros(cols, dtype=float, device=device)
         self._crest_top = wp.zeros(1, dtype=float, device=device)
-        self._sums = wp.zeros((CHUNKS, _SUMS), dtype=float, device=device)
+        self._sums = wp.zeros((CHUNKS, STREAM_SUM_COLUMNS), dtype=float, device=device)
         self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
         self._crossing_x = wp.zeros(max(n_particles, 1), dtype=float, device=device)
         self._commands: dict[tuple, wp.Launch] = {}
