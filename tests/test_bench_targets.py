@@ -31,7 +31,7 @@ def measured():
 
 def test_every_measurement_runs_and_reports_its_figure(measured):
     assert list(measured) == list(targets.TARGETS)
-    assert all(not m.failed and m.value > 0.0 for m in measured.values()), [m.detail for m in measured.values()]
+    assert all(not m.failed and m.value > 0.0 and m.took_s > 0.0 for m in measured.values()), [m.detail for m in measured.values()]
     assert "example_sph at the same count" in measured[THROUGHPUT_3D].detail
     assert "wcsph:" in measured[STEPS_2D].detail and "dfsph:" in measured[STEPS_2D].detail
     assert "the rest (host)" in measured[POUR_3D].detail
@@ -62,7 +62,7 @@ def test_a_failing_measurement_is_a_row_and_the_others_still_run(monkeypatch):
 
 
 def test_cosim_bench_targets_writes_the_report_and_the_docs_block(tmp_path, monkeypatch, capsys):
-    rows = [Measurement(THROUGHPUT_3D, None, "no CUDA device on this machine"), Measurement(DEFAULT_POUR, 42.0, "runs: 42.0 s")]
+    rows = [Measurement(THROUGHPUT_3D, None, "no CUDA device on this machine"), Measurement(DEFAULT_POUR, 42.0, "runs: 42.0 s", took_s=170.2)]
     monkeypatch.setattr(targets, "measure_all", lambda cuda=None, on_row=None: rows)
     monkeypatch.setattr("cosim.fluid.runtime.cuda_available", lambda: False)
     docs = tmp_path / "bench.md"
@@ -71,8 +71,8 @@ def test_cosim_bench_targets_writes_the_report_and_the_docs_block(tmp_path, monk
     assert main(["bench", "--plan", "targets", "--out", str(out), "--docs", str(docs)]) == 0
     text = docs.read_text()
     assert "kept" in text and "tail" in text and "the previous run" not in text
-    assert "| default pour, `cosim pour --no-log`, compiled kernels cached | cpu | <= 60 s wall | 42 s wall | met | runs: 42.0 s |" in text
-    assert "| not measured | no CUDA device on this machine |" in text
+    assert "| default pour, `cosim pour --no-log`, compiled kernels cached | cpu | <= 60 s wall | 42 s wall | met | runs: 42.0 s | 170 s |" in text
+    assert "| not measured | no CUDA device on this machine | - |" in text
     assert "Command: `cosim bench --plan targets --docs" in text
     saved = json.loads((out / "targets.json").read_text())
     assert [r["verdict"] for r in saved] == ["not measured", "met"] and saved[1]["value"] == 42.0

@@ -72,12 +72,14 @@ class Target:
 @dataclass(frozen=True)
 class Measurement:
     """value: the measured figure in the target's unit (None: not measured or failed); detail: what else the same run
-    measured, or why nothing was measured; failed: the measurement raised (detail holds its error)."""
+    measured, or why nothing was measured; failed: the measurement raised (detail holds its error); took_s: wall
+    seconds the measurement took, set-up and warm-up included (what it costs on a lent GPU machine)."""
 
     target: Target
     value: float | None
     detail: str
     failed: bool = False
+    took_s: float = 0.0
 
     @property
     def verdict(self) -> str:
@@ -95,7 +97,7 @@ class Measurement:
     def to_json(self) -> dict:
         t = self.target
         return {"target": t.name, "device": t.device, "threshold": t.threshold, "unit": t.unit, "at_least": t.at_least,
-                "value": self.value, "detail": self.detail, "verdict": self.verdict}
+                "value": self.value, "detail": self.detail, "verdict": self.verdict, "took_s": self.took_s}
 
 
 THROUGHPUT_3D = Target("3-D WCSPH, 1M particles: full step throughput", "cuda", 1.0, "G particle-steps/s", True)
@@ -176,12 +178,14 @@ MEASURES: dict[Target, Callable[[str, TargetSizes], tuple[float, str]]] = {
 def _measure(target: Target, device: str | None, sizes: TargetSizes) -> Measurement:
     if device is None:
         return Measurement(target, None, "no CUDA device on this machine")
+    start = time.perf_counter()
     try:
         value, detail = MEASURES[target](device, sizes)
     except Exception as exc:  # a broken measurement is a row of the report, not the end of the others
         message = str(exc).strip().splitlines()
-        return Measurement(target, None, f"{type(exc).__name__}: {message[0] if message else ''}", failed=True)
-    return Measurement(target, value, detail)
+        return Measurement(target, None, f"{type(exc).__name__}: {message[0] if message else ''}", failed=True,
+                           took_s=time.perf_counter() - start)
+    return Measurement(target, value, detail, took_s=time.perf_counter() - start)
 
 
 def measure_all(sizes: TargetSizes = TargetSizes(), cuda: str | None = None,
@@ -199,12 +203,13 @@ def measure_all(sizes: TargetSizes = TargetSizes(), cuda: str | None = None,
 
 def markdown(measurements: list[Measurement], header: str) -> str:
     """The report: ``header``, then one row per target."""
-    lines = [header.rstrip(), "", "| target | on | threshold | measured | verdict | detail |", "|---|---|---|---|---|---|"]
+    lines = [header.rstrip(), "", "| target | on | threshold | measured | verdict | detail | took |", "|---|---|---|---|---|---|---|"]
     for m in measurements:
         t = m.target
         bound = f"{'>=' if t.at_least else '<='} {t.threshold:g} {t.unit}"
         value = "-" if m.value is None else f"{m.value:.4g} {t.unit}"
-        lines.append(f"| {t.name} | {t.device} | {bound} | {value} | {m.verdict} | {m.detail} |")
+        took = f"{m.took_s:.0f} s" if m.took_s else "-"
+        lines.append(f"| {t.name} | {t.device} | {bound} | {value} | {m.verdict} | {m.detail} | {took} |")
     return "\n".join(lines) + "\n"
 
 
