@@ -10,7 +10,7 @@ from collections import Counter
 
 import warp as wp
 
-from cosim.bench.host_overhead import time_steps, warm_pour
+from cosim.bench.host_overhead import POUR_WARM_UP, time_steps, warm_pour
 from cosim.coupling.measure import CHUNKS, STREAM_SUM_COLUMNS
 
 STREAM_SUMS = CHUNKS * STREAM_SUM_COLUMNS  # the probe's partial sums of the leaving stream, per chunk: a fixed size
@@ -47,7 +47,7 @@ def _spied(monkeypatch, pour) -> Counter:
 
 def _transfers(across: int, monkeypatch) -> tuple[int, Counter]:
     pour = warm_pour("cpu", 2, across, WARM_SECONDS + SPIED_SECONDS, "dfsph", "gauss_seidel")
-    time_steps(pour, WARM_SECONDS - 0.05)  # warm_pour stepped the first 0.05 s
+    time_steps(pour, WARM_SECONDS - POUR_WARM_UP)  # warm_pour stepped the first POUR_WARM_UP
     return pour.fluid.n_particles, _spied(monkeypatch, pour)
 
 
