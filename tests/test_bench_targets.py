@@ -82,3 +82,12 @@ def test_cosim_bench_targets_writes_the_report_and_the_docs_block(tmp_path, monk
 def test_a_failed_target_sets_the_exit_status(tmp_path, monkeypatch):
     monkeypatch.setattr(targets, "measure_all", lambda cuda=None, on_row=None: [Measurement(DEFAULT_POUR, None, "RuntimeError: x", failed=True)])
     assert main(["bench", "--plan", "targets", "--out", str(tmp_path)]) == 1
+
+
+@pytest.mark.parametrize("extra", [["--fresh"], ["--cache", "somewhere"]])
+def test_cache_options_with_the_targets_plan_are_one_line_exit_2(extra, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["bench", "--plan", "targets", "--out", str(out), *extra]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and extra[0] in err[0] and "caches nothing" in err[0]
+    assert not out.exists()

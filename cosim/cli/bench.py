@@ -91,6 +91,8 @@ def run(args) -> int:
     if args.out.exists() and not args.out.is_dir():
         raise InputError(f"--out: {args.out} exists and is not a folder")
     if args.plan == "targets":
+        if args.cache is not None or args.fresh:
+            raise InputError(f"{'--cache' if args.cache is not None else '--fresh'}: the targets plan measures afresh every time and caches nothing")
         return _run_targets(args)
     plan = build_plan(args.plan)
     cache = ResultCache(args.cache or args.out / "cache")
