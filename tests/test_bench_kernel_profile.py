@@ -1,8 +1,13 @@
-"""The kernel profile's case syntax (cosim.bench.kernel_profile; its CUDA tables need a GPU)."""
+"""The kernel profile (cosim.bench.kernel_profile): its case syntax, and its per-operation timing on the CPU (its CUDA
+tables need a GPU)."""
 
+import re
+
+import numpy as np
 import pytest
 
-from cosim.bench.kernel_profile import parse_case
+from cosim.bench.kernel_profile import OperationTimer, parse_case, profile_case
+from cosim.fluid.benchmark import resting_block
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 
 
@@ -11,3 +16,23 @@ def test_cases_name_dimension_particles_solver_and_density_iteration():
     assert parse_case("2:10000:dfsph:jacobi") == (2, 10_000, PressureSolver.DFSPH, DensityIteration.JACOBI)
     with pytest.raises(ValueError):
         parse_case("2:10000:sph")
+
+
+def test_on_the_cpu_each_operation_is_timed_and_the_results_do_not_change():
+    rows = profile_case(2, 400, PressureSolver.DFSPH, DensityIteration.GAUSS_SEIDEL, "cpu", 4, 50)
+    table = [r for r in rows if r.startswith("| ") and not r.startswith("| operation")]
+    names = [r.split(" | ")[0].lstrip("| ") for r in table]
+    # the density solve's sweeps, the stage that records the pairs, the neighbour grid's sort
+    assert {"gauss_seidel_density_sweep", "compute_density_factor", "integrate"} <= set(names)
+    assert any(n.endswith(".sort") for n in names)
+    wall, timed = (float(x) for x in re.search(r"wall ([\d.]+) ms .*?\), operations .*? ([\d.]+) ms", rows[2]).groups())
+    assert 0.0 < timed <= wall  # the operations run inside the timed interval
+
+    # the hook only wraps the calls: the same substeps give the same particles to the bit
+    runs = []
+    for hook in (None, OperationTimer()):
+        fluid, interval = resting_block(400, 2, "cpu", 4, PressureSolver.DFSPH, graphs=False)
+        fluid.operation_hook = hook
+        fluid.advance(2 * interval)
+        runs.append(fluid.positions())
+    assert np.array_equal(*runs) and sum(hook.count.values()) > 0

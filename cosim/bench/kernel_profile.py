@@ -7,7 +7,9 @@ timed by warp's CUDA activity timing (a profile, not a benchmark: launches run o
 For each case (dim:particles:solver, for DFSPH optionally :gauss_seidel or :jacobi, its density iteration) the
 block of ``cosim.fluid.benchmark`` settles for one interval of ``steps`` WCSPH substeps, then one more is timed: the wall time, the sum of the device activities (their
 difference is the host's launch and synchronisation cost), and the ``top`` activities by total time, with their
-count and milliseconds per substep. On the CPU warp times nothing per kernel: only the wall time is reported.
+count and milliseconds per substep. On the CPU, where warp times nothing per kernel, each operation of the substeps is
+timed on the host's clock instead (:class:`OperationTimer`, the solver's ``operation_hook``; a CPU launch returns
+when it is done), the lanes' shares one after the other.
 Writes DIR/kernel_profile.md (atomically) besides printing it.
 """
 
@@ -35,35 +37,62 @@ def parse_case(text: str) -> tuple[int, int, PressureSolver, DensityIteration]:
     return int(dim), int(n), PressureSolver(solver), DensityIteration(iteration[0]) if iteration else FluidConfig.density_iteration
 
 
+def operation_name(op) -> str:
+    """The kernel of a recorded launch, else the operation's own name (e.g. the neighbour grid's sort)."""
+    kernel = getattr(getattr(op, "__self__", None), "kernel", None)
+    return kernel.key if kernel is not None else getattr(op, "__qualname__", type(op).__name__)
+
+
+class OperationTimer:
+    """A :attr:`FluidSolver.operation_hook` that times each operation on the host's clock (ms, by
+    :func:`operation_name`): on the CPU a launch runs to completion before it returns."""
+
+    def __init__(self) -> None:
+        self.total: dict[str, float] = defaultdict(float)
+        self.count: dict[str, int] = defaultdict(int)
+
+    def __call__(self, op) -> None:
+        start = time.perf_counter()
+        op()
+        name = operation_name(op)
+        self.total[name] += 1e3 * (time.perf_counter() - start)
+        self.count[name] += 1
+
+
 def profile_case(dim: int, n: int, solver: PressureSolver, iteration: DensityIteration, device: str, steps: int, top: int) -> list[str]:
-    """The case's lines of the report: a heading, the wall and device totals, the table of the top activities."""
+    """The case's lines of the report: a heading, the wall and the timed totals, the table of the top activities
+    (on CUDA the device's activities, timed by warp; on the CPU each operation, timed on the host's clock)."""
     fluid, interval = resting_block(n, dim, device, steps, solver, graphs=False, iteration=iteration)
     fluid.advance(interval)  # compiles, settles
-    timed = fluid.device.is_cuda
-    if timed:
+    cuda = fluid.device.is_cuda
+    timer = OperationTimer()
+    if cuda:
         wp.timing_begin(cuda_filter=wp.TIMING_ALL)
+    else:
+        fluid.operation_hook = timer
     start = time.perf_counter()
     report = fluid.advance(interval)
     wp.synchronize_device(fluid.device)
     wall_ms = 1e3 * (time.perf_counter() - start)
-    results = wp.timing_end() if timed else []
-    total, count = defaultdict(float), defaultdict(int)
-    for r in results:
-        total[r.name] += r.elapsed
-        count[r.name] += 1
-    device_ms = sum(total.values())
+    fluid.operation_hook = None
+    for r in wp.timing_end() if cuda else []:
+        timer.total[r.name] += r.elapsed
+        timer.count[r.name] += 1
+    total, count = timer.total, timer.count
+    timed_ms, timed_count = sum(total.values()), sum(count.values())
+    what = "device activities" if cuda else "operations (each timed on the host's clock)"
     sub = report.substeps
     lines = [
         f"## {dim}-D, {fluid.n_particles} particles, {solver.value}{f' ({iteration.value})' if solver is PressureSolver.DFSPH else ''}, {fluid.device}",
         "",
-        f"{sub} substeps: wall {wall_ms:.2f} ms ({wall_ms / sub:.3f} ms a substep), device activities {device_ms:.2f} ms "
-        f"({device_ms / sub:.3f} ms a substep, {len(results)} activities, {len(results) / sub:.0f} a substep).",
+        f"{sub} substeps: wall {wall_ms:.2f} ms ({wall_ms / sub:.3f} ms a substep), {what} {timed_ms:.2f} ms "
+        f"({timed_ms / sub:.3f} ms a substep, {timed_count} of them, {timed_count / sub:.0f} a substep).",
         "",
     ]
-    if results:
-        lines += ["| activity | count | ms per substep | share of device time |", "|---|---|---|---|"]
+    if total:
+        lines += [f"| {'activity' if cuda else 'operation'} | count | ms per substep | share of the timed total |", "|---|---|---|---|"]
         for name in sorted(total, key=total.get, reverse=True)[:top]:
-            lines.append(f"| {name} | {count[name]} | {total[name] / sub:.4f} | {100 * total[name] / device_ms:.1f} % |")
+            lines.append(f"| {name} | {count[name]} | {total[name] / sub:.4f} | {100 * total[name] / timed_ms:.1f} % |")
         lines.append("")
     return lines
 

@@ -153,15 +153,19 @@ class PerLane(tuple):
     passes lane L its L-th value."""
 
 
-def run_serial(program: Program) -> None:
-    """Every lane's operations in lane order on the calling thread (uncaptured, or captured as one graph)."""
+def run_serial(program: Program, call: Callable[[Callable[[], None]], None] | None = None) -> None:
+    """Every lane's operations in lane order on the calling thread (uncaptured, or captured as one graph); ``call``,
+    when given, runs each operation instead (a profiler's hook: ``call(op)`` must call ``op()``)."""
     for item in program:
         if isinstance(item, Loop):
-            wp.capture_while(item.flag, lambda body=item.body: run_serial(body))
+            wp.capture_while(item.flag, lambda body=item.body: run_serial(body, call))
         else:
             for part in item.parts:
                 for op in part:
-                    op()
+                    if call is None:
+                        op()
+                    else:
+                        call(op)
 
 
 class _LaneThread:

@@ -140,6 +140,9 @@ class FluidSolver:
         self._capture_graphs = graphs
         self.graph_capture_error: str | None = None
         self._graphs: tuple | None = None  # per lane: (even, odd) substep graphs
+        # a profiler's hook (cosim.bench.kernel_profile): runs each operation of substeps launched one by one
+        # (graphs=False), ``operation_hook(op)`` calling ``op()``; None: the operations are called directly
+        self.operation_hook: Callable[[Callable[[], None]], None] | None = None
         self._allocate(particles)
         self.energy_account = EnergyAccount(config, vessels, particles.positions, particles.velocities, self._internal_energy())
 
@@ -606,7 +609,7 @@ class FluidSolver:
             self.lanes.replay([[graphs[p] for p in parities] for graphs in self._graphs])
         else:
             for k in range(count):
-                run_serial(self._ops[(self._parity + k) % 2])
+                run_serial(self._ops[(self._parity + k) % 2], self.operation_hook)
         if count % 2:
             self._parity ^= 1
             self.state, self._spare = self._spare, self.state
