@@ -148,9 +148,9 @@ def measure_pour_3d(device: str, sizes: TargetSizes) -> tuple[float, str]:
     )
 
 
-def _cosim_pour(out: Path, duration: float | None) -> float:
-    """Wall seconds of one ``cosim pour --no-log --quiet`` in a new process (its outputs into ``out``)."""
-    cmd = [sys.executable, "-m", "cosim", "pour", "--no-log", "--quiet", "--out", str(out)]
+def _cosim_pour(device: str, out: Path, duration: float | None) -> float:
+    """Wall seconds of one ``cosim pour --no-log --quiet --device DEVICE`` in a new process (its outputs into ``out``)."""
+    cmd = [sys.executable, "-m", "cosim", "pour", "--no-log", "--quiet", "--device", device, "--out", str(out)]
     cmd += [] if duration is None else ["--duration", f"{duration:g}"]
     start = time.perf_counter()
     done = subprocess.run(cmd, capture_output=True, text=True)
@@ -164,8 +164,8 @@ def _cosim_pour(out: Path, duration: float | None) -> float:
 def measure_default_pour(device: str, sizes: TargetSizes) -> tuple[float, str]:
     """Median wall seconds of the default pour as a user runs it, after a short run that loads the compiled kernels."""
     with tempfile.TemporaryDirectory(prefix="cosim-targets-") as tmp:
-        _cosim_pour(Path(tmp) / "warm-up", 0.05)
-        walls = [_cosim_pour(Path(tmp) / f"run{k}", sizes.default_pour_duration) for k in range(sizes.default_pour_repeats)]
+        _cosim_pour(device, Path(tmp) / "warm-up", 0.05)
+        walls = [_cosim_pour(device, Path(tmp) / f"run{k}", sizes.default_pour_duration) for k in range(sizes.default_pour_repeats)]
         summary = json.loads((Path(tmp) / "run0" / "summary.json").read_text())
     return statistics.median(walls), (
         f"runs: {', '.join(f'{w:.1f}' for w in walls)} s; {summary['sim_time']:.2f} s simulated, "
