@@ -1,8 +1,9 @@
 """``cosim bench``: wall time against error for the solver's resolutions and numerics, and the scenes' skip options.
 
 For each configuration of the plan (:mod:`cosim.bench.plan`: dimension, particles across, kernel, CFL number,
-pressure solver, device) it measures the wall time per simulated second and the errors: the validation cases
-(hydrostatic, slosh, dam-break, coupling-static) against their references, the pour against a finer reference pour
+smoothing ratio h/dx, pressure solver, DFSPH's density tolerance, device) it measures the wall time per simulated
+second and the errors: the validation cases (hydrostatic, slosh, dam-break, free fall, coupling-static) against
+their references, the pour against a finer reference pour
 (poured-volume curve, landing point, joint trajectories). Writes ``bench.csv``, ``bench.md`` and one Pareto plot
 per case (``bench_<case>.png``) to ``--out``; with ``--docs FILE`` it also rewrites the generated part of that
 Markdown file and puts the plots beside it. Results are cached per configuration under ``--cache`` (key: the
