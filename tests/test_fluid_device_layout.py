@@ -59,3 +59,25 @@ def test_the_cuda_layout_gives_the_cpu_layouts_state(dim, solver):
             np.testing.assert_allclose(b[key], a[key], rtol=SUM_ORDER_RTOL, atol=0.0)
         else:
             assert np.array_equal(a[key], b[key]), key
+
+
+@pytest.mark.parametrize("lanes", [1, 3])
+def test_a_devices_diagnostics_are_read_lane_by_lane_without_a_device_copy(lanes, monkeypatch):
+    # what a CUDA solver reads back after an interval (cosim.fluid.diagnostics.read_lane_rows): the leading rows of
+    # every lane, each lane's read a contiguous view (a non-contiguous one would cost warp a device copy first)
+    import warp as wp
+
+    from cosim.fluid.diagnostics import read_lane_rows
+
+    rows = wp.array(np.arange(lanes * 10 * 4, dtype=np.float32).reshape(lanes, 10, 4), device="cpu")
+    numpy = wp.array.numpy
+    views = []
+
+    def spy(self):
+        views.append(self.is_contiguous)
+        return numpy(self)
+
+    monkeypatch.setattr(wp.array, "numpy", spy)
+    out = read_lane_rows(rows, 6)
+    assert np.array_equal(out, numpy(rows)[:, :6])
+    assert views == [True] * lanes

@@ -39,6 +39,14 @@ N_DIAG_INT_BASE = 7
 LANE_MAX_FIELDS = (DIAG_MAX_SPEED, DIAG_MAX_ACCEL, DIAG_MAX_DENSITY_ERROR, DIAG_MAX_COMPRESSION)
 
 
+def read_lane_rows(rows: wp.array, used: int) -> np.ndarray:
+    """The first ``used`` rows of every lane of a device's (lanes, rows, fields) diagnostics array, copied to the
+    host lane by lane: each lane's leading rows are contiguous, so each is one device-to-host copy of just those
+    rows (slicing the rows of all lanes at once would make a non-contiguous view, which warp first copies into a
+    new device array)."""
+    return np.stack([rows[k, :used].numpy() for k in range(rows.shape[0])])
+
+
 def replicas_as_lanes(rows: np.ndarray, substeps: int, replicas: int) -> np.ndarray:
     """The first ``substeps`` rows of every lane from an array (lanes, substeps x replicas, fields) whose rows are
     replicated (``cosim.fluid.device_layout``), as (lanes x replicas, substeps, fields): each replica a lane of its

@@ -44,8 +44,8 @@ from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.device_layout import DeviceLayout, layout_for, pair_table, reduction_levels
 from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, pair_capacity, sum_wall_wrench_chunks
 from cosim.fluid.diagnostics import (
-    DIAG_INTERNAL_ENERGY, DIAG_KINETIC_ENERGY, DIAG_POTENTIAL_ENERGY, DIAG_REMOVED_ENERGY, N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, combine_lanes, replicas_as_lanes,
-    rows_to_records,
+    DIAG_INTERNAL_ENERGY, DIAG_KINETIC_ENERGY, DIAG_POTENTIAL_ENERGY, DIAG_REMOVED_ENERGY, N_DIAG_FLOAT, N_DIAG_INT_BASE, StepDiagnostics, combine_lanes, read_lane_rows,
+    replicas_as_lanes, rows_to_records,
 )
 from cosim.fluid.energy import EnergyAccount
 from cosim.fluid.lanes import LANE_CHUNK, Lanes, Loop, PerLane, Stage, lane_count, run_serial, together
@@ -342,7 +342,7 @@ class FluidSolver:
         if self._capture_graphs and self._graphs is None:
             self._graphs = self._capture()
         used = n_sub * self.layout.atomic_replicas  # rows written this interval (the device's copy: read only those)
-        diag_f, diag_i = self._diag_views or (self._diag_f[:, :used].numpy(), self._diag_i[:, :used].numpy())
+        diag_f, diag_i = self._diag_views or (read_lane_rows(self._diag_f, used), read_lane_rows(self._diag_i, used))
         rows_f, rows_i = combine_lanes(*(replicas_as_lanes(a, n_sub, self.layout.atomic_replicas) for a in (diag_f, diag_i)))
         first = self.step_count
         t0 = self.time
