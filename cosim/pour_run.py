@@ -27,6 +27,7 @@ import numpy as np
 
 from controllers.config import CFS_MAX_HEAD, CatcherConfig, PourConfig
 from controllers.geometry import VesselGeometry
+from cosim.atomic_files import check_output_folder
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour, build_pour
 from cosim.errors import InputError
@@ -185,9 +186,14 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
         raise InputError("logging.enabled: the Rerun recording needs rerun-sdk, which is not installed "
                          "(install it, or run without the recording: --no-log or logging.enabled = false)")
     final = destination(out, scene.name)
+    field = "--out" if out is not None else "--out (default recordings/)"
+    check_output_folder(final.parent, field)
     pour = prepare(scene)
-    final.parent.mkdir(parents=True, exist_ok=True)
-    work = Path(tempfile.mkdtemp(prefix=f".{final.name}.partial-", dir=final.parent))
+    try:
+        final.parent.mkdir(parents=True, exist_ok=True)
+        work = Path(tempfile.mkdtemp(prefix=f".{final.name}.partial-", dir=final.parent))
+    except OSError as exc:
+        raise InputError(f"{field}: cannot create a folder in {final.parent} ({exc.strerror or exc})") from None
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(work, 0o777 & ~umask)  # mkdtemp makes it private; the run folder gets the usual permissions

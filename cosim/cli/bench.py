@@ -23,7 +23,7 @@ import shutil
 from datetime import datetime, timezone
 from pathlib import Path
 
-from cosim.atomic_files import write_text_atomic
+from cosim.atomic_files import check_output_folder, write_text_atomic
 from cosim.bench.cache import ResultCache
 from cosim.bench.plan import build_plan
 from cosim.bench.report import build_rows, markdown, plot_case, rows_csv, skip_table, update_document
@@ -89,11 +89,14 @@ def run(args) -> int:
         raise InputError(f"--plan: must be one of {', '.join(PLANS)}, got {args.plan!r}")
     if args.docs is not None and args.docs.suffix != ".md":
         raise InputError(f"--docs: must be a Markdown file (.md), got {args.docs}")
-    if args.out.exists() and not args.out.is_dir():
-        raise InputError(f"--out: {args.out} exists and is not a folder")
+    if args.plan == "targets" and (args.cache is not None or args.fresh):
+        raise InputError(f"{'--cache' if args.cache is not None else '--fresh'}: the targets plan measures afresh every time and caches nothing")
+    check_output_folder(args.out, "--out")
+    if args.docs is not None:
+        check_output_folder(args.docs.parent, "--docs")
+    if args.cache is not None:
+        check_output_folder(args.cache, "--cache")
     if args.plan == "targets":
-        if args.cache is not None or args.fresh:
-            raise InputError(f"{'--cache' if args.cache is not None else '--fresh'}: the targets plan measures afresh every time and caches nothing")
         return _run_targets(args)
     plan = build_plan(args.plan)
     cache = ResultCache(args.cache or args.out / "cache")

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from cosim.atomic_files import write_text_atomic
+from cosim.atomic_files import check_output_folder, write_text_atomic
+from cosim.errors import InputError
 from cosim.pour_scene import PourScene, dump_scene, load_scene
 
 
@@ -19,6 +20,10 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
+    if args.out is not None:
+        if args.out.is_dir():
+            raise InputError(f"--out: {args.out} is a folder; give the scene file's name")
+        check_output_folder(args.out.parent, "--out")
     text = dump_scene(load_scene(args.check) if args.check else PourScene())
     if args.out:
         write_text_atomic(args.out, text)

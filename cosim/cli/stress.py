@@ -18,7 +18,7 @@ import traceback
 from collections import Counter
 from pathlib import Path
 
-from cosim.atomic_files import write_text_atomic
+from cosim.atomic_files import check_output_folder, write_text_atomic
 from cosim.checks import check_device
 from cosim.errors import InputError
 from cosim.stress.classify import FAILURES, Outcome, classify
@@ -85,6 +85,7 @@ def run(args) -> int:
         store = ResultStore(args.out / RESULTS)
         if not store.rows:
             raise InputError(f"--docs: no results in {args.out / RESULTS}; run `cosim stress --out {args.out}` first")
+        check_output_folder(args.docs, "--docs")
         commands = _commands(args.out) + [f"cosim stress --out {shlex.quote(str(args.out))} --docs {shlex.quote(str(args.docs))}"]
         write_report(_ordered(store), commands, args.docs)
         print(f"wrote {args.docs / 'stability.md'} and {args.docs / 'stability.png'} ({len(store.rows)} configurations)")
@@ -99,6 +100,7 @@ def run(args) -> int:
         return 0
     from tqdm import tqdm
 
+    check_output_folder(args.out, "--out")
     store = ResultStore(args.out / RESULTS, fresh=args.fresh)
     todo = [c for c in configs if c.id not in store]
     commands = [] if args.fresh else _commands(args.out)

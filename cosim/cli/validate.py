@@ -15,7 +15,7 @@ import json
 import sys
 from pathlib import Path
 
-from cosim.atomic_files import atomic_path
+from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
 from cosim.fluid.config import DensityIteration, PressureSolver
 from cosim.pour_scene import FluidSettings
@@ -87,6 +87,8 @@ def run(args) -> int:
     if unknown:
         raise InputError(f"case {unknown[0]!r}: unknown; choose from {', '.join(CASES)}")
     jobs = [(name, params) for name in names for params in _case_params(name, args)]  # validates every input first
+    if not args.no_plot:
+        check_output_folder(args.out, "--out")
     results = []
     for name, params in jobs:
         print(f"running {name} ({', '.join(f'{k}={v}' for k, v in vars(params).items() if v is not None)}) ...", file=sys.stderr)

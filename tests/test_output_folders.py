@@ -1,0 +1,68 @@
+"""Every command refuses an output folder it could not create or write in, before doing any work: one line naming
+the option, exit status 2, nothing written (instead of a traceback after the run)."""
+
+from __future__ import annotations
+
+import pytest
+
+import cosim.atomic_files
+import cosim.pour_run
+from cosim.atomic_files import check_output_folder
+from cosim.cli.main import main
+from cosim.errors import InputError
+
+# (command line with {blocked} for a path below a regular file, the option the error must name)
+COMMANDS = [
+    ("pour --out {blocked}/run --quiet", "--out"),
+    ("scene --dump --out {blocked}/scene.toml", "--out"),
+    ("validate coupling-static --out {blocked}/plots", "--out"),
+    ("bench --plan smoke --out {blocked}/bench --quiet", "--out"),
+    ("bench --plan smoke --out {ok}/bench --docs {blocked}/benchmarks.md --quiet", "--docs"),
+    ("bench --plan smoke --out {ok}/bench --cache {blocked}/cache --quiet", "--cache"),
+    ("bench --plan targets --out {blocked}/targets", "--out"),
+    ("stress --quick --out {blocked}/stress", "--out"),
+]
+
+
+def _files(root):
+    return sorted(p.relative_to(root) for p in root.rglob("*"))
+
+
+@pytest.mark.parametrize("command,option", COMMANDS, ids=["pour", "scene", "validate", "bench", "bench-docs", "bench-cache", "targets", "stress"])
+def test_an_output_folder_below_a_file_is_one_line_exit_2_and_nothing_written(tmp_path, capsys, command, option):
+    blocked = tmp_path / "a_file"
+    blocked.write_text("not a folder")
+    before = _files(tmp_path)
+    argv = command.format(blocked=blocked, ok=tmp_path / "ok").split()
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"error: {option}:" in err[0] and "a_file is a file, not a folder" in err[0], err
+    assert _files(tmp_path) == before
+    assert blocked.read_text() == "not a folder"
+
+
+def test_a_folder_without_write_permission_is_refused_by_name(tmp_path, monkeypatch):
+    # root may write anywhere, so the permission is taken away at the check itself
+    monkeypatch.setattr(cosim.atomic_files.os, "access", lambda path, mode: False)
+    with pytest.raises(InputError, match=r"^--out: cannot write in .*\(no permission, or a read-only file system\)$"):
+        check_output_folder(tmp_path / "new" / "deeper", "--out")
+    assert _files(tmp_path) == []
+
+
+def test_a_writable_path_passes_and_creates_nothing(tmp_path):
+    check_output_folder(tmp_path / "new" / "deeper", "--out")
+    check_output_folder(tmp_path, "--out")
+    assert _files(tmp_path) == []
+
+
+def test_a_pour_whose_run_folder_cannot_be_made_is_one_line_exit_2(tmp_path, capsys, monkeypatch):
+    # a folder that passes the check but cannot be made all the same (as under /proc): refused by name, not a
+    # traceback, and nothing left behind
+    def refuse(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(cosim.pour_run.tempfile, "mkdtemp", refuse)
+    assert main(["pour", "--out", str(tmp_path / "run"), "--quiet", "--no-log", "--duration", "0.01"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "error: --out: cannot create a folder in" in err[0] and "Permission denied" in err[0], err
+    assert _files(tmp_path) == []
