@@ -108,6 +108,22 @@ def _new_run_folder(root: Path, name: str) -> Path:
     return candidate
 
 
+def _publish(work: Path, final: Path, default_name: str | None) -> Path:
+    """Rename the finished run folder ``work`` to ``final`` (replacing an empty --out folder) and return where it
+    went. A default run folder (``default_name``: the scene's name) that another run took while this one ran (two
+    pours started in the same second pick the same name) is not an error: the run gets the next free name."""
+    if final.is_dir() and not any(final.iterdir()):
+        final.rmdir()
+    try:
+        os.replace(work, final)
+    except OSError:
+        if default_name is None or not final.exists():
+            raise
+        final = _new_run_folder(final.parent, default_name)
+        os.replace(work, final)
+    return final
+
+
 def destination(out: Path | None, name: str) -> Path:
     """The run folder to create: ``out`` (must not exist or be empty) or a new one under recordings/."""
     if out is None:
@@ -251,9 +267,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
             scene=json.loads(json.dumps(asdict(scene), default=lambda o: getattr(o, "value", str(o)))),
         )
         (work / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
-        if final.exists():
-            final.rmdir()  # an empty --out folder
-        os.replace(work, final)
+        final = _publish(work, final, scene.name if out is None else None)
         return final, summary
     except BaseException:
         if recorder is not None:

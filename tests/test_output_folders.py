@@ -1,5 +1,6 @@
 """Every command refuses an output folder it could not create or write in, before doing any work: one line naming
-the option, exit status 2, nothing written (instead of a traceback after the run)."""
+the option, exit status 2, nothing written (instead of a traceback after the run); and a pour whose default run
+folder another pour took meanwhile keeps its outputs under the next free name."""
 
 from __future__ import annotations
 
@@ -66,3 +67,27 @@ def test_a_pour_whose_run_folder_cannot_be_made_is_one_line_exit_2(tmp_path, cap
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "error: --out: cannot create a folder in" in err[0] and "Permission denied" in err[0], err
     assert _files(tmp_path) == []
+
+
+def test_two_pours_that_pick_the_same_default_folder_both_keep_their_outputs(tmp_path, capsys, monkeypatch):
+    # two pours started in the same second choose the same recordings/ name; the one finishing second gets the next
+    # free name instead of failing at its end (and losing its outputs)
+    monkeypatch.chdir(tmp_path)
+    real = cosim.pour_run.destination
+    taken = []
+
+    def destination_taken_meanwhile(out, name):
+        final = real(out, name)
+        final.mkdir(parents=True)
+        (final / "summary.json").write_text("the other run's")
+        taken.append(final)
+        return final
+
+    monkeypatch.setattr(cosim.pour_run, "destination", destination_taken_meanwhile)
+    assert main(["pour", "--quiet", "--no-log", "--duration", "0.01"]) == 0
+    runs = sorted(p.relative_to(tmp_path) for p in (tmp_path / "recordings").iterdir())
+    assert len(runs) == 2 and taken[0] in runs  # taken[0] is relative to the working directory, tmp_path
+    assert (taken[0] / "summary.json").read_text() == "the other run's"
+    ours = next(p for p in runs if p != taken[0])
+    assert (ours / "summary.json").is_file() and (ours / "trajectory.csv").is_file()
+    assert f"wrote {ours}:" in capsys.readouterr().out
