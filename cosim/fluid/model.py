@@ -9,6 +9,7 @@ import warp as wp
 
 from cosim.fluid.boundary import SHAPE_BOX, SHAPE_CYLINDER, VesselGeometry
 from cosim.fluid.config import FluidConfig
+from cosim.fluid.memory import check_memory
 from cosim.fluid.neighbors import CellGrid
 from cosim.fluid.params import SPHParams, make_params
 from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls, wetted_layer
@@ -67,10 +68,12 @@ def _geometry(spec: VesselSpec, wall_thickness: float) -> VesselGeometry:
 
 
 def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: int, device, atomic_replicas: int = 1) -> FluidModel:
-    """Fill the walls with dummy particles and allocate the static arrays."""
+    """Fill the walls with dummy particles and allocate the static arrays (after checking that the liquid fits in
+    the device's memory, :func:`cosim.fluid.memory.check_memory`)."""
     walls = [sample_vessel_walls(s, cfg.spacing, cfg.support_radius, cfg.dim) for s in specs]
     samples = [w[0] for w in walls]
     b_local = np.concatenate(samples) if samples else np.zeros((0, 3))
+    check_memory(cfg, n_particles, len(b_local), wp.get_device(device))
     b_volume = np.concatenate([w[1] for w in walls]) if walls else np.zeros(0)
     b_wetted = np.concatenate([wetted_layer(s, w[0], cfg.spacing, cfg.dim) for s, w in zip(specs, walls)]) if walls else np.zeros(0, bool)
     b_vessel = np.concatenate([np.full(len(s), k, dtype=np.int32) for k, s in enumerate(samples)]) if samples else np.zeros(0, np.int32)

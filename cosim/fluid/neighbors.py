@@ -109,6 +109,16 @@ def clear_occupied_cells(
         cell_end[k] = 0
 
 
+def grid_counts(domain_min, domain_max, cell_size: float, dim: int) -> list[int]:
+    """Cells per axis of the dense grid over the domain (one cell thick in y in 2-D)."""
+    lo = np.asarray(domain_min, dtype=float)
+    hi = np.asarray(domain_max, dtype=float)
+    counts = [max(1, math.ceil((hi[a] - lo[a]) / cell_size)) for a in range(3)]
+    if dim == 2:
+        counts[1] = 1
+    return counts
+
+
 class CellGrid:
     """A reusable sorted cell list for up to ``capacity`` points.
 
@@ -117,12 +127,9 @@ class CellGrid:
     """
 
     def __init__(self, domain_min, domain_max, cell_size: float, dim: int, capacity: int, device, reset: GridReset = GridReset.OCCUPIED):
-        lo = np.asarray(domain_min, dtype=float)
-        hi = np.asarray(domain_max, dtype=float)
-        counts = [max(1, math.ceil((hi[a] - lo[a]) / cell_size)) for a in range(3)]
+        lo = np.asarray(domain_min, dtype=float).copy()
+        counts = grid_counts(domain_min, domain_max, cell_size, dim)
         if dim == 2:
-            counts[1] = 1
-            lo = lo.copy()
             lo[1] = -0.5 * cell_size
         self.spec = GridSpec()
         self.spec.origin = wp.vec3(*lo)

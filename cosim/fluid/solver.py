@@ -49,6 +49,7 @@ from cosim.fluid.diagnostics import (
 )
 from cosim.fluid.energy import EnergyAccount
 from cosim.fluid.lanes import LANE_CHUNK, Lanes, Loop, PerLane, Stage, lane_count, run_serial, together
+from cosim.fluid.memory import allocation_failure_refused
 from cosim.fluid.model import FluidModel, FluidState, build_model
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
@@ -126,7 +127,6 @@ class FluidSolver:
         self.device = resolve_device(device)
         self.layout = layout or layout_for(self.device)
         self.n_particles = len(particles)
-        self.model: FluidModel = build_model(config, tuple(vessels), self.n_particles, self.device, self.layout.atomic_replicas)
         self.lanes = Lanes(lane_count(config.cpu_threads, self.n_particles, self.device), self.device)
         self.time = 0.0
         self.step_count = 0
@@ -143,7 +143,9 @@ class FluidSolver:
         # a profiler's hook (cosim.bench.kernel_profile): runs each operation of substeps launched one by one
         # (graphs=False), ``operation_hook(op)`` calling ``op()``; None: the operations are called directly
         self.operation_hook: Callable[[Callable[[], None]], None] | None = None
-        self._allocate(particles)
+        with allocation_failure_refused(self.device):
+            self.model: FluidModel = build_model(config, tuple(vessels), self.n_particles, self.device, self.layout.atomic_replicas)
+            self._allocate(particles)
         self.energy_account = EnergyAccount(config, vessels, particles.positions, particles.velocities, self._internal_energy())
 
     # ---- set-up ----------------------------------------------------------------------------------------------
