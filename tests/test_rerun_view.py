@@ -32,6 +32,13 @@ def test_missing_run_exits_2_with_one_line(tmp_path, capsys):
     assert main(["view", str(tmp_path)]) == 2  # a folder without pour.rrd
 
 
+def test_a_run_made_without_its_recording_says_so(tmp_path, capsys):
+    (tmp_path / "summary.json").write_text("{}")  # a run folder of `cosim pour --no-log`: outputs, no pour.rrd
+    assert main(["view", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("cosim view: error: RUN: ") and "without its recording" in err and "--no-log" in err and err.count("\n") == 1
+
+
 @pytest.mark.parametrize("content", [b"", b"not a recording\n"])
 def test_unreadable_file_exits_2_with_one_line(tmp_path, capsys, content):
     bad = tmp_path / "pour.rrd"

@@ -47,6 +47,9 @@ def recording_path(run_arg: str) -> Path:
     if path.is_dir():
         path = path / RECORDING_NAME
     if not path.is_file():
+        if (path.parent / "summary.json").is_file() and path.name == RECORDING_NAME:
+            raise InputError(f"RUN: {path.parent} is a run without its recording (made with --no-log or logging.enabled "
+                             "= false); run the pour again with logging on to view it")
         raise InputError(f"RUN: no recording at {path} (expected a run folder with {RECORDING_NAME}, or a .rrd file)")
     try:
         with warnings.catch_warnings():  # a file without footer warns before failing; the error below says it all
