@@ -64,7 +64,7 @@ def test_a_liquid_beyond_the_available_memory_is_refused_before_anything_is_allo
     out = tmp_path / "run"
     assert main(["pour", "--dim", "3", "--no-log", "--quiet", "--duration", "0.01", "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "need at least" in err[0] and "0.1 GB available" in err[0] and "fluid.particles_across" in err[0], err
+    assert len(err) == 1 and "need at least" in err[0] and "more than the 0.1 GB cpu can give" in err[0] and "fluid.particles_across" in err[0], err
     assert list(tmp_path.iterdir()) == []
 
 

@@ -41,10 +41,12 @@ def liquid_bytes(config: FluidConfig, n_particles: int, n_wall: int) -> int:
 
 
 def available_bytes(device: wp.Device) -> int | None:
-    """Memory the liquid may take on ``device`` (bytes): free device memory on CUDA, the kernel's MemAvailable on
-    a Linux host; None where it cannot be read (no check then)."""
+    """Memory the liquid may take on ``device`` (bytes): the kernel's MemAvailable on a Linux host; on CUDA the
+    device's whole memory, not its free memory, which leaves out what earlier liquids of the process freed into
+    warp's memory pool and would refuse runs that fit (an allocation that fails all the same is caught by
+    :func:`allocation_failure_refused`); None where it cannot be read (no check then)."""
     if device.is_cuda:
-        return int(device.free_memory)
+        return int(device.total_memory)
     try:
         for line in MEMINFO.read_text().splitlines():
             if line.startswith("MemAvailable:"):
@@ -60,8 +62,8 @@ def check_memory(config: FluidConfig, n_particles: int, n_wall: int, device: wp.
     have = available_bytes(device)
     if have is not None and need > have:
         raise InputError(
-            f"fluid: {n_particles:,} liquid and {n_wall:,} wall particles need at least {need / 1e9:.1f} GB on {device}, "
-            f"{have / 1e9:.1f} GB available: choose a coarser resolution (fluid.particles_across)"
+            f"fluid: {n_particles:,} liquid and {n_wall:,} wall particles need at least {need / 1e9:.1f} GB, more than the "
+            f"{have / 1e9:.1f} GB {device} can give: choose a coarser resolution (fluid.particles_across)"
         )
 
 
