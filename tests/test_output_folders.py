@@ -1,8 +1,14 @@
 """Every command refuses an output folder it could not create or write in, before doing any work: one line naming
 the option, exit status 2, nothing written (instead of a traceback after the run); and a pour whose default run
-folder another pour took meanwhile keeps its outputs under the next free name."""
+folder another pour took meanwhile keeps its outputs under the next free name; a pour stopped by SIGTERM removes its
+partial run folder."""
 
 from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
 
 import pytest
 
@@ -91,3 +97,20 @@ def test_two_pours_that_pick_the_same_default_folder_both_keep_their_outputs(tmp
     ours = next(p for p in runs if p != taken[0])
     assert (ours / "summary.json").is_file() and (ours / "trajectory.csv").is_file()
     assert f"wrote {ours}:" in capsys.readouterr().out
+
+
+def test_a_terminated_pour_leaves_nothing_behind_and_exits_143(tmp_path):
+    # a batch scheduler stops a job with SIGTERM: the pour unwinds as on Ctrl-C, removing its partial run folder
+    out = tmp_path / "run"
+    proc = subprocess.Popen([sys.executable, "-m", "cosim", "pour", "--out", str(out), "--no-log", "--quiet"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60.0
+    while not list(tmp_path.glob(".run.partial-*")) and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(1.0)  # into the step loop
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143, err
+    assert err.strip().splitlines()[-1] == "cosim pour: terminated", err
+    assert list(tmp_path.iterdir()) == []

@@ -3,14 +3,19 @@
 Each subcommand lives in its own module under ``cosim.cli`` and provides ``register(subparsers)`` (adds its parser,
 sets ``func``) and a ``run(args) -> int``. Bad input (:class:`InputError`, or the controllers' own
 ``ControllerInputError``) prints one line and exits with 2; a simulation that broke (:class:`SimulationError`, the
-controllers' ``MeasurementError``) prints one line and exits with 1; Ctrl-C exits with 130.
+controllers' ``MeasurementError``) prints one line and exits with 1; Ctrl-C exits with 130, SIGTERM (a batch
+scheduler's stop) with 143, both through the same clean-up, so neither leaves a half-written output behind.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import signal
 import sys
+import threading
+from typing import Iterator
 
 from controllers.errors import ControllerInputError, MeasurementError
 from cosim import __version__
@@ -41,6 +46,28 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where Python next runs in the main thread: unwinds like Ctrl-C (every ``except
+    BaseException`` clean-up runs: the pour's partial run folder is removed, the liquid's lanes are stopped)."""
+
+
+def _raise_terminated(signum, frame) -> None:
+    raise Terminated
+
+
+@contextlib.contextmanager
+def _sigterm_unwinds() -> Iterator[None]:
+    """SIGTERM raises :class:`Terminated` inside the block (main thread only; the previous handler restored)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -48,13 +75,17 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 2
     try:
-        return int(args.func(args) or 0)
+        with _sigterm_unwinds():
+            return int(args.func(args) or 0)
     except (InputError, ControllerInputError) as exc:
         print(f"cosim {args.command}: error: {exc}", file=sys.stderr)
         return 2
     except (SimulationError, MeasurementError) as exc:
         print(f"cosim {args.command}: simulation failed: {exc}", file=sys.stderr)
         return 1
+    except Terminated:
+        print(f"cosim {args.command}: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print(f"cosim {args.command}: interrupted", file=sys.stderr)
         return 130
