@@ -5,4 +5,8 @@ Layers (dependency direction is fixed): ``controllers`` (pure numpy + python-con
 wires them; ``cosim.io`` observes. SI units everywhere, z-up world, quaternions [w, x, y, z].
 """
 
+from cosim.reproducibility import pin_openblas_core
+
+pin_openblas_core()  # before anything imports numpy: the same BLAS kernels, so the same bits, on every AVX2 machine
+
 __version__ = "0.1.0"

@@ -2,6 +2,7 @@
 path at small sizes on the CPU (numbers meaningless there), and the report the command writes."""
 
 import json
+import re
 
 import pytest
 
@@ -37,6 +38,7 @@ def test_every_measurement_runs_and_reports_its_figure(measured):
     assert "the rest (host)" in measured[POUR_3D].detail
     # the default pour ran as a user runs it, to its --duration: 0.04 s simulated
     assert "0.04 s simulated" in measured[DEFAULT_POUR].detail
+    assert re.search(r"trajectory\.csv sha256 [0-9a-f]{12} ", measured[DEFAULT_POUR].detail), measured[DEFAULT_POUR].detail
 
 
 def test_without_cuda_the_cuda_targets_are_listed_not_measured(monkeypatch):

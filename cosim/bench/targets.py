@@ -22,6 +22,7 @@ DFSPH faster than WCSPH at equal error on the default pour, is the full plan's p
 
 from __future__ import annotations
 
+import hashlib
 import json
 import statistics
 import subprocess
@@ -167,9 +168,11 @@ def measure_default_pour(device: str, sizes: TargetSizes) -> tuple[float, str]:
         _cosim_pour(device, Path(tmp) / "warm-up", 0.05)
         walls = [_cosim_pour(device, Path(tmp) / f"run{k}", sizes.default_pour_duration) for k in range(sizes.default_pour_repeats)]
         summary = json.loads((Path(tmp) / "run0" / "summary.json").read_text())
+        fingerprint = hashlib.sha256((Path(tmp) / "run0" / "trajectory.csv").read_bytes()).hexdigest()[:12]
     return statistics.median(walls), (
         f"runs: {', '.join(f'{w:.1f}' for w in walls)} s; {summary['sim_time']:.2f} s simulated, "
-        f"{1e6 * summary['poured_volume']:.0f} of {1e6 * summary['initial_volume']:.0f} mL poured"
+        f"{1e6 * summary['poured_volume']:.0f} of {1e6 * summary['initial_volume']:.0f} mL poured; "
+        f"trajectory.csv sha256 {fingerprint} (the same bits as another machine's if equal)"
     )
 
 

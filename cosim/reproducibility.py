@@ -1,0 +1,56 @@
+"""The same bits on every x86-64 machine with AVX2: numpy's OpenBLAS kernels pinned before numpy loads.
+
+numpy's OpenBLAS is built for many CPUs at once (DYNAMIC_ARCH) and picks its kernels for the CPU it runs on: CPUs
+with AVX-512 (Intel's, and AMD's Zen 4, such as the 2-core AMD EPYC these numbers come from) get its SkylakeX
+kernels, AVX2-only ones its Haswell kernels. Their results differ in the last bit, and a pour is chaotic: the
+controller's and the IK's small matrix products and solves differ in the last bit, and the pour that follows is
+another one. Measured on that EPYC (2026-12-04), the default pour's first 3 s: OpenBLAS's own choice (SkylakeX) and
+``OPENBLAS_CORETYPE`` = SkylakeX gave one series.csv, = Haswell another (that machine's environment sets
+``OPENBLAS_CORETYPE=Haswell``, so its documented numbers come from those kernels), = Prescott a third; warp's kernels built for other instruction sets and numpy without its AVX-512 paths changed
+nothing (README, Known limitations). So where the CPU has what the Haswell kernels need (AVX2 and FMA), they are
+pinned. Slower kernels for large matrices cost nothing here (the matrices are a few rows by a few columns). This
+only works before numpy is first imported (OpenBLAS reads the variable once, when it loads), so
+``cosim/__init__.py`` calls :func:`pin_openblas_core` first thing; a user's own ``OPENBLAS_CORETYPE`` is left alone.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import sys
+from pathlib import Path
+
+PINNED_CORE = "Haswell"
+REQUIRED_FLAGS = frozenset({"avx2", "fma"})  # what the Haswell kernels execute (/proc/cpuinfo names)
+CPUINFO = Path("/proc/cpuinfo")
+
+
+def cpu_flags() -> frozenset[str]:
+    """The CPU's feature flags as /proc/cpuinfo lists them (empty where there is no such file)."""
+    try:
+        for line in CPUINFO.read_text().splitlines():
+            if line.startswith("flags"):
+                return frozenset(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    return frozenset()
+
+
+def openblas_core(machine: str, flags: frozenset[str]) -> str | None:
+    """The OpenBLAS core to pin on a CPU (``platform.machine()``, its flags), or None: not x86-64, or without
+    the instructions the pinned kernels need (forcing them there would stop the process with an illegal
+    instruction)."""
+    if machine.lower() not in ("x86_64", "amd64"):
+        return None
+    return PINNED_CORE if REQUIRED_FLAGS <= flags else None
+
+
+def pin_openblas_core() -> str | None:
+    """Set ``OPENBLAS_CORETYPE`` for numpy's OpenBLAS unless it is set already or numpy is loaded (too late then);
+    returns the core pinned, or None."""
+    if "OPENBLAS_CORETYPE" in os.environ or "numpy" in sys.modules:
+        return None
+    core = openblas_core(platform.machine(), cpu_flags())
+    if core is not None:
+        os.environ["OPENBLAS_CORETYPE"] = core
+    return core
