@@ -4,15 +4,16 @@ numpy's OpenBLAS is built for many CPUs at once (DYNAMIC_ARCH) and picks its ker
 with AVX-512 (Intel's, and AMD's Zen 4, such as the 2-core AMD EPYC these numbers come from) get its SkylakeX
 kernels, AVX2-only ones its Haswell kernels. Their results differ in the last bit, and a pour is chaotic: the
 controller's and the IK's small matrix products and solves differ in the last bit, and the pour that follows is
-another one. Measured on that EPYC (2026-12-04), the default pour's first 3 s: OpenBLAS's own choice (SkylakeX) and
-``OPENBLAS_CORETYPE`` = SkylakeX gave one series.csv, = Haswell another (that machine's environment sets
-``OPENBLAS_CORETYPE=Haswell``, so its documented numbers come from those kernels), = Prescott a third; the WCSPH default pour poured 2964 mL in 228,728 substeps under SkylakeX and 2968 mL in 230,643
-under Haswell, the two results earlier sessions had found on different machines with the same code. warp's kernels
-built for other instruction sets and numpy without its AVX-512 paths changed
-nothing (README, Known limitations). So where the CPU has what the Haswell kernels need (AVX2 and FMA), they are
-pinned. Slower kernels for large matrices cost nothing here (the matrices are a few rows by a few columns). This
-only works before numpy is first imported (OpenBLAS reads the variable once, when it loads), so
-``cosim/__init__.py`` calls :func:`pin_openblas_core` first thing; a user's own ``OPENBLAS_CORETYPE`` is left alone.
+another one. Measured on that EPYC (2026-12-04): the default pour's first 3 s under OpenBLAS's own choice (SkylakeX)
+and under ``OPENBLAS_CORETYPE`` = SkylakeX gave one series.csv, = Haswell another (that machine's environment sets
+``OPENBLAS_CORETYPE=Haswell``, so its documented numbers come from those kernels), = Prescott a third; the WCSPH
+default pour poured 2964 mL in 228,728 substeps under SkylakeX and 2968 mL in 230,643 under Haswell, the two results
+earlier sessions had found on different machines with the same code. warp's kernels built for other instruction sets
+and numpy without its AVX-512 paths changed nothing (README, Known limitations). So where the CPU has what the
+Haswell kernels need (AVX2 and FMA), they are pinned. Slower kernels for large matrices cost nothing here (the
+matrices are a few rows by a few columns). This only works before numpy is first imported (OpenBLAS reads the
+variable once, when it loads), so ``cosim/__init__.py`` calls :func:`pin_openblas_core` first thing; a user's own
+``OPENBLAS_CORETYPE`` is left alone.
 """
 
 from __future__ import annotations
