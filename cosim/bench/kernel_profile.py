@@ -111,7 +111,6 @@ def main(argv: list[str] | None = None) -> int:
         case_lines = profile_case(*parse_case(case), device, args.steps, args.top)
         print("\n".join(case_lines), flush=True)
         lines += case_lines
-    args.out.mkdir(parents=True, exist_ok=True)
     write_text_atomic(args.out / "kernel_profile.md", "\n".join(lines) + "\n")
     return 0
 
