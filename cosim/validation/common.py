@@ -59,7 +59,8 @@ class FluidCaseParams:
     """Parameters every fluid case shares (overridable from the command line).
 
     spacing: m, particle spacing (None: the case's default resolution). dim: 2 or 3. device: 'cpu' or 'cuda[:N]'.
-    depth: m, tank depth perpendicular to the pour plane (3-D extent; 2-D out-of-plane scale).
+    depth: m, tank depth perpendicular to the pour plane (3-D extent, rounded to whole spacings by
+        :meth:`tank_depth`; 2-D out-of-plane scale).
     solver: pressure solver, :class:`PressureSolver` or its name ('wcsph', 'dfsph').
     numerics: overrides of the solver's numerical settings, (FluidConfig field, value) pairs, e.g.
         (("kernel", "cubic_spline"), ("cfl", 0.4)); one of NUMERICS_FIELDS each (the benchmark's axes).
@@ -83,6 +84,17 @@ class FluidCaseParams:
             if name not in NUMERICS_FIELDS:
                 raise InputError(f"numerics: {name!r} cannot be overridden; choose from {', '.join(NUMERICS_FIELDS)}")
         FluidConfig(**dict(self.numerics))  # the values' own range checks, before anything runs
+
+    def tank_depth(self, spacing: float) -> float:
+        """m, the tank depth the case builds: in 3-D ``depth`` rounded to a whole number of ``spacing`` (at least
+        one), so that the seeded lattice fills the tank across. A remainder leaves the outer columns a gap to the
+        wall: the liquid slumps into it and stands taller than its volume over the floor area, by 4.5 % at the
+        default 0.1 m, which is 8.38, 12.57 or 16.75 spacings at 16, 24 or 32 across B = 0.191 m (3-D hydrostatic
+        tank at 16 across: worst probe +25.6 % in the 0.1 m tank, +2.8 % in the 8-spacing one). In 2-D ``depth``
+        only scales the liquid out of the plane and is kept."""
+        if self.dim == 2:
+            return self.depth
+        return max(1, round(self.depth / spacing)) * spacing
 
 
 def reference_speed(liquid_height: float) -> float:

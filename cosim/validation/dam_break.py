@@ -80,17 +80,18 @@ class Params(FluidCaseParams):
 def run(p: Params) -> CaseResult:
     a, dx = p.width, p.resolved_spacing
     require_particles_across("spacing", a, dx, 8)
+    depth = p.tank_depth(dx)
     length = TANK_LENGTH * a
-    tank = VesselSpec(name="tank", inner_width=length, inner_depth=p.depth, inner_height=2.0 * p.height)
+    tank = VesselSpec(name="tank", inner_width=length, inner_depth=depth, inner_height=2.0 * p.height)
     wall = -0.5 * length
     margin = 10 * dx + 0.02
     cfg = case_fluid_config(
-        p.dim, dx, p.height, p.depth,
-        (wall - margin, -0.5 * p.depth - margin, -margin), (-wall + margin, 0.5 * p.depth + margin, tank.inner_height + margin),
+        p.dim, dx, p.height, depth,
+        (wall - margin, -0.5 * depth - margin, -margin), (-wall + margin, 0.5 * depth + margin, tank.inner_height + margin),
         p.solver,
         numerics=p.numerics,
     )
-    column = liquid_block((wall, -0.5 * p.depth, 0.0), (wall + a, 0.5 * p.depth, p.height), cfg)
+    column = liquid_block((wall, -0.5 * depth, 0.0), (wall + a, 0.5 * depth, p.height), cfg)
     solver = FluidSolver(cfg, [tank], [Pose()], column, device=p.device)
     scale = math.sqrt(2.0 * GRAVITY / a)
     t_end = p.t_max / scale
@@ -125,7 +126,7 @@ def run(p: Params) -> CaseResult:
         "particles": solver.n_particles,
         "steps": solver.step_count,
     }
-    params = dict(width=a, fill=p.height, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, t_max=p.t_max, depth=p.depth)
+    params = dict(width=a, fill=p.height, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, t_max=p.t_max, depth=depth)
     return CaseResult("dam-break", params, metrics, raw, wall_time)
 
 

@@ -65,11 +65,12 @@ def _interpolate(points: np.ndarray, x: np.ndarray, values: np.ndarray, volumes:
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
     require_particles_across("spacing", p.width, dx, 8)
-    tank = VesselSpec(name="tank", inner_width=p.width, inner_depth=p.depth, inner_height=p.fill * 1.25 + 4 * dx)
+    depth = p.tank_depth(dx)
+    tank = VesselSpec(name="tank", inner_width=p.width, inner_depth=depth, inner_height=p.fill * 1.25 + 4 * dx)
     margin = 0.05 * p.width + 10 * dx
     half = 0.5 * p.width + margin
     cfg = case_fluid_config(
-        p.dim, dx, p.fill, p.depth, (-half, -0.5 * p.depth - margin, -margin), (half, 0.5 * p.depth + margin, tank.inner_height + margin), p.solver,
+        p.dim, dx, p.fill, depth, (-half, -0.5 * depth - margin, -margin), (half, 0.5 * depth + margin, tank.inner_height + margin), p.solver,
         numerics=p.numerics,
     )
     solver = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, p.fill, cfg), device=p.device)
@@ -81,7 +82,7 @@ def run(p: Params) -> CaseResult:
     x, pressure, rho, active = solver.positions(), solver.pressures(), solver.densities(), solver.active_mask()
     h = cfg.smoothing_length
     volume0 = solver.n_particles * cfg.particle_volume
-    height = volume0 / (tank.inner_floor_area if p.dim == 3 else p.width * p.depth)
+    height = volume0 / (tank.inner_floor_area if p.dim == 3 else p.width * depth)
     clearance = PROBE_CLEARANCE * h
     zs = np.linspace(clearance, height - clearance, 12)
     xs = np.linspace(-0.5 * p.width + clearance, 0.5 * p.width - clearance, 5)
@@ -116,7 +117,7 @@ def run(p: Params) -> CaseResult:
         "steps": solver.step_count,
         "active": int(active.sum()),
     }
-    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, duration=p.duration, depth=p.depth)
+    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, duration=p.duration, depth=depth)
     return CaseResult("hydrostatic", params, metrics, raw, wall)
 
 

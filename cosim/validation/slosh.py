@@ -68,14 +68,15 @@ class Params(FluidCaseParams):
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
     require_particles_across("spacing", p.width, dx, 8)
+    depth = p.tank_depth(dx)
     f_ref = eq17_frequency(p.width, p.fill)
     period = 1.0 / f_ref
     pulse = 0.25 * period
-    tank = VesselSpec(name="tank", inner_width=p.width, inner_depth=p.depth, inner_height=p.fill + 0.5 * p.width + 4 * dx)
+    tank = VesselSpec(name="tank", inner_width=p.width, inner_depth=depth, inner_height=p.fill + 0.5 * p.width + 4 * dx)
     margin = 0.05 * p.width + 10 * dx
     half = 0.5 * p.width + margin
     cfg = case_fluid_config(
-        p.dim, dx, p.fill, p.depth, (-half, -0.5 * p.depth - margin, -margin), (half + PULSE_AMPLITUDE, 0.5 * p.depth + margin, tank.inner_height + margin), p.solver,
+        p.dim, dx, p.fill, depth, (-half, -0.5 * depth - margin, -margin), (half + PULSE_AMPLITUDE, 0.5 * depth + margin, tank.inner_height + margin), p.solver,
         numerics=p.numerics,
     )
     solver = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, p.fill, cfg), device=p.device)
@@ -111,7 +112,7 @@ def run(p: Params) -> CaseResult:
         "particles": solver.n_particles,
         "steps": solver.step_count,
     }
-    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, periods=p.periods, depth=p.depth)
+    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, periods=p.periods, depth=depth)
     return CaseResult("slosh", params, metrics, raw, wall)
 
 
