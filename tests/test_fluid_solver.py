@@ -38,7 +38,7 @@ def test_hydrostatic_coarse_2d_meets_the_acceptance_tolerances():
 
 # The hydrostatic law p = rho0 g (H - z) puts the free surface at H = liquid volume / floor area (issue "Fluid
 # core"); the pressure profile's zero must sit there to a tenth of a spacing. In a 3-D tank whose depth is not a
-# whole number of spacings it sat 0.2 spacings higher (the liquid slumped into the gap the lattice left at the walls).
+# whole number of spacings it sat 0.2 spacings higher (the seeded lattice covered only part of the floor).
 SURFACE_HEIGHT_TOLERANCE = 0.1  # particle spacings
 
 

@@ -88,10 +88,10 @@ class FluidCaseParams:
     def tank_depth(self, spacing: float) -> float:
         """m, the tank depth the case builds: in 3-D ``depth`` rounded to a whole number of ``spacing`` (at least
         one), so that the seeded lattice fills the tank across. A remainder leaves the outer columns a gap to the
-        wall: the liquid slumps into it and stands taller than its volume over the floor area, by 4.5 % at the
-        default 0.1 m, which is 8.38, 12.57 or 16.75 spacings at 16, 24 or 32 across B = 0.191 m (3-D hydrostatic
-        tank at 16 across: worst probe +25.6 % in the 0.1 m tank, +2.8 % in the 8-spacing one). In 2-D ``depth``
-        only scales the liquid out of the plane and is kept."""
+        wall, and the liquid stands taller than its volume over the floor area: the default 0.1 m is 8.38, 12.57 or
+        16.75 spacings at 16, 24 or 32 across B = 0.191 m, so the lattice covers 95.5 % of it (3-D hydrostatic tank
+        at 16 across: worst probe +25.6 % in the 0.1 m tank, +2.8 % in the 8-spacing one). In 2-D ``depth`` only
+        scales the liquid out of the plane and is kept."""
         if self.dim == 2:
             return self.depth
         return max(1, round(self.depth / spacing)) * spacing
