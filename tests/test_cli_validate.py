@@ -35,6 +35,15 @@ def test_table_output(capsys, tmp_path):
     assert "pressure (worst probe)" in out and "vertical reaction" in out
 
 
+def test_density_tolerance_reaches_the_solver(capsys):
+    argv = ["validate", "hydrostatic", "--spacing", "0.0125", "--width", "0.1", "--fill", "0.05", "--no-plot", "--json"]
+    assert main(argv) == 0
+    default = json.loads(capsys.readouterr().out)["cases"][0]
+    assert main([*argv, "--density-tolerance", "1e-5"]) == 0
+    tight = json.loads(capsys.readouterr().out)["cases"][0]
+    assert tight["max_density_error"] < default["max_density_error"]
+
+
 def test_a_3d_tank_rounded_to_whole_spacings_says_so(capsys):
     assert main(["validate", "dam-break", "--dim", "3", "--width", "0.05", "--spacing", "0.006", "--json", "--no-plot"]) == 0
     captured = capsys.readouterr()
@@ -43,7 +52,7 @@ def test_a_3d_tank_rounded_to_whole_spacings_says_so(capsys):
 
 
 @pytest.mark.parametrize("argv", [["validate", "nope"], ["validate", "slosh", "--width", "-1"], ["validate", "--spacing", "nan"],
-                                  ["validate", "hydrostatic", "--device", "tpu"]])
+                                  ["validate", "hydrostatic", "--device", "tpu"], ["validate", "--density-tolerance", "-1"]])
 def test_bad_input_exits_2_with_one_line(argv, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()

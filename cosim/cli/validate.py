@@ -42,6 +42,8 @@ def register(subparsers) -> None:
     default_iteration = FluidSettings().density_iteration.value
     p.add_argument("--density-iteration", choices=[d.value for d in DensityIteration], default=default_iteration,
                    help=f"DFSPH's density solve: gauss_seidel or jacobi, each at its own default tolerance (default: {default_iteration})")
+    p.add_argument("--density-tolerance", type=float, help="DFSPH's density solve stops at this average compression "
+                   "(default: the density iteration's own, fluid.density_tolerance)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
@@ -49,8 +51,10 @@ def register(subparsers) -> None:
 
 
 def _case_params(name: str, args) -> list:
-    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing, "solver": args.solver,
-              "numerics": (("density_iteration", args.density_iteration),)}
+    numerics = (("density_iteration", args.density_iteration),)
+    if args.density_tolerance is not None:
+        numerics += (("density_tolerance", args.density_tolerance),)
+    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing, "solver": args.solver, "numerics": numerics}
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
     if name in ("tilt", "shake", "free-fall", "coupling-static"):
