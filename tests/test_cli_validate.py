@@ -48,7 +48,8 @@ def test_a_3d_tank_rounded_to_whole_spacings_says_so(capsys):
     assert main(["validate", "dam-break", "--dim", "3", "--width", "0.05", "--spacing", "0.006", "--json", "--no-plot"]) == 0
     captured = capsys.readouterr()
     assert json.loads(captured.out)["cases"][0]["parameters"]["depth"] == pytest.approx(17 * 0.006)  # 0.1 m is 16.7 spacings
-    assert "tank depth 0.102 m: 0.1 m rounded to whole particle spacings (3-D)" in captured.err
+    assert "tank depth 0.102 m: 0.1 m rounded to whole particle spacings" in captured.err
+    assert "tank width" not in captured.err  # the dam-break's column width is the experiment's scale, kept
 
 
 @pytest.mark.parametrize("argv", [["validate", "nope"], ["validate", "slosh", "--width", "-1"], ["validate", "--spacing", "nan"],

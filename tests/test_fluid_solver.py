@@ -13,6 +13,7 @@ from cosim.fluid.seeding import ParticleSet, fill_vessel, liquid_block
 from cosim.fluid.solver import FluidInstabilityError, FluidSolver
 from cosim.frames import Pose, rotation_y
 from cosim.validation import hydrostatic, moving_vessel, slosh
+from cosim.validation.common import whole_spacings
 from cosim.vessel import VesselSpec
 
 B = 0.191  # m, the seed's vessel width
@@ -53,11 +54,19 @@ def test_static_3d_tank_weighs_its_liquid_and_stands_at_its_volume_over_the_floo
     assert abs(intercept / slope - r.raw["liquid_height"]) <= SURFACE_HEIGHT_TOLERANCE * dx
 
 
-def test_3d_validation_tanks_are_whole_spacings_deep():
+def test_validation_tanks_are_whole_spacings_wide_and_deep():
     dx = B / 16  # 0.1 m is 8.38 of these spacings
     assert hydrostatic.Params(dim=3).tank_depth(dx) == pytest.approx(8 * dx)
     assert slosh.Params(dim=3).tank_depth(B / 24) == pytest.approx(13 * B / 24)  # 12.57 rounds up
     assert hydrostatic.Params(dim=2).tank_depth(dx) == 0.1  # 2-D: an out-of-plane scale, kept
+    assert whole_spacings(B, B / 40) == B  # already whole: kept to the bit (the default resolutions)
+    assert whole_spacings(B, 0.006) == pytest.approx(32 * 0.006)  # 31.8 spacings
+
+
+def test_hydrostatic_at_a_spacing_that_does_not_divide_the_tank():
+    r = hydrostatic.run(hydrostatic.Params(spacing=0.006, duration=1.0))  # B = 31.8 spacings: built 32 wide
+    assert r.parameters["width"] == pytest.approx(32 * 0.006)
+    assert abs({m.name: m for m in r.metrics}["pressure (worst probe)"].error) <= hydrostatic.PRESSURE_TOLERANCE
 
 
 def test_slosh_coarse_frequency_matches_eq17():

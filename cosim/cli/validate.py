@@ -98,9 +98,10 @@ def run(args) -> int:
         print(f"running {name} ({', '.join(f'{k}={v}' for k, v in vars(params).items() if v is not None)}) ...", file=sys.stderr)
         result = CASES[name].run(params)
         results.append(result)
-        asked, built = getattr(params, "depth", None), result.parameters.get("depth")
-        if asked is not None and built is not None and built != asked:
-            print(f"  tank depth {built:.4g} m: {asked:g} m rounded to whole particle spacings (3-D)", file=sys.stderr)
+        for extent in ("width", "depth"):  # the cases build tanks of whole particle spacings (whole_spacings)
+            asked, built = getattr(params, extent, None), result.parameters.get(extent)
+            if asked is not None and built is not None and built != asked:
+                print(f"  tank {extent} {built:.4g} m: {asked:g} m rounded to whole particle spacings", file=sys.stderr)
         if not args.no_plot:
             suffix = f"-A{result.parameters['fill']:.3f}" if name == "slosh" else ""
             path = args.out / f"{name}{suffix}-{result.parameters['dim']}d.png"

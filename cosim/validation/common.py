@@ -86,15 +86,20 @@ class FluidCaseParams:
         FluidConfig(**dict(self.numerics))  # the values' own range checks, before anything runs
 
     def tank_depth(self, spacing: float) -> float:
-        """m, the tank depth the case builds: in 3-D ``depth`` rounded to a whole number of ``spacing`` (at least
-        one), so that the seeded lattice fills the tank across. A remainder leaves the outer columns a gap to the
-        wall, and the liquid stands taller than its volume over the floor area: the default 0.1 m is 8.38, 12.57 or
-        16.75 spacings at 16, 24 or 32 across B = 0.191 m, so the lattice covers 95.5 % of it (3-D hydrostatic tank
-        at 16 across: worst probe +25.6 % in the 0.1 m tank, +2.8 % in the 8-spacing one). In 2-D ``depth`` only
-        scales the liquid out of the plane and is kept."""
-        if self.dim == 2:
-            return self.depth
-        return max(1, round(self.depth / spacing)) * spacing
+        """m, the tank depth the case builds: in 3-D ``depth`` in whole spacings (:func:`whole_spacings`); in 2-D
+        ``depth`` only scales the liquid out of the plane and is kept."""
+        return self.depth if self.dim == 2 else whole_spacings(self.depth, spacing)
+
+
+def whole_spacings(length: float, spacing: float) -> float:
+    """m, a tank's ``length`` rounded to a whole number of ``spacing`` (at least one; kept where it is one already, to
+    1e-9 of a spacing), so that the seeded lattice fills the tank across. A remainder leaves the outer columns a gap
+    to the wall, and the liquid stands taller than its volume over the floor area: the default 0.1 m depth is 8.38,
+    12.57 or 16.75 spacings at 16, 24 or 32 across B = 0.191 m, so the lattice covered 95.5 % of it (3-D hydrostatic
+    tank at 16 across: worst probe +25.6 % in the 0.1 m tank, +2.8 % in the 8-spacing one), and at a spacing of 6 mm
+    B is 31.8 spacings (2-D hydrostatic: +6.2 %)."""
+    count = max(1, round(length / spacing))
+    return length if abs(length / spacing - count) <= 1e-9 else count * spacing
 
 
 def reference_speed(liquid_height: float) -> float:

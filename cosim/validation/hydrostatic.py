@@ -19,7 +19,15 @@ from cosim.fluid.config import GRAVITY
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
-from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across
+from cosim.validation.common import (
+    CaseResult,
+    FluidCaseParams,
+    Metric,
+    case_fluid_config,
+    new_figure,
+    require_particles_across,
+    whole_spacings,
+)
 from cosim.vessel import VesselSpec
 
 # Acceptance (issue "Fluid core"): pressure within 2 % of rho0 g (H - z) away from walls and surface, density
@@ -65,10 +73,10 @@ def _interpolate(points: np.ndarray, x: np.ndarray, values: np.ndarray, volumes:
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
     require_particles_across("spacing", p.width, dx, 8)
-    depth = p.tank_depth(dx)
-    tank = VesselSpec(name="tank", inner_width=p.width, inner_depth=depth, inner_height=p.fill * 1.25 + 4 * dx)
-    margin = 0.05 * p.width + 10 * dx
-    half = 0.5 * p.width + margin
+    width, depth = whole_spacings(p.width, dx), p.tank_depth(dx)
+    tank = VesselSpec(name="tank", inner_width=width, inner_depth=depth, inner_height=p.fill * 1.25 + 4 * dx)
+    margin = 0.05 * width + 10 * dx
+    half = 0.5 * width + margin
     cfg = case_fluid_config(
         p.dim, dx, p.fill, depth, (-half, -0.5 * depth - margin, -margin), (half, 0.5 * depth + margin, tank.inner_height + margin), p.solver,
         numerics=p.numerics,
@@ -82,10 +90,10 @@ def run(p: Params) -> CaseResult:
     x, pressure, rho, active = solver.positions(), solver.pressures(), solver.densities(), solver.active_mask()
     h = cfg.smoothing_length
     volume0 = solver.n_particles * cfg.particle_volume
-    height = volume0 / (tank.inner_floor_area if p.dim == 3 else p.width * depth)
+    height = volume0 / (tank.inner_floor_area if p.dim == 3 else width * depth)
     clearance = PROBE_CLEARANCE * h
     zs = np.linspace(clearance, height - clearance, 12)
-    xs = np.linspace(-0.5 * p.width + clearance, 0.5 * p.width - clearance, 5)
+    xs = np.linspace(-0.5 * width + clearance, 0.5 * width - clearance, 5)
     probes = np.array([(px, 0.0, pz) for px in xs for pz in zs])
     probe_p = _interpolate(probes, x, pressure, cfg.particle_mass / rho, h)
     ref_p = cfg.rest_density * GRAVITY * (height - probes[:, 2])
@@ -117,7 +125,7 @@ def run(p: Params) -> CaseResult:
         "steps": solver.step_count,
         "active": int(active.sum()),
     }
-    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, duration=p.duration, depth=depth)
+    params = dict(width=width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, duration=p.duration, depth=depth)
     return CaseResult("hydrostatic", params, metrics, raw, wall)
 
 

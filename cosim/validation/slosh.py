@@ -29,6 +29,7 @@ from cosim.validation.common import (
     case_fluid_config,
     new_figure,
     require_particles_across,
+    whole_spacings,
     zero_crossing_frequency,
 )
 from cosim.vessel import VesselSpec
@@ -68,13 +69,13 @@ class Params(FluidCaseParams):
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
     require_particles_across("spacing", p.width, dx, 8)
-    depth = p.tank_depth(dx)
-    f_ref = eq17_frequency(p.width, p.fill)
+    width, depth = whole_spacings(p.width, dx), p.tank_depth(dx)
+    f_ref = eq17_frequency(width, p.fill)
     period = 1.0 / f_ref
     pulse = 0.25 * period
-    tank = VesselSpec(name="tank", inner_width=p.width, inner_depth=depth, inner_height=p.fill + 0.5 * p.width + 4 * dx)
-    margin = 0.05 * p.width + 10 * dx
-    half = 0.5 * p.width + margin
+    tank = VesselSpec(name="tank", inner_width=width, inner_depth=depth, inner_height=p.fill + 0.5 * width + 4 * dx)
+    margin = 0.05 * width + 10 * dx
+    half = 0.5 * width + margin
     cfg = case_fluid_config(
         p.dim, dx, p.fill, depth, (-half, -0.5 * depth - margin, -margin), (half + PULSE_AMPLITUDE, 0.5 * depth + margin, tank.inner_height + margin), p.solver,
         numerics=p.numerics,
@@ -112,7 +113,7 @@ def run(p: Params) -> CaseResult:
         "particles": solver.n_particles,
         "steps": solver.step_count,
     }
-    params = dict(width=p.width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, periods=p.periods, depth=depth)
+    params = dict(width=width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, periods=p.periods, depth=depth)
     return CaseResult("slosh", params, metrics, raw, wall)
 
 
