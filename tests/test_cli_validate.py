@@ -44,12 +44,14 @@ def test_density_tolerance_reaches_the_solver(capsys):
     assert tight["max_density_error"] < default["max_density_error"]
 
 
-def test_a_3d_tank_rounded_to_whole_spacings_says_so(capsys):
+def test_a_tank_rounded_to_whole_spacings_says_so(capsys):
     assert main(["validate", "dam-break", "--dim", "3", "--width", "0.05", "--spacing", "0.006", "--json", "--no-plot"]) == 0
     captured = capsys.readouterr()
-    assert json.loads(captured.out)["cases"][0]["parameters"]["depth"] == pytest.approx(17 * 0.006)  # 0.1 m is 16.7 spacings
-    assert "tank depth 0.102 m: 0.1 m rounded to whole particle spacings" in captured.err
-    assert "tank width" not in captured.err  # the dam-break's column width is the experiment's scale, kept
+    case = json.loads(captured.out)["cases"][0]
+    assert case["parameters"]["depth"] == pytest.approx(17 * 0.006)  # 0.1 m is 16.7 spacings
+    assert case["a"] == pytest.approx(8 * 0.006)  # 8.33 spacings: the column is 8 wide, and T and Z are scaled by it
+    assert "depth 0.102 m: 0.1 m rounded to whole particle spacings" in captured.err
+    assert "width 0.048 m: 0.05 m rounded to whole particle spacings" in captured.err
 
 
 @pytest.mark.parametrize("argv", [["validate", "nope"], ["validate", "slosh", "--width", "-1"], ["validate", "--spacing", "nan"],

@@ -101,7 +101,7 @@ def run(args) -> int:
         for extent in ("width", "depth"):  # the cases build tanks of whole particle spacings (whole_spacings)
             asked, built = getattr(params, extent, None), result.parameters.get(extent)
             if asked is not None and built is not None and built != asked:
-                print(f"  tank {extent} {built:.4g} m: {asked:g} m rounded to whole particle spacings", file=sys.stderr)
+                print(f"  {extent} {built:.4g} m: {asked:g} m rounded to whole particle spacings", file=sys.stderr)
         if not args.no_plot:
             suffix = f"-A{result.parameters['fill']:.3f}" if name == "slosh" else ""
             path = args.out / f"{name}{suffix}-{result.parameters['dim']}d.png"

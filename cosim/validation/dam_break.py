@@ -23,7 +23,15 @@ from cosim.fluid.config import GRAVITY
 from cosim.fluid.seeding import liquid_block
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
-from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across
+from cosim.validation.common import (
+    CaseResult,
+    FluidCaseParams,
+    Metric,
+    case_fluid_config,
+    new_figure,
+    require_particles_across,
+    whole_spacings,
+)
 from cosim.vessel import VesselSpec
 
 # Acceptance (issue "Fluid core"): surge front within 10 % of Martin & Moyce at every point with T <= 3.
@@ -69,29 +77,27 @@ class Params(FluidCaseParams):
         check_positive("t_max", self.t_max, "", 10.0)
 
     @property
-    def height(self) -> float:
-        return self.width if self.fill is None else self.fill
-
-    @property
     def resolved_spacing(self) -> float:
         return self.spacing if self.spacing is not None else self.width / PARTICLES_ACROSS
 
 
 def run(p: Params) -> CaseResult:
-    a, dx = p.width, p.resolved_spacing
-    require_particles_across("spacing", a, dx, 8)
+    dx = p.resolved_spacing
+    require_particles_across("spacing", p.width, dx, 8)
+    a = whole_spacings(p.width, dx)  # the column the lattice fills; T and Z are scaled by it
+    height = a if p.fill is None else p.fill
     depth = p.tank_depth(dx)
     length = TANK_LENGTH * a
-    tank = VesselSpec(name="tank", inner_width=length, inner_depth=depth, inner_height=2.0 * p.height)
+    tank = VesselSpec(name="tank", inner_width=length, inner_depth=depth, inner_height=2.0 * height)
     wall = -0.5 * length
     margin = 10 * dx + 0.02
     cfg = case_fluid_config(
-        p.dim, dx, p.height, depth,
+        p.dim, dx, height, depth,
         (wall - margin, -0.5 * depth - margin, -margin), (-wall + margin, 0.5 * depth + margin, tank.inner_height + margin),
         p.solver,
         numerics=p.numerics,
     )
-    column = liquid_block((wall, -0.5 * depth, 0.0), (wall + a, 0.5 * depth, p.height), cfg)
+    column = liquid_block((wall, -0.5 * depth, 0.0), (wall + a, 0.5 * depth, height), cfg)
     solver = FluidSolver(cfg, [tank], [Pose()], column, device=p.device)
     scale = math.sqrt(2.0 * GRAVITY / a)
     t_end = p.t_max / scale
@@ -117,7 +123,7 @@ def run(p: Params) -> CaseResult:
         metrics.append(Metric(f"front Z at T={tr:.3f}", zs, float(zr), err, tol, ""))
     raw = {
         "a": a,
-        "height": p.height,
+        "height": height,
         "t": t.tolist(),
         "front": front.tolist(),
         "T": T.tolist(),
@@ -126,7 +132,7 @@ def run(p: Params) -> CaseResult:
         "particles": solver.n_particles,
         "steps": solver.step_count,
     }
-    params = dict(width=a, fill=p.height, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, t_max=p.t_max, depth=depth)
+    params = dict(width=a, fill=height, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, t_max=p.t_max, depth=depth)
     return CaseResult("dam-break", params, metrics, raw, wall_time)
 
 
