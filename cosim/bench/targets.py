@@ -222,7 +222,6 @@ def markdown(measurements: list[Measurement], header: str) -> str:
 def write_report(measurements: list[Measurement], header: str, out: Path) -> str:
     """Write OUT/targets.md and OUT/targets.json (atomically); returns the Markdown."""
     text = markdown(measurements, header)
-    out.mkdir(parents=True, exist_ok=True)
     write_text_atomic(out / "targets.json", json.dumps([m.to_json() for m in measurements], indent=1) + "\n")
     write_text_atomic(out / "targets.md", text)
     return text
