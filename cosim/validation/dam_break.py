@@ -23,15 +23,7 @@ from cosim.fluid.config import GRAVITY
 from cosim.fluid.seeding import liquid_block
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
-from cosim.validation.common import (
-    CaseResult,
-    FluidCaseParams,
-    Metric,
-    case_fluid_config,
-    new_figure,
-    require_particles_across,
-    whole_spacings,
-)
+from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
 from cosim.vessel import VesselSpec
 
 # Acceptance (issue "Fluid core"): surge front within 10 % of Martin & Moyce at every point with T <= 3.

@@ -19,15 +19,7 @@ from cosim.fluid.config import GRAVITY
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
-from cosim.validation.common import (
-    CaseResult,
-    FluidCaseParams,
-    Metric,
-    case_fluid_config,
-    new_figure,
-    require_particles_across,
-    whole_spacings,
-)
+from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
 from cosim.vessel import VesselSpec
 
 # Acceptance (issue "Fluid core"): pressure within 2 % of rho0 g (H - z) away from walls and surface, density
