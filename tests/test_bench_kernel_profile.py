@@ -9,6 +9,7 @@ import pytest
 from cosim.bench.kernel_profile import OperationTimer, parse_case, profile_case
 from cosim.fluid.benchmark import resting_block
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
+from cosim.fluid.device_layout import DeviceLayout
 
 
 def test_cases_name_dimension_particles_solver_and_density_iteration():
@@ -36,3 +37,17 @@ def test_on_the_cpu_each_operation_is_timed_and_the_results_do_not_change():
         fluid.advance(2 * interval)
         runs.append(fluid.positions())
     assert np.array_equal(*runs) and sum(hook.count.values()) > 0
+
+
+def test_each_pair_layout_asked_for_is_profiled_with_the_rest_of_the_devices_layout(tmp_path):
+    from cosim.bench.kernel_profile import main
+    from cosim.fluid.device_layout import CPU_LAYOUT
+
+    assert main(["--device", "cpu", "--cases", "2:400:dfsph:jacobi", "--steps", "4", "--pair-layouts", "rows", "columns", "--out", str(tmp_path)]) == 0
+    headings = [line for line in (tmp_path / "kernel_profile.md").read_text().splitlines() if line.startswith("## ")]
+    assert [h.rsplit(", ", 1)[1] for h in headings] == ["pair tables in rows", "pair tables in columns"]
+
+    # the solver is built with the layout asked for (slot-major tables on the CPU, the CPU's reductions kept)
+    columns = DeviceLayout(True, CPU_LAYOUT.interleaved_reduction, CPU_LAYOUT.atomic_replicas)
+    fluid, _ = resting_block(400, 2, "cpu", 4, PressureSolver.DFSPH, graphs=False, layout=columns)
+    assert fluid.layout == columns

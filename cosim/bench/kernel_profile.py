@@ -2,7 +2,7 @@
 timed by warp's CUDA activity timing (a profile, not a benchmark: launches run one by one so each is timed).
 
     python -m cosim.bench.kernel_profile [--device cuda] [--cases 3:1000000:wcsph 2:10000:dfsph:jacobi] [--steps 20]
-                                         [--top 12] [--out DIR]
+                                         [--top 12] [--pair-layouts rows columns] [--out DIR]
 
 For each case (dim:particles:solver, for DFSPH optionally :gauss_seidel or :jacobi, its density iteration) the
 block of ``cosim.fluid.benchmark`` settles for one interval of ``steps`` WCSPH substeps, then one more is timed: the wall time, the sum of the device activities (their
@@ -10,6 +10,9 @@ difference is the host's launch and synchronisation cost), and the ``top`` activ
 count and milliseconds per substep. On the CPU, where warp times nothing per kernel, each operation of the substeps is
 timed on the host's clock instead (:class:`OperationTimer`, the solver's ``operation_hook``; a CPU launch returns
 when it is done), the lanes' shares one after the other.
+``--pair-layouts`` profiles each case once per layout of the neighbour-pair tables (``rows``: a row per particle,
+the CPU's; ``columns``: slot-major, CUDA's; :mod:`cosim.fluid.device_layout`), the rest of the device's layout kept:
+the particles are the same under either, so the kernels' times compare the layouts alone.
 Writes DIR/kernel_profile.md (atomically) besides printing it.
 """
 
@@ -25,10 +28,12 @@ import warp as wp
 from cosim.atomic_files import write_text_atomic
 from cosim.fluid.benchmark import resting_block
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
+from cosim.fluid.device_layout import DeviceLayout, layout_for
 from cosim.fluid.runtime import resolve_device
 
 # issue 7's sizes (3-D 1M, 2-D 10k), each solver, DFSPH with either density iteration
 DEFAULT_CASES = [f"{size}:{solver}" for size in ("3:1000000", "2:10000") for solver in ("wcsph", "dfsph:jacobi", "dfsph:gauss_seidel")]
+PAIR_LAYOUTS = {"rows": False, "columns": True}  # --pair-layouts: name -> DeviceLayout.pairs_by_column
 
 
 def parse_case(text: str) -> tuple[int, int, PressureSolver, DensityIteration]:
@@ -59,10 +64,17 @@ class OperationTimer:
         self.count[name] += 1
 
 
-def profile_case(dim: int, n: int, solver: PressureSolver, iteration: DensityIteration, device: str, steps: int, top: int) -> list[str]:
+def profile_case(
+    dim: int, n: int, solver: PressureSolver, iteration: DensityIteration, device: str, steps: int, top: int, pair_layout: str | None = None,
+) -> list[str]:
     """The case's lines of the report: a heading, the wall and the timed totals, the table of the top activities
-    (on CUDA the device's activities, timed by warp; on the CPU each operation, timed on the host's clock)."""
-    fluid, interval = resting_block(n, dim, device, steps, solver, graphs=False, iteration=iteration)
+    (on CUDA the device's activities, timed by warp; on the CPU each operation, timed on the host's clock).
+    ``pair_layout``: a key of :data:`PAIR_LAYOUTS` (None: the device's own layout)."""
+    layout = None
+    if pair_layout is not None:
+        own = layout_for(wp.get_device(device))
+        layout = DeviceLayout(PAIR_LAYOUTS[pair_layout], own.interleaved_reduction, own.atomic_replicas)
+    fluid, interval = resting_block(n, dim, device, steps, solver, graphs=False, iteration=iteration, layout=layout)
     fluid.advance(interval)  # compiles, settles
     cuda = fluid.device.is_cuda
     timer = OperationTimer()
@@ -82,8 +94,9 @@ def profile_case(dim: int, n: int, solver: PressureSolver, iteration: DensityIte
     timed_ms, timed_count = sum(total.values()), sum(count.values())
     what = "device activities" if cuda else "operations (each timed on the host's clock)"
     sub = report.substeps
+    layout_name = "" if pair_layout is None else f", pair tables in {pair_layout}"
     lines = [
-        f"## {dim}-D, {fluid.n_particles} particles, {solver.value}{f' ({iteration.value})' if solver is PressureSolver.DFSPH else ''}, {fluid.device}",
+        f"## {dim}-D, {fluid.n_particles} particles, {solver.value}{f' ({iteration.value})' if solver is PressureSolver.DFSPH else ''}, {fluid.device}{layout_name}",
         "",
         f"{sub} substeps: wall {wall_ms:.2f} ms ({wall_ms / sub:.3f} ms a substep), {what} {timed_ms:.2f} ms "
         f"({timed_ms / sub:.3f} ms a substep, {timed_count} of them, {timed_count / sub:.0f} a substep).",
@@ -103,14 +116,17 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--cases", nargs="*", default=DEFAULT_CASES, help="dim:particles:solver[:iteration], one profile each")
     p.add_argument("--steps", type=int, default=20, help="WCSPH substeps per interval (the benchmark's)")
     p.add_argument("--top", type=int, default=12, help="activities listed per case")
+    p.add_argument("--pair-layouts", nargs="*", choices=sorted(PAIR_LAYOUTS), help="profile each case under each of these pair-table layouts "
+                   "(default: the device's own only)")
     p.add_argument("--out", type=Path, default=Path("recordings") / "kernel_profile")
     args = p.parse_args(argv)
     device = str(resolve_device(args.device))
     lines = [f"# Kernel profile ({device})", ""]
     for case in args.cases:
-        case_lines = profile_case(*parse_case(case), device, args.steps, args.top)
-        print("\n".join(case_lines), flush=True)
-        lines += case_lines
+        for pair_layout in args.pair_layouts or [None]:
+            case_lines = profile_case(*parse_case(case), device, args.steps, args.top, pair_layout)
+            print("\n".join(case_lines), flush=True)
+            lines += case_lines
     write_text_atomic(args.out / "kernel_profile.md", "\n".join(lines) + "\n")
     return 0
 

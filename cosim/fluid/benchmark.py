@@ -34,6 +34,7 @@ import numpy as np
 import warp as wp
 
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
+from cosim.fluid.device_layout import DeviceLayout
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import liquid_block
 from cosim.fluid.solver import FluidSolver
@@ -45,10 +46,11 @@ TANK_ASPECT = 1.0  # the liquid block is as tall as it is wide
 
 def resting_block(
     n: int, dim: int, device: str, steps: int, solver: PressureSolver, graphs: bool = True, threads: int = 0,
-    iteration: DensityIteration = FluidConfig.density_iteration,
+    iteration: DensityIteration = FluidConfig.density_iteration, layout: DeviceLayout | None = None,
 ) -> tuple[FluidSolver, float]:
     """The benchmark's liquid: a resting block of ~n particles in a tank, and the interval (s) of ``steps`` WCSPH
-    substeps that every solver is timed over (``iteration``: DFSPH's density iteration)."""
+    substeps that every solver is timed over (``iteration``: DFSPH's density iteration; ``layout``: the solver's
+    :class:`DeviceLayout`, None for the device's own)."""
     width = 0.2
     depth = width if dim == 3 else 0.1
     cells = n ** (1.0 / dim)
@@ -60,7 +62,7 @@ def resting_block(
         domain_min=(-0.5 * width - m, -0.5 * depth - m, -m), domain_max=(0.5 * width + m, 0.5 * depth + m, 1.5 * width + m),
     )
     block = liquid_block((-0.5 * width, -0.5 * depth, 0.0), (0.5 * width, 0.5 * depth, width * TANK_ASPECT), cfg)
-    fluid = FluidSolver(cfg, [tank], [Pose()], block, device=device, graphs=graphs)
+    fluid = FluidSolver(cfg, [tank], [Pose()], block, device=device, graphs=graphs, layout=layout)
     return fluid, steps * cfg.cfl * cfg.smoothing_length / cfg.sound_speed * 0.999
 
 
