@@ -1,13 +1,15 @@
-"""The CUDA layout of the pair tables, the wrench reduction and the diagnostics rows (cosim.fluid.device_layout),
+"""The CUDA layouts of the pair tables, the wrench reduction and the diagnostics rows (cosim.fluid.device_layout),
 run on the CPU: the same particle state bit for bit as the CPU layout, the sums the same to float32 rounding."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from cosim.fluid import solver as solver_module
 from cosim.fluid.config import FluidConfig
-from cosim.fluid.device_layout import CPU_LAYOUT, CUDA_LAYOUT, REDUCTION_ITEMS, WRENCH_CHUNKS, reduction_levels
+from cosim.fluid.device_layout import CPU_LAYOUT, CUDA_LAYOUT, CUDA_SWEEP_LAYOUT, REDUCTION_ITEMS, WRENCH_CHUNKS, layout_for, reduction_levels
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose, rotation_y
@@ -42,12 +44,13 @@ def _shaken_tank(dim: int, solver: str, layout):
     return fluid
 
 
+@pytest.mark.parametrize("layout", [CUDA_LAYOUT, CUDA_SWEEP_LAYOUT], ids=["cuda", "cuda-sweeps"])
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("solver", ["wcsph", "dfsph"])
-def test_the_cuda_layout_gives_the_cpu_layouts_state(dim, solver):
+def test_the_cuda_layouts_give_the_cpu_layouts_state(dim, solver, layout):
     ref = _shaken_tank(dim, solver, CPU_LAYOUT)
-    cuda = _shaken_tank(dim, solver, CUDA_LAYOUT)
-    assert cuda._pair_index.strides != ref._pair_index.strides  # the layouts differ in memory...
+    cuda = _shaken_tank(dim, solver, layout)
+    assert (cuda._pair_index.strides != ref._pair_index.strides) == layout.pairs_by_column  # the layouts differ in memory...
     assert np.array_equal(ref.positions(), cuda.positions())  # ...not in the particles
     assert np.array_equal(ref.state.v.numpy(), cuda.state.v.numpy())
     wrench_scale = np.abs(ref.vessel_wrenches()).max()
@@ -81,3 +84,21 @@ def test_a_devices_diagnostics_are_read_lane_by_lane_without_a_device_copy(lanes
     out = read_lane_rows(rows, 6)
     assert np.array_equal(out, numpy(rows)[:, :6])
     assert views == [True] * lanes
+
+
+def test_on_cuda_a_gauss_seidel_density_solve_keeps_a_row_per_particle_in_the_pair_tables(monkeypatch):
+    cuda, cpu = SimpleNamespace(is_cuda=True), SimpleNamespace(is_cuda=False)
+    assert layout_for(cuda) == CUDA_LAYOUT and layout_for(cpu) == layout_for(cpu, sweeps=True) == CPU_LAYOUT
+    sweeping = layout_for(cuda, sweeps=True)
+    assert sweeping == CUDA_SWEEP_LAYOUT and not sweeping.pairs_by_column  # the sweeps' tables a row per particle, as on the CPU...
+    assert (sweeping.interleaved_reduction, sweeping.atomic_replicas) == (CUDA_LAYOUT.interleaved_reduction, CUDA_LAYOUT.atomic_replicas)  # ...the rest CUDA's
+
+    # the solver asks for the sweeping layout exactly when its density solve sweeps
+    asked = []
+    monkeypatch.setattr(solver_module, "layout_for", lambda device, sweeps=False: asked.append(sweeps) or CPU_LAYOUT)
+    tank = VesselSpec(name="tank", inner_width=0.1, inner_depth=0.1, inner_height=0.15)
+    for solver, iteration in (("dfsph", "gauss_seidel"), ("dfsph", "jacobi"), ("wcsph", "gauss_seidel")):
+        cfg = FluidConfig(dim=2, spacing=0.005, pressure_solver=solver, density_iteration=iteration, max_expected_speed=1.5,
+                          domain_min=(-0.15, -0.15, -0.05), domain_max=(0.15, 0.15, 0.25))
+        FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, 0.03, cfg))
+    assert asked == [True, False, False]

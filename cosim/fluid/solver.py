@@ -125,7 +125,8 @@ class FluidSolver:
             raise InputError("fluid.domain_min[1]..domain_max[1]: must contain y = 0 (the pour plane) in 2-D")
         self.config = config
         self.device = resolve_device(device)
-        self.layout = layout or layout_for(self.device)
+        sweeps = config.pressure_solver is PressureSolver.DFSPH and config.density_iteration is DensityIteration.GAUSS_SEIDEL
+        self.layout = layout or layout_for(self.device, sweeps)
         self.n_particles = len(particles)
         self.lanes = Lanes(lane_count(config.cpu_threads, self.n_particles, self.device), self.device)
         self.time = 0.0
