@@ -34,6 +34,7 @@ from cosim.errors import InputError
 from cosim.frames import tilt_about_y
 from cosim.io.pour_series import write_series_csv
 from cosim.pour_scene import PourScene
+from cosim.reproducibility import blas_description
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.export import write_trajectory_files
@@ -186,13 +187,15 @@ class _SignalLogger:
 
 
 def package_versions() -> dict[str, str]:
-    """Python's version and each of :data:`VERSIONED_PACKAGES`' installed version ('not installed' where absent)."""
+    """Python's version, each of :data:`VERSIONED_PACKAGES`' installed version ('not installed' where absent) and
+    numpy's BLAS (:func:`cosim.reproducibility.blas_description`)."""
     out = {"python": platform.python_version()}
     for name in VERSIONED_PACKAGES:
         try:
             out[name] = metadata.version(name)
         except metadata.PackageNotFoundError:
             out[name] = "not installed"
+    out["blas"] = blas_description()  # its version and kernels change a pour's bits (cosim.reproducibility)
     return out
 
 

@@ -14,6 +14,11 @@ Haswell kernels need (AVX2 and FMA), they are pinned. Slower kernels for large m
 matrices are a few rows by a few columns). This only works before numpy is first imported (OpenBLAS reads the
 variable once, when it loads), so ``cosim/__init__.py`` calls :func:`pin_openblas_core` first thing; a user's own
 ``OPENBLAS_CORETYPE`` is left alone.
+
+The kernels' bits also change with OpenBLAS's version, which numpy's wheel bundles: the default pour under Python
+3.12 with numpy 2.4.6 (OpenBLAS 0.3.31) and with numpy 2.5.2 (OpenBLAS 0.3.34), Haswell kernels in both, gave two
+trajectories, and numpy 2.4.6 given 2.5.2's OpenBLAS library gave 2.5.2's bit for bit (2026-12-04). So
+:func:`blas_description` names the BLAS and its kernels beside the package versions a pour's summary records.
 """
 
 from __future__ import annotations
@@ -57,3 +62,17 @@ def pin_openblas_core() -> str | None:
     if core is not None:
         os.environ["OPENBLAS_CORETYPE"] = core
     return core
+
+
+def blas_description() -> str:
+    """numpy's BLAS library and version (as numpy was built with it; its wheels bundle that one) and the OpenBLAS
+    kernels asked for, e.g. 'scipy-openblas 0.3.31.188.0, Haswell kernels'."""
+    import numpy as np
+
+    try:
+        blas = np.show_config(mode="dicts")["Build Dependencies"]["blas"]
+        library = f"{blas['name']} {blas['version']}"
+    except (KeyError, TypeError, ValueError):  # a numpy built without that record
+        library = "unknown"
+    core = os.environ.get("OPENBLAS_CORETYPE")
+    return f"{library}, {core + ' kernels' if core else 'kernels chosen by OpenBLAS for this CPU'}"

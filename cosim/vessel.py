@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import math
+import operator
 from dataclasses import dataclass
 from enum import Enum
 
@@ -22,6 +23,14 @@ from cosim.checks import check_choice, check_positive, check_range
 
 # Poly(methyl methacrylate), a common lab vessel material (kg/m^3).
 ACRYLIC_DENSITY = 1180.0
+
+
+def _left_to_right_sum(values) -> float:
+    """The floats added left to right, whatever the Python version. Python 3.12's built-in sum() compensates its
+    rounding (Neumaier) and 3.11's does not: the two gave the default vessels' wall volumes one ulp apart, so the
+    vessels' masses in MuJoCo differed and, the pour being chaotic, so did the whole default pour (README, Known
+    limitations, reproducibility)."""
+    return functools.reduce(operator.add, values, 0.0)
 
 
 class VesselShape(Enum):
@@ -132,7 +141,7 @@ class VesselSpec:
     @property
     def wall_volume(self) -> float:
         """m^3 of wall material."""
-        return sum(v for v, _ in self._wall_parts())
+        return _left_to_right_sum(v for v, _ in self._wall_parts())
 
     @property
     def mass(self) -> float:
@@ -144,7 +153,7 @@ class VesselSpec:
         """Centre of mass of the empty vessel in the vessel frame (m); read-only (computed once: the coupling reads
         it every step)."""
         parts = self._wall_parts()
-        com = sum(v * c for v, c in parts) / sum(v for v, _ in parts)
+        com = sum(v * c for v, c in parts) / _left_to_right_sum(v for v, _ in parts)
         com.flags.writeable = False
         return com
 

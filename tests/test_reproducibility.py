@@ -67,3 +67,28 @@ def test_the_cosim_command_runs_the_pinned_kernels_on_this_machine():
     if expected is None:
         pytest.skip("this CPU gets no pinned core (not x86-64 with AVX2 and FMA)")
     assert core == expected
+
+
+def test_vessel_masses_are_summed_left_to_right_on_every_python_version():
+    from cosim.robots.scene_config import default_catching_vessel, seed_pouring_vessel
+    from cosim.vessel import _left_to_right_sum
+
+    # Python 3.12's sum() compensates its rounding (here 2.0), 3.11's adds left to right (0.0)
+    assert _left_to_right_sum([1.0, 1e100, 1.0, -1e100]) == 0.0
+    # the default vessels' wall volumes, left to right: Python 3.12's sum() gives each one ulp less
+    assert seed_pouring_vessel().wall_volume.hex() == "0x1.6760e24300b0cp-11"
+    assert default_catching_vessel().wall_volume.hex() == "0x1.c219eb6390c93p-11"
+
+
+def test_a_pours_versions_name_numpys_blas_and_its_kernels(monkeypatch):
+    import numpy as np
+
+    from cosim.pour_run import package_versions
+    from cosim.reproducibility import blas_description
+
+    blas = np.show_config(mode="dicts")["Build Dependencies"]["blas"]
+    monkeypatch.setenv("OPENBLAS_CORETYPE", "Haswell")
+    assert blas_description() == f"{blas['name']} {blas['version']}, Haswell kernels"
+    assert package_versions()["blas"] == blas_description()
+    monkeypatch.delenv("OPENBLAS_CORETYPE")
+    assert blas_description().endswith(", kernels chosen by OpenBLAS for this CPU")
