@@ -66,7 +66,7 @@ def pin_openblas_core() -> str | None:
 
 def blas_description() -> str:
     """numpy's BLAS library and version (as numpy was built with it; its wheels bundle that one) and the OpenBLAS
-    kernels asked for, e.g. 'scipy-openblas 0.3.31.188.0, Haswell kernels'."""
+    kernels asked for, e.g. 'scipy-openblas 0.3.31.188.0 (Haswell kernels)'."""
     import numpy as np
 
     try:
@@ -75,4 +75,4 @@ def blas_description() -> str:
     except (KeyError, TypeError, ValueError):  # a numpy built without that record
         library = "unknown"
     core = os.environ.get("OPENBLAS_CORETYPE")
-    return f"{library}, {core + ' kernels' if core else 'kernels chosen by OpenBLAS for this CPU'}"
+    return f"{library} ({core + ' kernels' if core else 'kernels chosen by OpenBLAS for this CPU'})"

@@ -88,7 +88,7 @@ def test_a_pours_versions_name_numpys_blas_and_its_kernels(monkeypatch):
 
     blas = np.show_config(mode="dicts")["Build Dependencies"]["blas"]
     monkeypatch.setenv("OPENBLAS_CORETYPE", "Haswell")
-    assert blas_description() == f"{blas['name']} {blas['version']}, Haswell kernels"
+    assert blas_description() == f"{blas['name']} {blas['version']} (Haswell kernels)"
     assert package_versions()["blas"] == blas_description()
     monkeypatch.delenv("OPENBLAS_CORETYPE")
-    assert blas_description().endswith(", kernels chosen by OpenBLAS for this CPU")
+    assert blas_description().endswith(" (kernels chosen by OpenBLAS for this CPU)")
