@@ -2,6 +2,7 @@
 tables need a GPU)."""
 
 import re
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -9,7 +10,6 @@ import pytest
 from cosim.bench.kernel_profile import OperationTimer, parse_case, profile_case
 from cosim.fluid.benchmark import resting_block
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
-from cosim.fluid.device_layout import DeviceLayout
 
 
 def test_cases_name_dimension_particles_solver_and_density_iteration():
@@ -48,6 +48,6 @@ def test_each_pair_layout_asked_for_is_profiled_with_the_rest_of_the_devices_lay
     assert [h.rsplit(", ", 1)[1] for h in headings] == ["pair tables in rows", "pair tables in columns"]
 
     # the solver is built with the layout asked for (slot-major tables on the CPU, the CPU's reductions kept)
-    columns = DeviceLayout(True, CPU_LAYOUT.interleaved_reduction, CPU_LAYOUT.atomic_replicas)
+    columns = replace(CPU_LAYOUT, pairs_by_column=True)
     fluid, _ = resting_block(400, 2, "cpu", 4, PressureSolver.DFSPH, graphs=False, layout=columns)
     assert fluid.layout == columns

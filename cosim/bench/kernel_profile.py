@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import time
 from collections import defaultdict
+from dataclasses import replace
 from pathlib import Path
 
 import warp as wp
@@ -28,7 +29,7 @@ import warp as wp
 from cosim.atomic_files import write_text_atomic
 from cosim.fluid.benchmark import resting_block
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
-from cosim.fluid.device_layout import DeviceLayout, layout_for
+from cosim.fluid.device_layout import layout_for
 from cosim.fluid.runtime import resolve_device
 
 # issue 7's sizes (3-D 1M, 2-D 10k), each solver, DFSPH with either density iteration
@@ -70,10 +71,7 @@ def profile_case(
     """The case's lines of the report: a heading, the wall and the timed totals, the table of the top activities
     (on CUDA the device's activities, timed by warp; on the CPU each operation, timed on the host's clock).
     ``pair_layout``: a key of :data:`PAIR_LAYOUTS` (None: the device's own layout)."""
-    layout = None
-    if pair_layout is not None:
-        own = layout_for(wp.get_device(device))
-        layout = DeviceLayout(PAIR_LAYOUTS[pair_layout], own.interleaved_reduction, own.atomic_replicas)
+    layout = None if pair_layout is None else replace(layout_for(wp.get_device(device)), pairs_by_column=PAIR_LAYOUTS[pair_layout])
     fluid, interval = resting_block(n, dim, device, steps, solver, graphs=False, iteration=iteration, layout=layout)
     fluid.advance(interval)  # compiles, settles
     cuda = fluid.device.is_cuda

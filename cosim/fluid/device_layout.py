@@ -30,7 +30,7 @@ in another order (tests/test_fluid_device_layout.py).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import warp as wp
 
@@ -52,7 +52,7 @@ class DeviceLayout:
 
 CPU_LAYOUT = DeviceLayout(pairs_by_column=False, interleaved_reduction=False, atomic_replicas=1)
 CUDA_LAYOUT = DeviceLayout(pairs_by_column=True, interleaved_reduction=True, atomic_replicas=CUDA_ATOMIC_REPLICAS)
-CUDA_SWEEP_LAYOUT = DeviceLayout(pairs_by_column=False, interleaved_reduction=True, atomic_replicas=CUDA_ATOMIC_REPLICAS)
+CUDA_SWEEP_LAYOUT = replace(CUDA_LAYOUT, pairs_by_column=False)  # CUDA's, the pair tables a row per particle
 
 
 def layout_for(device, sweeps: bool = False) -> DeviceLayout:
