@@ -14,7 +14,7 @@ from controllers.checks import check_choice, check_range
 from controllers.errors import ControllerInputError
 from controllers.geometry import VesselGeometry
 from controllers.pid import PidDesignSpec
-from controllers.slosh import GRAVITY
+from controllers.slosh import GRAVITY, SloshModel, potential_flow_model
 
 
 class SimMode(Enum):
@@ -103,7 +103,9 @@ class CfsConfig:
       [0, 0.5]
     max_tilt_hold: s, holding max_tilt this long also ends the pour (what is left cannot be poured). [0, 60]
     pivot_margin: m, least world height of the CFS pivot above the slosh pendulum's hinge (the pivot is the lip
-      while the lip is that high; see controllers.cfs). [0, 0.2]
+      while the lip is that high; see controllers.cfs). [0, 0.2] The CFS integral law damps the slosh at the rate
+      m / (2 l1 time_constant): 0.1 m gives 2.7 /s in the paper's vessel, which brings the slosh SIM leaves to
+      within 0.25 mm of the head reference 3 s into CFS on the pendulum plant (tests/test_controllers_pour.py).
     final_head_fraction: a partial pour holds this fraction of h_q_ref in its final stage, so that the outflow
       (and with it the after-flow the stop has to predict) is smaller when it stops; 1 disables the stage. (0, 1]
     final_stage_time: s, the final stage starts when the volume still to pour before the predicted after-flow
@@ -116,7 +118,7 @@ class CfsConfig:
     max_tilt: float = 1.75
     empty_fraction: float = 0.02
     max_tilt_hold: float = 3.0
-    pivot_margin: float = 0.03
+    pivot_margin: float = 0.1
     final_head_fraction: float = 0.5
     final_stage_time: float = 0.8
 
@@ -192,6 +194,9 @@ class PourConfig:
       margin, 13.8 dB gain margin and Ms = 1.47 (50 Hz: 43 deg, 11.6 dB, Ms = 1.70).
     start_time: s, the controller idles (vessel at home, catcher pre-positioned) until this time. [0, 60]
     gravity: m/s^2. (0, 100]
+    slosh: the pourer's first-mode slosh model the controller is designed on; None: potential flow for the box
+      vessel and fill (:func:`controllers.slosh.potential_flow_model`). Set it for a vessel with no closed form, from
+      the SPH identification (``cosim validate slosh-plant``).
     """
 
     catcher: CatcherConfig
@@ -201,6 +206,7 @@ class PourConfig:
     control_rate: float = 100.0
     start_time: float = 0.0
     gravity: float = GRAVITY
+    slosh: SloshModel | None = None
     sim: SimConfig = field(default_factory=SimConfig)
     approach: ApproachConfig = field(default_factory=ApproachConfig)
     cfs: CfsConfig = field(default_factory=CfsConfig)
@@ -222,6 +228,14 @@ class PourConfig:
         check_range("pour.control_rate", self.control_rate, 20.0, 500.0, "Hz")
         check_range("pour.start_time", self.start_time, 0.0, 60.0, "s")
         check_range("pour.gravity", self.gravity, 0.0, 100.0, "m/s^2", lo_open=True)
+        if self.slosh is not None:
+            _check_type("pour.slosh", self.slosh, SloshModel)
+
+    def slosh_model(self) -> SloshModel:
+        """The slosh model the controller is designed on: ``slosh`` if set, else potential flow for the box."""
+        if self.slosh is not None:
+            return self.slosh
+        return potential_flow_model(self.vessel.inner_width, self.fill_depth, self.gravity)
 
     @property
     def initial_volume(self) -> float:

@@ -1,8 +1,11 @@
-"""Model versions of the seed's controller figures (the SPH versions come from the coupled simulation).
+"""Model versions of the controller figures of Camporredondo et al. (2019) (the SPH versions come from the coupled
+simulation).
 
-    python -m controllers.figures --out DIR
+    python -m controllers.figures --out DIR [--plant potential-flow|printed-paper]
 
-writes, for the seed's vessel (B = L = 0.191 m, A = 0.1591 m) and the default configuration:
+writes, for the paper's vessel (B = L = 0.191 m, A = 0.1591 m) and the default configuration, on the physical
+slosh model (potential flow, the default) or, to reproduce the paper's own figures, on its Eqs. 10-11 as printed
+(:func:`controllers.slosh.printed_paper_model`):
   fig13_theta1_ratio.png    theta1/theta against the excitation frequency, fills A = 54..162 mm (Eq. 13; Fig. 13)
   fig14_root_locus.png      root loci of Gp and of C Gp with the design's closed-loop poles (Fig. 14)
   fig15_step_response.png   step responses of Gp and C Gp in unity feedback (Fig. 15)
@@ -28,9 +31,10 @@ from controllers.measurement import Phase  # noqa: E402
 from controllers.model_plant import ModelPlant, ModelPlantConfig, Trace, run_closed_loop  # noqa: E402
 from controllers.pid import PidDesign, design_filtered_pid, sampled_plant  # noqa: E402
 from controllers.pour import PourController  # noqa: E402
-from controllers.slosh import SloshModel  # noqa: E402
+from controllers.slosh import potential_flow_model, printed_paper_model  # noqa: E402
 
-SEED_FILLS_MM = (54, 81, 108, 135, 162)  # seed Sec. 4 tests fills from 54 to 162 mm
+PAPER_FILLS_MM = (54, 81, 108, 135, 162)  # the paper's Sec. 4 tests fills from 54 to 162 mm
+PLANTS = {"potential-flow": potential_flow_model, "printed-paper": printed_paper_model}
 SIM_PLOT_SECONDS = 4.0  # s of the SIM timeline plotted: excitation, hold, damping and the start of CFS
 PHASE_COLOURS = {
     Phase.SIM_EXCITE: "#fde0c5",
@@ -41,23 +45,26 @@ PHASE_COLOURS = {
 }
 
 
-def seed_config() -> PourConfig:
-    """The default pour of the seed's vessel and fill; vessel B's home is arbitrary for these figures."""
-    return PourConfig(catcher=CatcherConfig(home_x=0.25))
+def paper_config(plant: str = "potential-flow") -> PourConfig:
+    """The default pour of the paper's vessel and fill on the slosh model ``plant`` (a key of :data:`PLANTS`);
+    vessel B's home is arbitrary for these figures."""
+    config = PourConfig(catcher=CatcherConfig(home_x=0.25))
+    model = PLANTS[plant](config.vessel.inner_width, config.fill_depth, config.gravity)
+    return PourConfig(catcher=config.catcher, slosh=model)
 
 
-def figure_ratio(path: Path, config: PourConfig) -> None:
+def figure_ratio(path: Path, config: PourConfig, plant: str) -> None:
     width = config.vessel.inner_width
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for fill_mm in SEED_FILLS_MM:
-        model = SloshModel(width, fill_mm / 1000.0, config.gravity)
+    for fill_mm in PAPER_FILLS_MM:
+        model = PLANTS[plant](width, fill_mm / 1000.0, config.gravity)
         alpha = np.linspace(0.0, 0.97 * model.omega1, 400)
         ax.plot(alpha, np.abs(model.forced_ratio(alpha)), label=f"A = {fill_mm} mm (omega1 = {model.omega1:.1f} rad/s)")
-    seed = SloshModel(width, config.fill_depth, config.gravity)
-    ax.axvline(config.sim.frequency_ratio * seed.omega1, color="k", ls="--", lw=1, label="SIM alpha (A = 159 mm)")
+    own = config.slosh_model()
+    ax.axvline(config.sim.frequency_ratio * own.omega1, color="k", ls="--", lw=1, label="SIM alpha (A = 159 mm)")
     ax.axhline(1.0, color="grey", lw=0.8)
     ax.set(xlabel="excitation frequency alpha (rad/s)", ylabel="|theta1 / theta|", ylim=(0.0, 4.0),
-           title="Forced slosh response, pendulum model (seed Eq. 13)")
+           title=f"Forced slosh response, pendulum model (paper Eq. 13; {own.source})")
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
@@ -114,7 +121,7 @@ def figure_step(path: Path, design: PidDesign) -> None:
 def sim_timeline(config: PourConfig) -> tuple[PourController, Trace]:
     """The controller's SIM timeline on the model plant (pendulum + box + weir), first SIM_PLOT_SECONDS."""
     controller = PourController(config)
-    plant = ModelPlant(ModelPlantConfig(vessel=config.vessel, fill_depth=config.fill_depth), config.dt)
+    plant = ModelPlant(ModelPlantConfig(vessel=config.vessel, fill_depth=config.fill_depth, slosh=config.slosh), config.dt)
     return controller, run_closed_loop(controller, plant, SIM_PLOT_SECONDS)
 
 
@@ -127,7 +134,7 @@ def figure_sim_timeline(path: Path, config: PourConfig) -> PourController:
     a1.plot(t, theta, label="theta (vessel tilt, command)")
     a1.plot(t, np.degrees(trace.series("theta1")), label="theta1 (free surface, vessel frame)")
     a1.plot(t, np.degrees(trace.series("theta1") - trace.series("tilt")), label="sigma = theta1 - theta (slosh)")
-    a1.set(ylabel="angle (deg)", title="SIM timeline on the pendulum model (seed Figs. 7, 16)")
+    a1.set(ylabel="angle (deg)", title="SIM timeline on the pendulum model (paper Figs. 7, 16)")
     a1.legend(fontsize=8)
     a2.plot(t, 1e3 * trace.series("h_q"), color="tab:purple", label="h_q")
     a2.axhline(1e3 * config.cfs.h_q_ref, color="grey", ls="--", lw=0.8, label="h_q reference")
@@ -148,19 +155,21 @@ def figure_sim_timeline(path: Path, config: PourConfig) -> PourController:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m controllers.figures", description=__doc__.split("\n")[0])
     parser.add_argument("--out", type=Path, required=True, help="directory for the PNG files")
+    parser.add_argument("--plant", choices=sorted(PLANTS), default="potential-flow",
+                        help="slosh model: potential flow (physical, the default) or the paper's Eqs. 10-11 as printed")
     args = parser.parse_args(argv)
     args.out.mkdir(parents=True, exist_ok=True)
-    config = seed_config()
-    model = SloshModel(config.vessel.inner_width, config.fill_depth, config.gravity)
+    config = paper_config(args.plant)
+    model = config.slosh_model()
     design = design_filtered_pid(model, config.sim.pid, config.dt)
-    figure_ratio(args.out / "fig13_theta1_ratio.png", config)
+    figure_ratio(args.out / "fig13_theta1_ratio.png", config, args.plant)
     figure_root_locus(args.out / "fig14_root_locus.png", design)
     figure_step(args.out / "fig15_step_response.png", design)
     controller = figure_sim_timeline(args.out / "fig16_sim_timeline.png", config)
     for name in ("fig13_theta1_ratio.png", "fig14_root_locus.png", "fig15_step_response.png", "fig16_sim_timeline.png"):
         print(args.out / name)
     g = design.gains
-    print(f"plant: l1 = {model.l1:.5f} m, L1 = {model.L1:.5f} m, b2 = {model.b2:.5f} m, "
+    print(f"plant ({model.source}): l1 = {model.l1:.5f} m, hinge {model.hinge_height:.5f} m, b2 = {model.b2:.5f} m, "
           f"omega1 = {model.omega1:.3f} rad/s, RHP zero = {model.rhp_zero:.2f} rad/s")
     print(f"PID: Kp = {g.kp:.4f}, Ki = {g.ki:.4f} 1/s, Kd = {g.kd:.5f} s, Tf = {g.tf:.5f} s")
     print("closed-loop poles (rad/s): " + ", ".join(f"{p:.3f}" for p in design.closed_loop_poles))

@@ -25,7 +25,7 @@ from controllers.errors import ControllerInputError
 from controllers.geometry import PlanarPose, VesselGeometry, height_above, surface_offset
 from controllers.measurement import LiquidMeasurement, PourCommand
 from controllers.pour import PourController
-from controllers.slosh import GRAVITY, SloshModel
+from controllers.slosh import GRAVITY, SloshModel, potential_flow_model
 
 
 @dataclass(frozen=True)
@@ -37,6 +37,7 @@ class ModelPlantConfig:
     discharge_coefficient: C_d of the weir outflow. (0, 1]
     substeps: integration steps per control period (the input is interpolated linearly). [1, 100]
     arm_delay_steps: control periods by which the arm carries out each command late. [0, 100]
+    slosh: the liquid's first-mode pendulum; None: potential flow for the box and fill.
     """
 
     vessel: VesselGeometry = field(default_factory=VesselGeometry)
@@ -48,6 +49,7 @@ class ModelPlantConfig:
     substeps: int = 10
     gravity: float = GRAVITY
     arm_delay_steps: int = 0
+    slosh: SloshModel | None = None
 
     def __post_init__(self) -> None:
         check_range("plant.fill_depth", self.fill_depth, 0.0, self.vessel.inner_height, "m", lo_open=True)
@@ -65,7 +67,7 @@ class ModelPlant:
     def __init__(self, config: ModelPlantConfig, dt: float) -> None:
         self.config = config
         geom = config.vessel
-        self.model = SloshModel(geom.inner_width, config.fill_depth, config.gravity)
+        self.model = config.slosh or potential_flow_model(geom.inner_width, config.fill_depth, config.gravity)
         self._h = dt / config.substeps
         sysd = ct.c2d(self.model.state_space(), self._h, "zoh")
         self._a, self._b = np.asarray(sysd.A), np.asarray(sysd.B)

@@ -1,9 +1,9 @@
-"""PID compensator for the slosh plant Gp (seed Sec. 3.1, Eq. 15; Figs. 8, 14, 15).
+"""PID compensator for the slosh plant Gp (Camporredondo et al. 2019, Sec. 3.1, Eq. 15; Figs. 8, 14, 15).
 
 Loop: unity negative feedback, theta = C(s) (r - theta1), theta1 = Gp(s) theta, with Gp from
 :meth:`controllers.slosh.SloshModel.plant` (sign convention there: DC gain +1).
 
-* The seed's ideal PID C = (Kd s^2 + Kp s + Ki)/s cannot stabilise Gp: the closed-loop characteristic
+* The paper's ideal PID C = (Kd s^2 + Kp s + Ki)/s cannot stabilise Gp: the closed-loop characteristic
   polynomial (:func:`ideal_pid_characteristic`) is
       b2 Kd s^4 + (l1 + b2 Kp) s^3 + (b2 Ki + g Kd) s^2 + g (1 + Kp) s + g Ki
   and with b2 < 0 its s^4, s^2 and s^0 coefficients can never share one sign (Hurwitz necessary condition).
@@ -11,7 +11,13 @@ Loop: unity negative feedback, theta = C(s) (r - theta1), theta1 = Gp(s) theta, 
       [Tf l1 + b2 u] s^4 + [l1 + b2 v] s^3 + [Tf g + b2 w + g u] s^2 + [g + g v] s + g w,
       u = Kp Tf + Kd,  v = Kp + Ki Tf,  w = Ki,
   is linear in (Tf, u, v, w) and in a scale factor, so any four target poles are placed exactly by one linear
-  solve (:func:`design_filtered_pid`). The integrator gives zero steady-state error to a step reference.
+  solve (:func:`place_filtered_pid`). The integrator gives zero steady-state error to a step reference.
+* The loop the PID really closes runs at the control period dt and through the arm: the tilt it commands reaches
+  the vessel ``actuation_delay`` later (the arm's trajectory generator and servos). Pole placement on Gp alone
+  ignores that lag; the paper's design placed on its printed plant, with the physical plant, has a closed-loop pole
+  at +33 rad/s. :func:`design_filtered_pid` therefore places the poles for a family of bandwidths and keeps the
+  design whose sampled loop with the delay (:func:`delayed_loop`) decays fastest while keeping the gain and phase
+  margins the spec asks for (6 dB and 45 deg by default, the usual robustness floor), verified with python-control.
 * :class:`DiscretePid` runs that compensator at the control rate: forward-Euler integrator, backward-Euler
   derivative filter acting on the measurement (no derivative kick), output and output-rate limits, and
   back-calculation anti-windup. :meth:`PidGains.discrete_tf` is its exact z-domain transfer function.
@@ -19,11 +25,13 @@ Loop: unity negative feedback, theta = C(s) (r - theta1), theta1 = Gp(s) theta, 
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import control as ct
 import numpy as np
+import scipy.optimize
 
 from controllers.checks import check_range
 from controllers.errors import ControllerInputError
@@ -76,29 +84,50 @@ class PidGains:
         return ct.tf([self.kp], [1.0], dt) + integ + deriv
 
 
+BANDWIDTH_RATIOS = np.round(np.arange(3.0, 0.29, -0.1), 1)  # wn / omega1 tried by design_filtered_pid, fastest first
+DAMPING_RATIOS = (0.4, 0.55, 0.7)  # zeta tried by design_filtered_pid
+SEARCH_PENALTY = 100.0  # 1/s of decay rate per dB (or per 10 deg) of margin short of the spec, in the design search
+# The search aims this far inside the margins, so that its numpy estimate (3000 frequencies) clears python-control's
+# verification, which the design must pass.
+SEARCH_SLACK_DB, SEARCH_SLACK_DEG = 0.1, 1.0
+SEARCH_ITERATIONS = 2000  # Nelder-Mead iterations of the design search's refinement
+
+
 @dataclass(frozen=True)
 class PidDesignSpec:
-    """Closed-loop target: poles of (s^2 + 2 zeta wn s + wn^2)(s + wn)^2 with wn = bandwidth_ratio * omega1.
+    """Closed-loop target: poles of (s^2 + 2 zeta wn s + wn^2)(s + wn)^2 with wn = bandwidth_ratio * omega1, the
+    bandwidth chosen for the loop with the actuation delay.
 
     damping: zeta of the complex pair, [0.3, 0.95] (1 would make a fourfold pole, which floating point cannot
-      verify to better than 1e-4).
-    bandwidth_ratio: wn / omega1, [0.3, 3].
-
-    The defaults (zeta = 0.7, wn = omega1) give the seed's vessel a sensitivity peak Ms = 1.29, a 0.65 s
-    settling time and a derivative filter Tf = 27 ms, which a 100 Hz loop resolves (see the report figures).
+      verify to better than 1e-4); not set: searched with the bandwidth over :data:`DAMPING_RATIOS`.
+    bandwidth_ratio: wn / omega1, [0.3, 3]; not set: searched over :data:`BANDWIDTH_RATIOS`. The search keeps the
+      pair whose sampled loop with the delay decays fastest within the margins.
+    actuation_delay: s, from the tilt command to the vessel's tilt, rounded up to whole control periods in the
+      design. [0, 0.5] The default is the lag of the arms' joint generators and servos alone; the coupled pour's
+      task-space filter adds an amplitude-dependent lag at the slosh frequency (docs/controller.md).
+    min_gain_margin: dB. [0, 40]   min_phase_margin: deg. [0, 90]
     """
 
-    damping: float = 0.7
-    bandwidth_ratio: float = 1.0
+    damping: float | None = None
+    bandwidth_ratio: float | None = None
+    actuation_delay: float = 0.02
+    min_gain_margin: float = 6.0
+    min_phase_margin: float = 45.0
 
     def __post_init__(self) -> None:
-        check_range("pid.damping", self.damping, 0.3, 0.95)
-        check_range("pid.bandwidth_ratio", self.bandwidth_ratio, 0.3, 3.0)
+        if self.damping is not None:
+            check_range("pid.damping", self.damping, 0.3, 0.95)
+        if self.bandwidth_ratio is not None:
+            check_range("pid.bandwidth_ratio", self.bandwidth_ratio, 0.3, 3.0)
+        check_range("pid.actuation_delay", self.actuation_delay, 0.0, 0.5, "s")
+        check_range("pid.min_gain_margin", self.min_gain_margin, 0.0, 40.0, "dB")
+        check_range("pid.min_phase_margin", self.min_phase_margin, 0.0, 90.0, "deg")
 
-    def target_poles(self, omega1: float) -> np.ndarray:
-        wn = self.bandwidth_ratio * omega1
-        wd = wn * math.sqrt(1.0 - self.damping**2)
-        sr = -self.damping * wn
+    def target_poles(self, omega1: float, damping: float, bandwidth_ratio: float) -> np.ndarray:
+        """The four target poles (rad/s) for a slosh frequency ``omega1`` (rad/s)."""
+        wn = bandwidth_ratio * omega1
+        wd = wn * math.sqrt(1.0 - damping**2)
+        sr = -damping * wn
         return np.array([complex(sr, wd), complex(sr, -wd), -wn, -wn])
 
 
@@ -106,9 +135,11 @@ class PidDesignSpec:
 class PidDesign:
     """A filtered PID for one plant, with its verified closed loop.
 
-    closed_loop_poles: rad/s, from python-control's feedback(C Gp, 1). min_damping: smallest -Re(p)/|p| over
-    them. settling_time: s, 2 % band of the closed-loop step response. discrete_poles: z-plane poles of the
-    loop with :meth:`PidGains.discrete_tf` on :func:`sampled_plant`, when a sample time was given.
+    closed_loop_poles: rad/s, from python-control's feedback(C Gp, 1) (no delay). min_damping: smallest
+    -Re(p)/|p| over them. settling_time: s, 2 % band of that closed-loop step response. With a sample time ``dt``:
+    delay_steps, the actuation delay in control periods; discrete_poles, the z-plane poles of :func:`delayed_loop`
+    in unity feedback; decay_rate (1/s), -ln(max |z|) / dt, the slowest closed-loop decay; gain_margin (dB) and
+    phase_margin (deg) of that loop (python-control's stability_margins).
     """
 
     gains: PidGains
@@ -119,6 +150,10 @@ class PidDesign:
     settling_time: float
     dt: float | None
     discrete_poles: np.ndarray | None
+    delay_steps: int = 0
+    decay_rate: float = math.nan
+    gain_margin: float = math.nan
+    phase_margin: float = math.nan
 
     def closed_loop(self) -> ct.TransferFunction:
         """theta1 / r of the continuous loop."""
@@ -146,50 +181,163 @@ def _pole_mismatch(poles: np.ndarray, target: np.ndarray) -> float:
     return worst
 
 
-def design_filtered_pid(model: SloshModel, spec: PidDesignSpec = PidDesignSpec(), dt: float | None = None) -> PidDesign:
-    """Place the closed-loop poles of C Gp exactly at ``spec``'s targets and verify the result.
+def delayed_loop(gains: PidGains, model: SloshModel, dt: float, delay_steps: int) -> ct.TransferFunction:
+    """The open loop C(z) Gz(z) z^-delay_steps the controller closes at sample time ``dt`` (s)."""
+    return gains.discrete_tf(dt) * sampled_plant(model, dt) * ct.tf([1.0], [1.0] + [0.0] * delay_steps, dt)
 
-    Raises :class:`ControllerInputError` if the placement needs a derivative filter outside (0, 10] s
-    (:class:`PidGains`), if python-control finds a closed-loop pole off the target or in the right half-plane,
-    or (with ``dt`` in s) if the sampled loop is not stable at that control period.
-    """
+
+def place_filtered_pid(model: SloshModel, target: np.ndarray) -> PidGains | None:
+    """The filtered PID whose continuous closed loop with Gp has exactly the four poles ``target`` (rad/s) (module
+    docstring); None when that needs a derivative filter outside (0, 10] s."""
     g, l1, b2 = model.gravity, model.l1, model.b2
-    target = spec.target_poles(model.omega1)
+    c = model._damping()
     _, c3, c2, c1, c0 = np.real(np.poly(target))
-    # Unknowns (Tf, u, v, w, k): characteristic polynomial = k * monic target polynomial.
+    # Unknowns (Tf, u, v, w, k): characteristic polynomial (with Gp's damping term c) = k * monic target polynomial.
     m = np.array(
         [
             [l1, b2, 0.0, 0.0, -1.0],
-            [0.0, 0.0, b2, 0.0, -c3],
-            [g, g, 0.0, b2, -c2],
-            [0.0, 0.0, g, 0.0, -c1],
+            [c, c, b2, 0.0, -c3],
+            [g, g, c, b2, -c2],
+            [0.0, 0.0, g, c, -c1],
             [0.0, 0.0, 0.0, g, -c0],
         ]
     )
-    tf, u, v, w, _ = np.linalg.solve(m, np.array([0.0, -l1, 0.0, -g, 0.0]))
-    ki = w
-    kp = v - ki * tf
-    gains = PidGains(kp=float(kp), ki=float(ki), kd=float(u - kp * tf), tf=float(tf))
+    tf, u, v, w, _ = np.linalg.solve(m, np.array([0.0, -l1, -c, -g, 0.0]))
+    if not 0.0 < tf <= 10.0:
+        return None
+    kp = v - w * tf
+    return PidGains(kp=float(kp), ki=float(w), kd=float(u - kp * tf), tf=float(tf))
+
+
+def delayed_loop_figures(gains: PidGains, model: SloshModel, dt: float, delay_steps: int) -> tuple[float, float, float]:
+    """(decay rate 1/s, gain margin dB, phase margin deg) of :func:`delayed_loop` in unity feedback: -ln(max |z|)/dt
+    over the closed-loop poles (-inf if unstable); the margins from python-control's crossings as distances from
+    the critical point: the gain margin closest to 0 dB (up or down) over every phase crossover, the phase margin
+    closest to 0 over every gain crossover (inf where the loop has none)."""
+    loop = delayed_loop(gains, model, dt, delay_steps)
+    radius = float(np.max(np.abs(ct.poles(ct.feedback(loop, 1)))))
+    if radius >= 1.0:
+        return -math.inf, -math.inf, -math.inf
+    gms, pms, *_ = ct.stability_margins(loop, returnall=True)
+    gm_db = min((abs(20.0 * math.log10(g)) for g in np.atleast_1d(gms) if g > 0.0 and math.isfinite(g)), default=math.inf)
+    pm = min((abs(float(p)) for p in np.atleast_1d(pms) if math.isfinite(p)), default=math.inf)
+    return -math.log(radius) / dt, gm_db, pm
+
+
+def _fast_loop_figures(gains: PidGains, plant: tuple[np.ndarray, np.ndarray], dt: float, delay_steps: int,
+                       frequencies: np.ndarray) -> tuple[float, float, float]:
+    """:func:`delayed_loop_figures` in numpy, for the design search: closed-loop roots of den + num, and the margins
+    from the loop's response at ``frequencies`` (rad/sample) as python-control defines them (the gain margin closest
+    to 0 dB, up or down, over every phase crossover; the smallest phase margin over every gain crossover)."""
+    k, t = gains, dt
+    c_num = np.polyadd(np.polyadd(np.polymul([k.kp], np.polymul([1.0, -1.0], [k.tf + t, -k.tf])),
+                                  np.polymul([k.ki * t], [k.tf + t, -k.tf])), np.polymul([k.kd, -k.kd], [1.0, -1.0]))
+    c_den = np.polymul([1.0, -1.0], [k.tf + t, -k.tf])
+    num = np.polymul(c_num, plant[0])
+    den = np.polymul(np.polymul(c_den, plant[1]), [1.0] + [0.0] * delay_steps)
+    radius = float(np.max(np.abs(np.roots(np.polyadd(den, num)))))
+    if not radius < 1.0:
+        return -math.inf, -math.inf, -math.inf
+    z = np.exp(1j * frequencies)
+    response = np.polyval(num, z) / np.polyval(den, z)
+    magnitude = np.abs(response)
+    from_half_turn = np.mod(np.angle(response), 2.0 * math.pi) - math.pi  # phase + pi, wrapped into [-pi, pi)
+    gm = min((abs(20.0 * math.log10(magnitude[i])) for i in _crossings(from_half_turn)), default=math.inf)
+    pm = min((abs(math.degrees(from_half_turn[i])) for i in _crossings(magnitude - 1.0)), default=math.inf)
+    return -math.log(radius) / dt, gm, pm
+
+
+def _crossings(values: np.ndarray) -> np.ndarray:
+    """Indices i where ``values`` changes sign between i and i + 1 (the jumps of a wrapped phase excluded)."""
+    change = np.sign(values[:-1]) != np.sign(values[1:])
+    return np.flatnonzero(change & (np.abs(values[1:] - values[:-1]) < math.pi))
+
+
+def _search(model: SloshModel, spec: PidDesignSpec, dt: float, delay_steps: int) -> tuple[PidGains, np.ndarray]:
+    """The gains whose delayed sampled loop decays fastest within the spec's margins: the best pole placement over
+    the damping and bandwidth grid, refined by Nelder-Mead on (kp, ki, kd, ln tf) with the margins as penalties.
+    Returns the gains and the placement's target poles it started from."""
+    zoh = sampled_plant(model, dt)
+    plant = (np.asarray(zoh.num[0][0], dtype=float), np.asarray(zoh.den[0][0], dtype=float))
+    frequencies = np.linspace(1e-4, math.pi, 3000)
+
+    def score(gains: PidGains) -> float:
+        decay, gm, pm = _fast_loop_figures(gains, plant, dt, delay_steps, frequencies)
+        shortfall = (max(spec.min_gain_margin + SEARCH_SLACK_DB - gm, 0.0)
+                     + max(spec.min_phase_margin + SEARCH_SLACK_DEG - pm, 0.0) / 10.0)
+        return -decay + SEARCH_PENALTY * shortfall if math.isfinite(decay) else math.inf
+
+    start = None
+    for zeta in DAMPING_RATIOS if spec.damping is None else (spec.damping,):
+        for r in BANDWIDTH_RATIOS if spec.bandwidth_ratio is None else (spec.bandwidth_ratio,):
+            target = spec.target_poles(model.omega1, zeta, float(r))
+            gains = place_filtered_pid(model, target)
+            if gains is not None and (start is None or score(gains) < start[0]):
+                start = (score(gains), gains, target)
+    if start is None or not math.isfinite(start[0]):
+        raise ControllerInputError(
+            f"pid: no stable design with an actuation delay of {spec.actuation_delay:g} s at {1.0 / dt:g} Hz"
+        )
+
+    def objective(x: np.ndarray) -> float:
+        tf = math.exp(x[3])
+        return score(PidGains(float(x[0]), float(x[1]), float(x[2]), tf)) if 0.0 < tf <= 10.0 else math.inf
+
+    g0 = start[1]
+    result = scipy.optimize.minimize(objective, np.array([g0.kp, g0.ki, g0.kd, math.log(g0.tf)]), method="Nelder-Mead",
+                                     options={"xatol": 1e-6, "fatol": 1e-6, "maxiter": SEARCH_ITERATIONS})
+    x = result.x if result.fun < start[0] else np.array([g0.kp, g0.ki, g0.kd, math.log(g0.tf)])
+    return PidGains(float(x[0]), float(x[1]), float(x[2]), math.exp(x[3])), start[2]
+
+
+@functools.lru_cache(maxsize=64)
+def design_filtered_pid(model: SloshModel, spec: PidDesignSpec = PidDesignSpec(), dt: float | None = None) -> PidDesign:
+    """A filtered PID for ``model``, verified with python-control.
+
+    With ``spec.damping`` and ``spec.bandwidth_ratio`` both set (or no sample time ``dt``): the closed-loop poles of
+    C Gp placed exactly at the spec's targets. Otherwise, with ``dt`` (s): the design whose sampled loop with the
+    actuation delay (:func:`delayed_loop`) decays fastest within the spec's margins (:func:`_search`). Raises
+    :class:`ControllerInputError` if the placement needs a derivative filter outside (0, 10] s, if python-control
+    finds a placed pole off its target or any in the right half-plane, or if the sampled loop with the delay is
+    unstable or (searched) short of the margins.
+    """
+    searched = dt is not None and (spec.damping is None or spec.bandwidth_ratio is None)
+    if dt is not None:
+        check_range("control_rate period", dt, 0.0, 0.1, "s", lo_open=True)
+    delay_steps = math.ceil(spec.actuation_delay / dt - 1e-9) if dt is not None else 0
+    if searched:
+        gains, target = _search(model, spec, dt, delay_steps)
+    else:
+        target = spec.target_poles(model.omega1, spec.damping or 0.7, spec.bandwidth_ratio or 1.0)
+        gains = place_filtered_pid(model, target)
+        if gains is None:
+            raise ControllerInputError(f"pid: the poles {target} need a derivative filter outside (0, 10] s")
 
     loop = ct.feedback(gains.transfer_function() * model.plant(), 1)
     poles = np.sort_complex(ct.poles(loop))
-    if poles.size != 4 or _pole_mismatch(poles, target) > POLE_MATCH_RTOL * float(np.max(np.abs(target))):
+    if not searched and (poles.size != 4 or _pole_mismatch(poles, target) > POLE_MATCH_RTOL * float(np.max(np.abs(target)))):
         raise ControllerInputError(f"pid: closed-loop poles {poles} differ from the targets {target}")
     if np.max(poles.real) >= 0.0:
         raise ControllerInputError(f"pid: closed loop is unstable, poles {poles}")
     min_damping = float(np.min(-poles.real / np.abs(poles)))
     horizon = np.linspace(0.0, 20.0 / float(np.min(-poles.real)), 4001)
     settling = float(ct.step_info(loop, T=horizon, SettlingTimeThreshold=SETTLING_BAND)["SettlingTime"])
+    if dt is None:
+        return PidDesign(gains, model, target, poles, min_damping, settling, dt, None)
 
-    dpoles = None
-    if dt is not None:
-        check_range("control_rate period", dt, 0.0, 0.1, "s", lo_open=True)
-        dpoles = ct.poles(ct.feedback(gains.discrete_tf(dt) * sampled_plant(model, dt), 1))
-        if np.max(np.abs(dpoles)) >= 1.0:
-            raise ControllerInputError(
-                f"control_rate: {1.0 / dt:g} Hz is too slow for the PID (Tf = {tf:.4g} s); sampled loop unstable"
-            )
-    return PidDesign(gains, model, target, poles, min_damping, settling, dt, dpoles)
+    dpoles = ct.poles(ct.feedback(delayed_loop(gains, model, dt, delay_steps), 1))
+    decay, gm_db, pm = delayed_loop_figures(gains, model, dt, delay_steps)
+    if np.max(np.abs(dpoles)) >= 1.0:
+        raise ControllerInputError(
+            f"control_rate: {1.0 / dt:g} Hz with an actuation delay of {spec.actuation_delay:g} s is too slow for the "
+            f"PID (Tf = {gains.tf:.4g} s); sampled loop unstable"
+        )
+    if searched and (gm_db < spec.min_gain_margin or pm < spec.min_phase_margin):
+        raise ControllerInputError(
+            f"pid: no design reaches {spec.min_gain_margin:g} dB and {spec.min_phase_margin:g} deg of margin with an "
+            f"actuation delay of {spec.actuation_delay:g} s at {1.0 / dt:g} Hz (best: {gm_db:.2f} dB, {pm:.1f} deg)"
+        )
+    return PidDesign(gains, model, target, poles, min_damping, settling, dt, dpoles, delay_steps, decay, gm_db, pm)
 
 
 class DiscretePid:

@@ -37,7 +37,6 @@ from controllers.geometry import PlanarPose, static_tilt_for_h_q
 from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
 from controllers.motion import RateLimitedTracker, fitted_delay
 from controllers.pid import DiscretePid, PidDesign, design_filtered_pid
-from controllers.slosh import SloshModel
 from controllers.slosh_induction import excitation_duration, excitation_tilt, sim_needed
 
 # Time constant (s) of the first-order filter on the measured outflow rate d(poured)/dt: a fifth of the seed
@@ -68,7 +67,7 @@ class PourController:
         self.config = config
         self.dt = config.dt
         geom = config.vessel
-        self.model = SloshModel(geom.inner_width, config.fill_depth, config.gravity)
+        self.model = config.slosh_model()
         sim = config.sim
         if sim.mode is SimMode.AUTO:
             self.use_sim, self.entry_reason = sim_needed(
@@ -303,8 +302,8 @@ class PourController:
         if stop:
             return stop
         if m.h_q > 0.0:
-            # seed Sec. 3.1: "at the beginning of t3, where the slosh finds free exit to flow out of the vessel,
-            # AFS will end and CFS will begin". From here the crest clamps the surface, theta1 no longer follows
+            # "at the beginning of t3, where the slosh finds free exit to flow out of the vessel, AFS will end and
+            # CFS will begin" (paper Sec. 3.1). From here the crest clamps the surface, theta1 no longer follows
             # the pendulum plant Gp, and a PID on theta1 would keep tilting into the outflow.
             return Phase.CFS, f"t3: the slosh found free exit over the crest (h_q = {1e3 * m.h_q:.2f} mm)"
         sim = self.config.sim

@@ -9,10 +9,10 @@ from scipy.integrate import quad
 
 from controllers.cfs import after_flow_volume, cfs_pivot, crest_lever, level_drop
 from controllers.geometry import VesselGeometry, rotate, vector_step
-from controllers.slosh import SloshModel
+from controllers.slosh import potential_flow_model
 
 SEED_VESSEL = VesselGeometry()
-SEED = SloshModel(SEED_VESSEL.inner_width, 0.1591)
+SEED = potential_flow_model(SEED_VESSEL.inner_width, 0.1591)
 K = 1.0 / 0.3  # 1/s, the default CFS time constant 0.3 s
 MARGINAL_RE = 1e-6  # rad/s: |Re| below this is the marginal case (roots of O(10) rad/s in float64)
 # First-order perturbation of the slosh poles by the integral law: relative error O(k / omega1) = 0.04 at k = 0.5.
