@@ -27,7 +27,7 @@ MAX_TOLERANCE_MM = 1000.0
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "replay",
-        help="play a joint trajectory CSV in MuJoCo (no liquid) and report tracking error",
+        help="play a joint trajectory CSV in MuJoCo (no liquid): tracking error and a pass/fail verdict",
         description="Play a joint trajectory CSV through the arms' position servos in MuJoCo without liquid (the "
         "liquid as a rigid payload), report per-joint tracking error and the vessel lips' path errors, and end with "
         "PASS (every lip within the tolerance of its commanded path, no contact) or FAIL. Exit status: 0 pass, "
