@@ -7,12 +7,17 @@ the value that was given, e.g. ``fluid.spacing: must be in (0, 0.05] m, got -0.0
 from __future__ import annotations
 
 import math
+import re
 from enum import Enum
 from typing import TypeVar
 
 from cosim.errors import InputError
 
 E = TypeVar("E", bound=Enum)
+
+# A ROS 2 name token (e.g. a tf prefix): a letter, then letters, digits and underscores; at most this long.
+ROS_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+ROS_NAME_MAX = 64
 
 
 def _fmt(value: object) -> str:
@@ -86,3 +91,15 @@ def check_device(field: str, value: object) -> str:
     if isinstance(value, str) and (value in ("cpu", "cuda") or (value.startswith("cuda:") and value[5:].isdigit())):
         return value
     raise InputError(f"{field}: must be 'cpu', 'cuda' or 'cuda:N', got {_fmt(value)}")
+
+
+def check_ros_name(field: str, value: object, allow_empty: bool = False) -> str:
+    """A ROS 2 name token (e.g. a tf prefix): a letter, then letters, digits or '_', at most :data:`ROS_NAME_MAX`
+    characters; ``''`` too where ``allow_empty``."""
+    if isinstance(value, str) and ((value == "" and allow_empty) or (ROS_NAME.fullmatch(value) and len(value) <= ROS_NAME_MAX)):
+        return value
+    empty = " or ''" if allow_empty else ""
+    raise InputError(
+        f"{field}: must be a letter followed by letters, digits or '_' (at most {ROS_NAME_MAX} characters){empty}, "
+        f"got {_fmt(value)}"
+    )

@@ -1,9 +1,11 @@
 """``cosim pour``: run one pour scene and write its outputs.
 
 Outputs, in a new run folder (``recordings/<UTC time>-<scene name>/``, never an earlier run's) or ``--out DIR``:
-``pour.rrd`` (Rerun recording, unless logging is off), ``trajectory.csv`` and ``trajectory.json`` (the arms' checked
-jerk-limited joint trajectories), ``series.csv`` (per-control-step signals, :mod:`cosim.io.pour_series`),
-``summary.json`` (volumes, phases, timings, versions, the scene). Everything is
+``pour.rrd`` (Rerun recording, unless logging is off), ``trajectory.csv``, ``trajectory.json`` and ``trajectory.mcap``
+(the arms' checked jerk-limited joint trajectories; the MCAP as ROS 2 ``JointTrajectory`` messages,
+:mod:`cosim.io.trajectory_mcap`), ``series.csv`` (per-control-step signals, :mod:`cosim.io.pour_series`),
+``summary.json`` (volumes, the volume left in the pourer and a partial pour's error first, phases, timings,
+versions, the scene). Everything is
 written into a hidden temporary folder next to the destination and renamed into place only when the run
 succeeded, so a failed or interrupted run leaves no half-written folder behind.
 """
@@ -37,6 +39,7 @@ from cosim.pour_scene import PourScene
 from cosim.reproducibility import blas_description
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.driver_names import driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.limits import scene_limits
 
@@ -204,7 +207,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
     if scene.logging.enabled and find_spec("rerun") is None:
         raise InputError("logging.enabled: the Rerun recording needs rerun-sdk, which is not installed "
                          "(install it, or run without the recording: --no-log or logging.enabled = false)")
-    final = destination(out, scene.name)
+    final = destination(out, scene.run_name)
     field = "--out" if out is not None else "--out (default recordings/)"
     check_output_folder(final.parent, field)
     pour = prepare(scene)
@@ -249,9 +252,13 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
             recorder.close()
         write_series_csv(pour.log.rows, work / "series.csv")
         trajectory = pour.recorder.trajectory()
-        write_trajectory_files(trajectory, pour.recorder.limits, pour.recorder.sample_rate_hz, work / "trajectory.csv", work / "trajectory.json")
+        write_trajectory_files(
+            trajectory, pour.recorder.limits, pour.recorder.sample_rate_hz,
+            driver_joint_names(pour.scene, scene.trajectory.joint_prefix),
+            work / "trajectory.csv", work / "trajectory.json", work / "trajectory.mcap",
+        )
         summary.update(
-            scene_name=scene.name,
+            scene_name=scene.run_name,
             device=str(pour.fluid.device),
             fluid_threads=pour.fluid.lanes.count,
             dim=pour.fluid.config.dim,
@@ -270,7 +277,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
             scene=json.loads(json.dumps(asdict(scene), default=lambda o: getattr(o, "value", str(o)))),
         )
         (work / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
-        final = _publish(work, final, scene.name if out is None else None)
+        final = _publish(work, final, scene.run_name if out is None else None)
         return final, summary
     except BaseException:
         if recorder is not None:

@@ -9,8 +9,9 @@ much to pour), ``fluid`` (SPH resolution and numerics), ``controller`` (the seed
 
 from __future__ import annotations
 
+import re
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from controllers.config import ApproachConfig, CfsConfig, ReturnConfig, SimConfig
@@ -21,6 +22,7 @@ from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
 from cosim.fluid.config import DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
 from cosim.io.recording_config import RecordingConfig
+from cosim.trajectory.driver_names import JointPrefix
 from cosim.trajectory.limits import JointLimitOverride
 
 
@@ -189,10 +191,13 @@ class TrajectorySettings:
     """sample_rate_hz: Hz, rate of the exported joint trajectories. (0, 10000]
     limits: per-joint overrides of the arms' limits, keyed '<arm>/<joint>' (e.g. 'pour_arm/elbow'), each with
       max_velocity (rad/s), max_acceleration (rad/s^2), max_jerk (rad/s^3), min_position, max_position (rad).
+    joint_prefix: per arm, the prefix of its joint names in trajectory.json and trajectory.mcap (the names its ROS 2
+      driver uses, e.g. 'shoulder_pan_joint'), as the driver's tf_prefix.
     """
 
     sample_rate_hz: float = 500.0
     limits: dict[str, JointLimitOverride] = field(default_factory=dict)
+    joint_prefix: JointPrefix = field(default_factory=JointPrefix)
 
     def __post_init__(self) -> None:
         check_positive("trajectory.sample_rate_hz", self.sample_rate_hz, "Hz", 10000.0)
@@ -215,9 +220,14 @@ class RobotSettings:
     scene: str = ""
 
 
+DEFAULT_SCENE_NAME = "seed-pour"  # the run folders' name of the embedded default scene
+_NOT_IN_NAMES = re.compile(r"[^A-Za-z0-9_-]")
+
+
 @dataclass(frozen=True)
 class PourScene:
-    """name: used in the run folder's name. [letters, digits, '-', '_']
+    """name: the run folder's name (recordings/<UTC time>-<name>); '' names it after the scene file (its name without
+      .toml), 'seed-pour' for the embedded default scene. [letters, digits, '-', '_'; or '']
     device: 'cpu' or 'cuda[:N]'.
     liquid: fill and pour amount.
     fluid: SPH resolution and numerics.
@@ -228,7 +238,7 @@ class PourScene:
     robots: the MuJoCo scene.
     """
 
-    name: str = "seed-pour"
+    name: str = ""
     device: str = "cpu"
     liquid: LiquidSettings = field(default_factory=LiquidSettings)
     fluid: FluidSettings = field(default_factory=FluidSettings)
@@ -239,9 +249,19 @@ class PourScene:
     robots: RobotSettings = field(default_factory=RobotSettings)
 
     def __post_init__(self) -> None:
-        if not self.name or not all(c.isalnum() or c in "-_" for c in self.name):
-            raise InputError(f"scene.name: must be letters, digits, '-' or '_', got {self.name!r}")
+        if not isinstance(self.name, str) or _NOT_IN_NAMES.search(self.name):
+            raise InputError(f"scene.name: must be letters, digits, '-' or '_' (or '': the scene file's name), got {self.name!r}")
         check_device("scene.device", self.device)
+
+    @property
+    def run_name(self) -> str:
+        """The run folder's name: :attr:`name`, else :data:`DEFAULT_SCENE_NAME`."""
+        return self.name or DEFAULT_SCENE_NAME
+
+    def named_after(self, path: str | Path) -> "PourScene":
+        """This scene, named after the file ``path`` (its stem, other characters than letters, digits, '-' and '_'
+        made '_') unless it has a name of its own."""
+        return self if self.name else replace(self, name=_NOT_IN_NAMES.sub("_", Path(path).stem))
 
 
 def load_scene(path: str | Path) -> PourScene:

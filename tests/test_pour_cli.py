@@ -29,6 +29,8 @@ max_duration = {duration}
 [logging.recording]
 particle_rate_hz = 20.0
 """
+# The coarsest liquid (8 particles across), without a recording: a pour's outputs in a few seconds.
+TINY = "[fluid]\nparticles_across = 8\n[logging]\nenabled = false\n"
 # Central differences of samples h = 1/500 s apart of a trajectory whose jerk is bounded by J (Taylor with integral
 # remainder): positions -> velocity within J h^2 / 6 (the second-order terms cancel); velocities -> acceleration within
 # J h / 2 (the remainders only cancel where the jerk does not change over [t - h, t + h]; ruckig switches it at every
@@ -53,10 +55,16 @@ def run(tmp_path_factory):
 
 
 def test_outputs_and_summary(run):
-    assert sorted(p.name for p in run.iterdir()) == ["pour.rrd", "series.csv", "summary.json", "trajectory.csv", "trajectory.json"]
+    files = ["pour.rrd", "series.csv", "summary.json", "trajectory.csv", "trajectory.json", "trajectory.mcap"]
+    assert sorted(p.name for p in run.iterdir()) == files
     summary = json.loads((run / "summary.json").read_text())
+    assert sorted(summary["outputs"]) == files
     for key in ("initial_volume", "poured_volume", "spilled_volume", "phases", "sim_time", "wall_time", "real_time_factor", "device", "versions"):
         assert key in summary
+    # a pour until empty has no target; what is left in the pourer is what the last measurement counted
+    assert summary["target_volume"] is summary["target_error"] is summary["target_relative_error"] is None
+    assert summary["volume_left_in_pourer"] == pytest.approx(summary["initial_volume"] - summary["poured_volume"], rel=1e-12)
+    assert 0.0 < summary["volume_left_in_pourer"] <= summary["initial_volume"]
     assert summary["initial_volume"] > 0 and summary["sim_time"] == pytest.approx(0.8)
     assert summary["cfs_head_reference"] == pytest.approx(2.5 * summary["particle_spacing"])  # 2-D, 10 across: 48 mm
     assert [p["phase"] for p in summary["phases"]][0] == "idle"
@@ -100,7 +108,7 @@ def test_exported_trajectory_differentiates_consistently_and_holds_every_limit(r
     qdd_fd = (qd[2:] - qd[:-2]) / (2 * h)
     limits = {}
     for arm in doc["arms"].values():
-        for k, name in enumerate(arm["joint_names"]):
+        for k, name in enumerate(arm["scene_joint_names"]):
             limits[name] = {f: arm["limits"][f][k] for f in arm["limits"]}
     for j, name in enumerate(traj.joint_names):
         lim = limits[name]
@@ -123,7 +131,7 @@ def test_replay_tracks_the_vessel_path(run, capsys):
 def test_same_scene_twice_gives_byte_identical_trajectories(tmp_path):
     a = _pour(tmp_path, "a", 0.4, ("--no-log",))
     b = _pour(tmp_path, "b", 0.4, ("--no-log",))
-    for name in ("trajectory.csv", "trajectory.json"):
+    for name in ("trajectory.csv", "trajectory.json", "trajectory.mcap"):
         assert (a / name).read_bytes() == (b / name).read_bytes()
     assert not (a / "pour.rrd").exists()
 
@@ -141,6 +149,8 @@ def test_same_scene_twice_gives_byte_identical_trajectories(tmp_path):
         ("[fluid]\nmax_tension = -1.0\n", "fluid.max_tension"),
         ("[fluid]\nfree_artificial_viscosity = 2.0\n", "fluid.free_artificial_viscosity"),
         ("device = 'tpu'\n", "scene.device"),
+        ("name = 'my cell'\n", "scene.name"),
+        ("[trajectory.joint_prefix]\npour_arm = 'ur-'\n", "trajectory.joint_prefix.pour_arm"),
         ("this is not toml", "not a valid TOML file"),
     ],
 )
@@ -237,12 +247,41 @@ def test_scene_dump_leaves_stream_particles_unset_so_that_changing_dim_keeps_its
     assert "# stream_particles = (not set)" in capsys.readouterr().out
 
 
+def test_run_folders_are_named_after_the_scene_file_unless_it_names_them(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "my_cell.toml").write_text(TINY)
+    (tmp_path / "other cell.v2.toml").write_text(TINY)
+    (tmp_path / "named.toml").write_text('name = "line-3"\n' + TINY)
+    for scene in ("my_cell.toml", "other cell.v2.toml", "named.toml"):
+        assert main(["pour", scene, "--quiet", "--duration", "0.02"]) == 0
+    runs = sorted(p.name.split("-", 2)[2] for p in (tmp_path / "recordings").iterdir())
+    assert runs == ["line-3", "my_cell", "other_cell_v2"]
+    summary = json.loads(next((tmp_path / "recordings").glob("*-my_cell/summary.json")).read_text())
+    assert summary["scene_name"] == "my_cell"
+    assert PourScene().run_name == "seed-pour"  # the embedded default scene (no file) keeps its name
+
+
+def _tiny_pour(tmp_path, name: str, head: str) -> dict:
+    """summary.json of a 0.05 s pour of the coarsest liquid, without recording, of the scene ``head`` + :data:`TINY`."""
+    scene = tmp_path / f"{name}.toml"
+    scene.write_text(head + TINY)
+    out = tmp_path / name
+    assert main(["pour", str(scene), "--out", str(out), "--quiet", "--duration", "0.05"]) == 0
+    return json.loads((out / "summary.json").read_text())
+
+
+def test_a_partial_pour_reports_its_target_and_error(tmp_path):
+    summary = _tiny_pour(tmp_path, "half", "[liquid]\npour_fraction = 0.5\n")
+    target = 0.5 * summary["initial_volume"]
+    assert summary["target_volume"] == pytest.approx(target, rel=1e-12)
+    # 0.05 s is still before the pour starts: nothing poured, the whole target missed
+    assert summary["poured_volume"] == 0.0 and summary["volume_left_in_pourer"] == summary["initial_volume"]
+    assert summary["target_error"] == pytest.approx(-target, rel=1e-12)
+    assert summary["target_relative_error"] == pytest.approx(-1.0, rel=1e-12)
+
+
 def test_coarsest_resolution_pours_with_the_head_floor_capped_at_the_cfs_limit(tmp_path):
     # 8 across: 2.5 spacings of 23.9 mm would be a 60 mm head, over cfs.h_q_ref's 0.05 m limit (the pour used to
     # stop there with an error about cfs.h_q_ref, a key the scene did not set)
-    scene = tmp_path / "coarse.toml"
-    scene.write_text('name = "coarse"\n[fluid]\nparticles_across = 8\n[logging]\nenabled = false\n')
-    out = tmp_path / "coarse"
-    assert main(["pour", str(scene), "--out", str(out), "--quiet", "--duration", "0.05"]) == 0
-    summary = json.loads((out / "summary.json").read_text())
+    summary = _tiny_pour(tmp_path, "coarse", "")
     assert summary["cfs_head_reference"] == CFS_MAX_HEAD < 2.5 * summary["particle_spacing"]

@@ -1,4 +1,5 @@
-"""``cosim replay``: JSON output of a good trajectory; one line and exit status 2 for bad input."""
+"""``cosim replay``: JSON output and PASS of a good trajectory; FAIL with its reasons and exit status 1 for one the
+servos cannot track; one line and exit status 2 for bad input."""
 
 from __future__ import annotations
 
@@ -12,15 +13,22 @@ from cosim.io.trajectory_csv import JointTrajectory, write_trajectory_csv
 from cosim.robots.scene import RobotScene
 
 
-@pytest.fixture(scope="module")
-def hold_csv(tmp_path_factory):
+def _two_samples(path, lift: float):
+    """A 0.2 s trajectory from home to home with the pour arm's shoulder lift turned by ``lift`` rad, at rest at both
+    ends."""
     scene = RobotScene.load()
     names = tuple(n for arm in scene.arms.values() for n in arm.joints)
     q = np.concatenate([arm.home_q for arm in scene.arms.values()])
+    end = q.copy()
+    end[names.index("pour_arm/shoulder_lift")] += lift
     zeros = np.zeros((2, q.size))
-    path = tmp_path_factory.mktemp("cli") / "hold.csv"
-    write_trajectory_csv(path, JointTrajectory(np.array([0.0, 0.2]), names, np.vstack((q, q)), zeros, zeros))
+    write_trajectory_csv(path, JointTrajectory(np.array([0.0, 0.2]), names, np.vstack((q, end)), zeros, zeros))
     return path
+
+
+@pytest.fixture(scope="module")
+def hold_csv(tmp_path_factory):
+    return _two_samples(tmp_path_factory.mktemp("cli") / "hold.csv", 0.0)
 
 
 def test_replay_json(hold_csv, capsys):
@@ -29,12 +37,38 @@ def test_replay_json(hold_csv, capsys):
     assert result["max_error_m"] < 1e-6
     assert len(result["joint_max_error_rad"]) == 12 and "pour_arm/shoulder_pan" in result["joint_max_error_rad"]
     assert result["first_contact"] is None
+    assert (result["verdict"], result["tolerance_m"], result["failures"]) == ("pass", 0.002, [])
 
 
 def test_replay_table(hold_csv, capsys):
     assert main(["replay", str(hold_csv), "--payload", "empty"]) == 0
     out = capsys.readouterr().out
     assert "pourer lip path error" in out and "contacts: none" in out
+    assert out.splitlines()[-1] == "PASS: every vessel lip within 2.000 mm of its commanded path, no contact"
+
+
+def test_replay_of_a_move_the_servos_cannot_track_fails_with_its_reasons_and_exit_1(tmp_path, capsys):
+    # 0.3 rad of shoulder lift in 0.2 s: the servos saturate, the pourer's lip falls centimetres behind its path and the
+    # pourer hits the catcher
+    path = _two_samples(tmp_path / "fast.csv", 0.3)
+    assert main(["replay", str(path), "--json", "--tolerance-mm", "3"]) == 1
+    result = json.loads(capsys.readouterr().out)
+    assert result["verdict"] == "fail" and result["tolerance_m"] == 0.003
+    assert result["lip_max_error_m"]["pourer"] > 0.003 and result["first_contact"] is not None
+    reasons = result["failures"]
+    assert reasons[0].startswith("pourer lip path error ") and reasons[0].endswith(" mm above 3.000 mm")
+    assert reasons[-1].startswith("contact at t=")
+    assert all(r.startswith("catcher lip") for r in reasons[1:-1])
+    assert (len(reasons) == 3) == (result["lip_max_error_m"]["catcher"] > 0.003)
+    assert main(["replay", str(path)]) == 1
+    assert capsys.readouterr().out.splitlines()[-1].startswith("FAIL: pourer lip path error ")
+
+
+def test_replay_tolerance_out_of_range_exits_2_with_one_line(hold_csv, capsys):
+    assert main(["replay", str(hold_csv), "--tolerance-mm", "0"]) == 2
+    captured = capsys.readouterr()
+    assert captured.err.strip() == "cosim replay: error: --tolerance-mm: must be in (0, 1000] mm, got 0"
+    assert captured.out == ""
 
 
 @pytest.mark.parametrize(

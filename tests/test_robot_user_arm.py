@@ -15,6 +15,7 @@ from cosim.robots.planar import tilt_about_pivot
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_builder import build_scene_spec, scene_mjcf
 from cosim.robots.scene_config import ArmModel, ArmPlacement, ArmRole, MountSide, default_scene_config
+from cosim.trajectory.driver_names import JointPrefix, driver_joint_names
 from cosim.vessel import VesselSpec, seed_pouring_vessel
 
 # A small 6-DOF arm in the style of a MuJoCo Menagerie model: its own joint names, a tool site whose z axis points
@@ -129,6 +130,24 @@ def test_user_scene_survives_save_and_reload(config, tmp_path):
     assert scene.arms[ArmRole.CATCH].vessel.shape.value == "cylinder"
     np.testing.assert_allclose(scene.arms[ArmRole.POUR].max_joint_speed, 2.0)
     assert scene.data.ncon == 0
+
+
+def test_user_arm_exports_its_drivers_joint_names(config, tmp_path):
+    # without driver names the MJCF's are exported; with them, they are recorded in the scene file and exported
+    assert RobotScene.from_config(config).arms[ArmRole.POUR].driver_joints == JOINTS
+    driver = tuple(f"fr3_joint{k}" for k in range(1, 7))
+    named = dataclasses.replace(config, pour=dataclasses.replace(config.pour, arm=dataclasses.replace(config.pour.arm, driver_joints=driver)))
+    path = tmp_path / "user_scene.xml"
+    path.write_text(scene_mjcf(named))
+    scene = RobotScene.load(path)
+    assert scene.arms[ArmRole.POUR].driver_joints == driver
+    assert driver_joint_names(scene, JointPrefix(pour_arm="left_"))["pour_arm"] == tuple(f"left_{n}" for n in driver)
+
+
+@pytest.mark.parametrize("driver", [("a",) * 6, ("a", "b"), ("a b", "c", "d", "e", "f", "g")])
+def test_bad_driver_joint_names_are_refused(driver):
+    with pytest.raises(InputError, match=r"^arm\.driver_joints: must name the arm's 6 joints once each, without spaces"):
+        ArmModel("test_arm.xml", JOINTS, "tool", (2.0,) * 6, driver)
 
 
 def test_bad_mapping_is_reported(config):

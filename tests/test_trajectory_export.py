@@ -1,4 +1,5 @@
-"""Exported trajectory files: independent differentiation of the CSV, replay in MuJoCo, JSON = CSV, unsafe refused.
+"""Exported trajectory files: independent differentiation of the CSV, replay in MuJoCo, JSON = CSV = MCAP (read back
+with the mcap reader), the arms' driver joint names, unsafe refused.
 
 The differentiation test uses nothing of cosim.trajectory: it reads the files back and checks them against the
 limits stored in the JSON.
@@ -11,15 +12,19 @@ import math
 
 import numpy as np
 import pytest
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
 
 from cosim.cli.main import main
 from cosim.errors import InputError
 from cosim.io.trajectory_csv import JointTrajectory, read_trajectory_csv
 from cosim.io.trajectory_json import FORMAT, UNITS, read_trajectory_json
+from cosim.robots.assets import DEFAULT_SCENE, models_dir
 from cosim.robots.pour_motion import Pivot, PourMotionSpec
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import UnsafeTrajectoryError
+from cosim.trajectory.driver_names import JointPrefix, driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.limits import JointLimitOverride, arm_limits
 from cosim.trajectory.scripted import generate_scripted, pour_poses
@@ -32,6 +37,9 @@ LIMIT_RTOL = 1e-9
 # JSON time_from_start is the sample time rounded to the nanosecond.
 JSON_TIME_RESOLUTION = 0.5e-9
 EPS = np.finfo(float).eps
+# The default prefixes before the UR driver's joint names (the scene does not change them).
+NAMES = {arm: tuple(f"{arm}_{j}_joint" for j in ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3"))
+         for arm in ("pour_arm", "catch_arm")}
 
 
 @pytest.fixture(scope="module")
@@ -43,7 +51,8 @@ def scene() -> RobotScene:
 def exported(scene, tmp_path_factory):
     run = generate_scripted(scene, pour_poses(scene, POUR))
     folder = tmp_path_factory.mktemp("pour")
-    write_trajectory_files(run.trajectory, run.limits, run.sample_rate_hz, folder / "trajectory.csv", folder / "trajectory.json")
+    write_trajectory_files(run.trajectory, run.limits, run.sample_rate_hz, driver_joint_names(scene, JointPrefix()),
+                           folder / "trajectory.csv", folder / "trajectory.json", folder / "trajectory.mcap")
     return run, folder
 
 
@@ -52,7 +61,7 @@ def _json_limits(folder, trajectory: JointTrajectory) -> dict[str, np.ndarray]:
     document = json.loads((folder / "trajectory.json").read_text())
     per_joint = {}
     for arm in document["arms"].values():
-        for i, name in enumerate(arm["joint_names"]):
+        for i, name in enumerate(arm["scene_joint_names"]):
             per_joint[name] = {field: values[i] for field, values in arm["limits"].items()}
     return {field: np.array([per_joint[n][field] for n in trajectory.joint_names])
             for field in ("max_velocity", "max_acceleration", "max_jerk", "min_position", "max_position")}
@@ -133,14 +142,65 @@ def test_json_and_csv_hold_the_same_numbers(exported):
     assert set(point) == {"positions", "velocities", "accelerations", "time_from_start"}
     assert point["time_from_start"] == {"sec": 0, "nanosec": 2_000_000}
     assert raw["arms"]["catch_arm"]["arm_model"] == "UR10e"
+    # ROS 2 users get the UR driver's joint names with the arm's prefix; the scene's names map them onto the CSV
+    assert document.driver_joint_names == NAMES
+    assert {arm: tuple(raw["arms"][arm]["joint_names"]) for arm in raw["arms"]} == NAMES
+    assert tuple(n for arm in raw["arms"].values() for n in arm["scene_joint_names"]) == csv.joint_names
+
+
+def test_mcap_holds_one_joint_trajectory_per_arm_equal_to_the_csv(exported):
+    _, folder = exported
+    csv = read_trajectory_csv(folder / "trajectory.csv")
+    with (folder / "trajectory.mcap").open("rb") as handle:
+        reader = make_reader(handle, decoder_factories=[DecoderFactory()])
+        profile = reader.get_header().profile
+        messages = [(schema, channel, message, ros) for schema, channel, message, ros in reader.iter_decoded_messages()]
+    assert profile == "ros2"
+    assert [channel.topic for _, channel, _, _ in messages] == ["/pour_arm/joint_trajectory", "/catch_arm/joint_trajectory"]
+    for schema, channel, message, ros in messages:
+        arm = channel.topic.split("/")[1]
+        assert (schema.name, schema.encoding, channel.message_encoding) == ("trajectory_msgs/msg/JointTrajectory", "ros2msg", "cdr")
+        assert message.log_time == 0 and (ros.header.stamp.sec, ros.header.stamp.nanosec, ros.header.frame_id) == (0, 0, "")
+        assert tuple(ros.joint_names) == NAMES[arm]
+        assert len(ros.points) == csv.time.size
+        columns = [i for i, name in enumerate(csv.joint_names) if name.startswith(f"{arm}/")]  # base to tip
+        for field in ("positions", "velocities", "accelerations"):
+            np.testing.assert_array_equal(np.array([getattr(p, field) for p in ros.points]), getattr(csv, field)[:, columns])
+        assert all(len(p.effort) == 0 for p in ros.points)
+        stamps = np.array([p.time_from_start.sec + p.time_from_start.nanosec * 1e-9 for p in ros.points])
+        np.testing.assert_allclose(stamps, csv.time, rtol=0.0, atol=JSON_TIME_RESOLUTION + 1e-15)
+
+
+def test_joint_prefixes_name_the_exported_joints(scene):
+    names = driver_joint_names(scene, JointPrefix(pour_arm="", catch_arm="bob_"))
+    assert names["pour_arm"] == tuple(n.removeprefix("pour_arm_") for n in NAMES["pour_arm"])
+    assert names["catch_arm"] == tuple(n.replace("catch_arm_", "bob_") for n in NAMES["catch_arm"])
+
+
+@pytest.mark.parametrize("prefix", ["2nd_", "ur-", "alice/", "a" * 65, 3])
+def test_a_bad_joint_prefix_is_refused_in_one_line(prefix):
+    with pytest.raises(InputError, match=r"^trajectory\.joint_prefix\.catch_arm: must be a letter followed by letters, digits or '_'"):
+        JointPrefix(catch_arm=prefix)
+
+
+def test_a_scene_file_without_driver_names_exports_the_mjcf_names(tmp_path):
+    # a scene written before the builder recorded the drivers' names: the arm's MJCF joint names are exported
+    text = (models_dir() / DEFAULT_SCENE).read_text()
+    lines = [line for line in text.splitlines() if "/driver_joints" not in line]
+    assert len(lines) == len(text.splitlines()) - 2
+    path = tmp_path / "scene.xml"
+    path.write_text("\n".join(lines))
+    names = driver_joint_names(RobotScene.load(path), JointPrefix())
+    assert names["pour_arm"][0] == "pour_arm_shoulder_pan" and names["catch_arm"][-1] == "catch_arm_wrist_3"
 
 
 def test_same_run_gives_byte_identical_files(scene, exported, tmp_path):
     _, folder = exported
     again = generate_scripted(scene, pour_poses(scene, POUR))
-    write_trajectory_files(again.trajectory, again.limits, again.sample_rate_hz, tmp_path / "t.csv", tmp_path / "t.json")
-    assert (tmp_path / "t.csv").read_bytes() == (folder / "trajectory.csv").read_bytes()
-    assert (tmp_path / "t.json").read_bytes() == (folder / "trajectory.json").read_bytes()
+    write_trajectory_files(again.trajectory, again.limits, again.sample_rate_hz, driver_joint_names(scene, JointPrefix()),
+                           tmp_path / "t.csv", tmp_path / "t.json", tmp_path / "t.mcap")
+    for suffix in ("csv", "json", "mcap"):
+        assert (tmp_path / f"t.{suffix}").read_bytes() == (folder / f"trajectory.{suffix}").read_bytes()
 
 
 def _corrupt(trajectory: JointTrajectory, how: str) -> JointTrajectory:
@@ -178,8 +238,18 @@ def test_unsafe_trajectory_is_refused_and_nothing_written(exported, tmp_path, ho
     run, _ = exported
     bad = _corrupt(run.trajectory, how)
     with pytest.raises(UnsafeTrajectoryError, match=r"^unsafe trajectory: " + message) as info:
-        write_trajectory_files(bad, run.limits, run.sample_rate_hz, tmp_path / "trajectory.csv", tmp_path / "trajectory.json")
+        write_trajectory_files(bad, run.limits, run.sample_rate_hz, NAMES, tmp_path / "trajectory.csv",
+                               tmp_path / "trajectory.json", tmp_path / "trajectory.mcap")
     assert "\n" not in str(info.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_driver_names_that_do_not_fit_the_arms_are_refused_and_nothing_written(exported, tmp_path):
+    run, _ = exported
+    short = {**NAMES, "catch_arm": NAMES["catch_arm"][:-1]}
+    with pytest.raises(ValueError, match=r"^JointTrajectory: catch_arm needs 6 unique driver joint names"):
+        write_trajectory_files(run.trajectory, run.limits, run.sample_rate_hz, short, tmp_path / "trajectory.csv",
+                               tmp_path / "trajectory.json", tmp_path / "trajectory.mcap")
     assert list(tmp_path.iterdir()) == []
 
 
@@ -195,19 +265,20 @@ def test_tighter_limits_refuse_the_pour(scene, exported, tmp_path, override, mes
     run, _ = exported
     tight = [arm_limits(scene, role, {"wrist_1": override}) for role in ArmRole]
     with pytest.raises(UnsafeTrajectoryError, match=r"^unsafe trajectory: arm pour_arm, joint wrist_1, t=\d+\.\d{4} s: " + message):
-        write_trajectory_files(run.trajectory, tight, run.sample_rate_hz, tmp_path / "trajectory.csv")
+        write_trajectory_files(run.trajectory, tight, run.sample_rate_hz, NAMES, tmp_path / "trajectory.csv")
     assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
-        (lambda d: d.update(format="ros"), r"format: must be 'cosim.joint_trajectory.v1', got 'ros'$"),
+        (lambda d: d.update(format="ros"), r"format: must be 'cosim.joint_trajectory.v2', got 'ros'$"),
         (lambda d: d["arms"]["pour_arm"]["points"][3].update(positions=[0.0]), r"arms\.pour_arm\.points\[3\]\.positions: must be a list of 6 finite numbers$"),
         (lambda d: d["arms"]["catch_arm"]["points"][2]["time_from_start"].update(nanosec=-1), r"arms\.catch_arm\.points\[2\]\.time_from_start: sec must be an integer >= 0"),
         (lambda d: d["arms"]["catch_arm"]["points"][2]["time_from_start"].update(nanosec=3_000_000), r"arms\.catch_arm\.points: the times differ from the first arm's$"),
         (lambda d: d["arms"]["pour_arm"]["limits"]["max_jerk"].__setitem__(0, -1.0), r"limits\.pour_arm/shoulder_pan\.max_jerk: must be in \(0, 1e\+06\] rad/s\^3, got -1$"),
         (lambda d: d["arms"]["pour_arm"].pop("joint_names"), r"arms\.pour_arm: missing key\(s\) joint_names$"),
+        (lambda d: d["arms"]["pour_arm"]["joint_names"].pop(), r"arms\.pour_arm\.joint_names: must be a non-empty list of 6 unique names$"),
     ],
 )
 def test_corrupt_json_is_rejected_in_one_line(exported, tmp_path, edit, message):

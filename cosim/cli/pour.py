@@ -1,8 +1,10 @@
 """``cosim pour [SCENE.toml]``: simulate a complete robot pour and write its outputs.
 
 Without a scene file the embedded default scene runs (``cosim scene --dump`` prints it). Outputs go to a new run
-folder under ``recordings/`` (or ``--out DIR``): pour.rrd (Rerun; ``cosim view RUN`` opens it), trajectory.csv and
-trajectory.json (jerk-limited joint trajectories for the real arms), summary.json.
+folder under ``recordings/`` named after the scene file (``cosim pour my_cell.toml``: recordings/<UTC time>-my_cell,
+unless the scene sets ``name``; the default scene: <UTC time>-seed-pour) or to ``--out DIR``: pour.rrd (Rerun;
+``cosim view RUN`` opens it), trajectory.csv, trajectory.json and trajectory.mcap (jerk-limited joint trajectories for
+the real arms; the MCAP for ROS 2, docs/ros2.md), summary.json.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ def register(subparsers) -> None:
 
 
 def scene_from_args(args) -> PourScene:
-    scene = load_scene(args.scene) if args.scene is not None else PourScene()
+    scene = load_scene(args.scene).named_after(args.scene) if args.scene is not None else PourScene()
     if args.device is not None:
         scene = replace(scene, device=check_device("--device", args.device))
     if args.threads is not None:
@@ -55,10 +57,14 @@ def run(args) -> int:
     ml = 1e6
     print(f"wrote {folder}: {', '.join(summary['outputs'])}")
     print(
-        f"poured {summary['poured_volume'] * ml:.0f} of {initial * ml:.0f} mL; caught {summary['caught_volume'] * ml:.0f} mL, "
-        f"spilled {summary['spilled_volume'] * ml:.0f} mL ({100 * summary['spilled_fraction_of_poured']:.1f} % of poured); "
+        f"poured {summary['poured_volume'] * ml:.0f} of {initial * ml:.0f} mL, {summary['volume_left_in_pourer'] * ml:.0f} mL "
+        f"left in the pourer; caught {summary['caught_volume'] * ml:.0f} mL, spilled {summary['spilled_volume'] * ml:.0f} mL "
+        f"({100 * summary['spilled_fraction_of_poured']:.1f} % of poured); "
         f"{'pour done' if summary['pour_done'] else 'pour NOT finished within the duration'}"
     )
+    if summary["target_volume"] is not None:
+        print(f"partial pour: target {summary['target_volume'] * ml:.1f} mL, poured {summary['target_error'] * ml:+.1f} mL "
+              f"({100 * summary['target_relative_error']:+.1f} %) off it")
     phases = " -> ".join(f"{p['phase']} {p['start']:.2f}-{p['end']:.2f}s" for p in summary["phases"])
     print(f"phases: {phases}")
     threads = f" ({summary['fluid_threads']} thread{'s' if summary['fluid_threads'] > 1 else ''})" if summary["device"] == "cpu" else ""

@@ -1,9 +1,12 @@
-"""``cosim replay TRAJECTORY.csv [--json] [--model SCENE] [--payload full|empty] [--feedforward ...]``.
+"""``cosim replay TRAJECTORY.csv [--json] [--tolerance-mm MM] [--model SCENE] [--payload full|empty] [--feedforward ...]``.
 
 Plays a joint trajectory (DESIGN.md CSV format) through the arms' position servos in MuJoCo without liquid (the
-liquid as a rigid payload, full by default) and reports per-joint tracking error and the pour-lip path error
-(:mod:`cosim.robots.replay`). ``--json`` prints a JSON object with ``max_error_m`` (largest pour-lip position
-error, m) and ``joint_max_error_rad`` (per-joint maxima). A bad trajectory file or scene prints one line and exits 2.
+liquid as a rigid payload, full by default) and reports per-joint tracking error and the vessel lips' path errors
+(:mod:`cosim.robots.replay`), then a verdict: PASS when every vessel lip stays within ``--tolerance-mm`` (default
+2 mm) of its commanded path and nothing collides, else FAIL with the reasons. The exit status says it, so that a
+script or CI job can gate on it: 0 pass, 1 fail, 2 bad input (a bad trajectory file, scene or option: one line).
+``--json`` prints a JSON object with ``verdict`` ("pass" or "fail"), ``tolerance_m``, ``failures`` (the reasons),
+``max_error_m`` (largest pour-lip position error, m), ``joint_max_error_rad`` (per-joint maxima) and the rest.
 """
 
 from __future__ import annotations
@@ -12,21 +15,30 @@ import argparse
 import json
 import math
 
+from cosim.checks import check_positive
 from cosim.io.trajectory_csv import read_trajectory_csv
 from cosim.robots.payload import PayloadMode
-from cosim.robots.replay import Feedforward, ReplayReport, replay
+from cosim.robots.replay import DEFAULT_TOLERANCE_M, Feedforward, ReplayReport, replay
 from cosim.robots.scene import RobotScene
+
+MAX_TOLERANCE_MM = 1000.0
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "replay",
-        help="play a joint trajectory CSV in MuJoCo (no liquid) and report tracking error",
+        help="play a joint trajectory CSV in MuJoCo (no liquid): tracking error and a pass/fail verdict",
         description="Play a joint trajectory CSV through the arms' position servos in MuJoCo without liquid (the "
-        "liquid as a rigid payload) and report per-joint tracking error and the pour-lip path error.",
+        "liquid as a rigid payload), report per-joint tracking error and the vessel lips' path errors, and end with "
+        "PASS (every lip within the tolerance of its commanded path, no contact) or FAIL. Exit status: 0 pass, "
+        "1 fail, 2 bad input.",
     )
     parser.add_argument("trajectory", help="trajectory CSV: time, <arm>/<joint>.pos/.vel/.acc columns")
-    parser.add_argument("--json", action="store_true", help="print the results as JSON")
+    parser.add_argument("--json", action="store_true", help="print the results as JSON (with verdict and tolerance_m)")
+    parser.add_argument(
+        "--tolerance-mm", type=float, default=DEFAULT_TOLERANCE_M * 1000.0,
+        help=f"largest lip path error that passes, mm, in (0, {MAX_TOLERANCE_MM:g}] (default {DEFAULT_TOLERANCE_M * 1000:g})",
+    )
     parser.add_argument("--model", default=None, help="scene MJCF written by cosim.robots (default: the project's scene)")
     parser.add_argument(
         "--payload", choices=[m.value for m in PayloadMode], default=PayloadMode.FULL.value,
@@ -57,12 +69,19 @@ def _print_table(report: ReplayReport) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    tolerance = check_positive("--tolerance-mm", args.tolerance_mm, "mm", MAX_TOLERANCE_MM) / 1000.0
     scene = RobotScene.load(args.model, PayloadMode(args.payload))
     joints = [name for arm in scene.arms.values() for name in arm.joints]
     trajectory = read_trajectory_csv(args.trajectory, known_joints=joints)
     report = replay(scene, trajectory, Feedforward(args.feedforward))
+    failures = report.failures(tolerance)
     if args.json:
-        print(json.dumps(report.to_json(), indent=2))
+        verdict = {"verdict": "fail" if failures else "pass", "tolerance_m": tolerance, "failures": failures}
+        print(json.dumps({**verdict, **report.to_json()}, indent=2))
     else:
         _print_table(report)
-    return 0
+        if failures:
+            print(f"FAIL: {'; '.join(failures)}")
+        else:
+            print(f"PASS: every vessel lip within {tolerance * 1000:.3f} mm of its commanded path, no contact")
+    return 1 if failures else 0

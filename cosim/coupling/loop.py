@@ -219,14 +219,23 @@ class CoupledPour:
     def summary(self) -> dict:
         """Volumes (m^3), phases (name, start s, end s), times (s) of the run so far; ``energy_created``: the most
         energy the SPH numerics had created at any time, over M g L (``cosim.fluid.energy``; the run stops with an
-        instability past ``fluid.max_energy_creation``)."""
+        instability past ``fluid.max_energy_creation``).
+
+        A partial pour (the controller's ``target_volume`` set) reports its ``target_volume`` (m^3) and how far the
+        poured volume missed it: ``target_error`` = poured - target (m^3, > 0: poured too much) and
+        ``target_relative_error`` = target_error / target; all three are None for a pour until empty."""
         last = self.fluid.last_report.last
         initial = self.geometry.initial_volume
         in_pourer, in_catcher = last.volume_in_vessel
         poured = initial - in_pourer
         spilled = max(initial - in_pourer - in_catcher, 0.0)  # volumes are particle counts x volume: -1e-19 is 0
+        target = self.controller.config.target_volume
         return {
             "initial_volume": initial,
+            "volume_left_in_pourer": in_pourer,
+            "target_volume": target,
+            "target_error": None if target is None else poured - target,
+            "target_relative_error": None if target is None else (poured - target) / target,
             "poured_volume": poured,
             "caught_volume": in_catcher,
             "spilled_volume": spilled,

@@ -2,11 +2,12 @@
 
 Layout (one object; numbers in SI units, listed in ``units``)::
 
-    {"format": "cosim.joint_trajectory.v1",
+    {"format": "cosim.joint_trajectory.v2",
      "units": {"time": "s", "position": "rad", "velocity": "rad/s", "acceleration": "rad/s^2", "jerk": "rad/s^3"},
      "sample_rate_hz": 500.0,
      "arms": {"pour_arm": {"arm_model": "UR10e",
-                           "joint_names": ["pour_arm/shoulder_pan", ...],
+                           "joint_names": ["pour_arm_shoulder_pan_joint", ...],
+                           "scene_joint_names": ["pour_arm/shoulder_pan", ...],
                            "limits": {"max_velocity": [...], "max_acceleration": [...], "max_jerk": [...],
                                       "min_position": [...], "max_position": [...]},
                            "points": [{"positions": [...], "velocities": [...], "accelerations": [...],
@@ -14,11 +15,12 @@ Layout (one object; numbers in SI units, listed in ``units``)::
               "catch_arm": {...}}}
 
 Per arm this is a ROS ``trajectory_msgs/JointTrajectory`` (``joint_names``, ``points`` of
-``JointTrajectoryPoint``) plus the arm model and the limits the trajectory was generated under, per joint in
-``joint_names`` order. Joint names are the scene's full names, the CSV's column stems. ``time_from_start`` is the
-sample time rounded to the nearest nanosecond (ROS ``builtin_interfaces/Duration``); every arm has the same points'
-times. Numbers are written with Python's shortest round-trip repr: positions, velocities and accelerations read back
-exactly, equal to the CSV of the same run (:mod:`cosim.io.trajectory_csv`).
+``JointTrajectoryPoint``, :mod:`cosim.io.joint_trajectory_msg`) plus the arm model, the scene's names of the same
+joints (the CSV's column stems) and the limits the trajectory was generated under, per joint in ``joint_names``
+order. ``joint_names`` are the names the arm's ROS 2 driver uses, with the scene's prefix
+(:mod:`cosim.trajectory.driver_names`). Every arm has the same points' times. Numbers are written with Python's
+shortest round-trip repr: positions, velocities and accelerations read back exactly, equal to the CSV of the same run
+(:mod:`cosim.io.trajectory_csv`).
 
 Writing is atomic (:mod:`cosim.atomic_files`). Reading validates everything and raises :class:`InputError` with one
 line naming the file, the field (e.g. ``arms.pour_arm.points[3].positions``) and the problem.
@@ -28,7 +30,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -36,53 +38,45 @@ import numpy as np
 
 from cosim.atomic_files import atomic_path
 from cosim.errors import InputError
+from cosim.io.joint_trajectory_msg import NANOSECONDS, POINT_FIELDS, arm_columns, check_driver_names, points
 from cosim.io.trajectory_csv import JointTrajectory
 from cosim.trajectory.limits import LIMIT_FIELDS, ArmLimits, JointLimits
 
-FORMAT = "cosim.joint_trajectory.v1"
+FORMAT = "cosim.joint_trajectory.v2"
 UNITS = {"time": "s", "position": "rad", "velocity": "rad/s", "acceleration": "rad/s^2", "jerk": "rad/s^3"}
-NANOSECONDS = 1_000_000_000
-POINT_FIELDS = ("positions", "velocities", "accelerations")  # JointTrajectoryPoint fields, JointTrajectory arrays order
 
 
 @dataclass(frozen=True)
 class TrajectoryDocument:
-    """A trajectory file's content: the samples of all arms (columns in file order), the sample rate (Hz) and each
-    arm's limits (with its arm model)."""
+    """A trajectory file's content: the samples of all arms (columns in file order, the scene's joint names), the
+    sample rate (Hz), each arm's limits (with its arm model) and each arm's joints as its ROS 2 driver names them
+    (arm name -> names, in the limits' joint order)."""
 
     trajectory: JointTrajectory
     sample_rate_hz: float
     limits: tuple[ArmLimits, ...]
+    driver_joint_names: dict[str, tuple[str, ...]]
 
 
-def _duration(t: float) -> dict[str, int]:
-    ns = round(t * NANOSECONDS)
-    return {"sec": ns // NANOSECONDS, "nanosec": ns % NANOSECONDS}
-
-
-def trajectory_json_text(trajectory: JointTrajectory, limits: Sequence[ArmLimits], sample_rate_hz: float) -> str:
-    """The JSON text of ``trajectory`` with the ``limits`` of its arms (their joints, in order, must be its columns)."""
+def trajectory_json_text(
+    trajectory: JointTrajectory, limits: Sequence[ArmLimits], sample_rate_hz: float, driver_names: Mapping[str, Sequence[str]]
+) -> str:
+    """The JSON text of ``trajectory`` with the ``limits`` of its arms (their joints, in order, must be its columns)
+    and their joints' ``driver_names`` (arm name -> names, in the limits' order)."""
     names = tuple(n for arm in limits for n in arm.joint_names)
     if names != trajectory.joint_names:
         raise ValueError(f"trajectory JSON: the limits' joints {names} are not the trajectory's {trajectory.joint_names}")
-    if trajectory.time[0] < 0.0:
-        raise ValueError("trajectory JSON: time_from_start cannot be negative")
-    stamps = [_duration(float(t)) for t in trajectory.time]
-    arms = {}
-    start = 0
-    for arm in limits:
-        cols = slice(start, start + len(arm.joints))
-        start = cols.stop
-        blocks = [trajectory.positions[:, cols], trajectory.velocities[:, cols], trajectory.accelerations[:, cols]]
-        arms[arm.arm] = {
+    check_driver_names(limits, driver_names)
+    arms = {
+        arm.arm: {
             "arm_model": arm.arm_model,
-            "joint_names": list(arm.joint_names),
+            "joint_names": list(driver_names[arm.arm]),
+            "scene_joint_names": list(arm.joint_names),
             "limits": {field: [float(v) for v in arm.array(field)] for field in LIMIT_FIELDS},
-            "points": [
-                {**{f: [float(v) for v in b[i]] for f, b in zip(POINT_FIELDS, blocks)}, "time_from_start": stamps[i]}
-                for i in range(trajectory.time.size)
-            ],
+            "points": points(trajectory, cols),
         }
+        for arm, cols in arm_columns(limits)
+    }
     document = {"format": FORMAT, "units": UNITS, "sample_rate_hz": float(sample_rate_hz), "arms": arms}
     return json.dumps(document, separators=(",", ":"), allow_nan=False) + "\n"
 
@@ -92,13 +86,6 @@ def write_json_text(path: str | Path, text: str) -> None:
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
         tmp.chmod(0o644)
-
-
-def write_trajectory_json(
-    path: str | Path, trajectory: JointTrajectory, limits: Sequence[ArmLimits], sample_rate_hz: float
-) -> None:
-    """Write :func:`trajectory_json_text` to ``path`` atomically (parent directories are created)."""
-    write_json_text(path, trajectory_json_text(trajectory, limits, sample_rate_hz))
 
 
 def _numbers(source: str, field: str, value: object, n: int) -> list[float]:
@@ -127,14 +114,22 @@ def _time(source: str, field: str, value: object) -> float:
     return sec + nanosec / NANOSECONDS
 
 
-def _read_arm(source: str, name: str, value: object) -> tuple[ArmLimits, list[float], np.ndarray]:
-    """(limits, times (N,), samples (3, N, n)) of one arm."""
+def _names(source: str, field: str, value: object, n: int | None = None) -> tuple[str, ...]:
+    """A list of unique non-empty names (``n`` of them, where given)."""
+    count = "" if n is None else f" {n}"
+    ok = isinstance(value, list) and value and all(isinstance(j, str) and j for j in value) and len(set(value)) == len(value)
+    if not ok or (n is not None and len(value) != n):  # type: ignore[arg-type]
+        raise InputError(f"{source}: {field}: must be a non-empty list of{count} unique names")
+    return tuple(value)  # type: ignore[arg-type]
+
+
+def _read_arm(source: str, name: str, value: object) -> tuple[ArmLimits, tuple[str, ...], list[float], np.ndarray]:
+    """(limits, driver joint names, times (N,), samples (3, N, n)) of one arm."""
     p = f"arms.{name}"
-    arm = _object(source, p, value, ("arm_model", "joint_names", "limits", "points"))
-    joints = arm["joint_names"]
-    if not isinstance(joints, list) or not joints or not all(isinstance(j, str) for j in joints):
-        raise InputError(f"{source}: {p}.joint_names: must be a non-empty list of names")
+    arm = _object(source, p, value, ("arm_model", "joint_names", "scene_joint_names", "limits", "points"))
+    joints = _names(source, f"{p}.scene_joint_names", arm["scene_joint_names"])
     n = len(joints)
+    driver = _names(source, f"{p}.joint_names", arm["joint_names"], n)
     raw = _object(source, f"{p}.limits", arm["limits"], LIMIT_FIELDS)
     values = {f: _numbers(source, f"{p}.limits.{f}", raw[f], n) for f in LIMIT_FIELDS}
     try:
@@ -155,7 +150,7 @@ def _read_arm(source: str, name: str, value: object) -> tuple[ArmLimits, list[fl
         for k, f in enumerate(POINT_FIELDS):
             samples[k, i] = _numbers(source, f"{q}.{f}", point[f], n)
         times.append(_time(source, f"{q}.time_from_start", point["time_from_start"]))
-    return limits, times, samples
+    return limits, driver, times, samples
 
 
 def read_trajectory_json(path: str | Path) -> TrajectoryDocument:
@@ -179,9 +174,9 @@ def read_trajectory_json(path: str | Path) -> TrajectoryDocument:
     arms = document["arms"]
     if not isinstance(arms, dict) or not arms:
         raise InputError(f"{source}: arms: must be a non-empty object")
-    limits, blocks, times = [], [], None
+    limits, driver, blocks, times = [], {}, [], None
     for name, value in arms.items():
-        arm_limits, arm_times, samples = _read_arm(source, name, value)
+        arm_limits, driver[name], arm_times, samples = _read_arm(source, name, value)
         if times is not None and arm_times != times:
             raise InputError(f"{source}: arms.{name}.points: the times differ from the first arm's")
         times = arm_times
@@ -194,4 +189,4 @@ def read_trajectory_json(path: str | Path) -> TrajectoryDocument:
         )
     except InputError as exc:
         raise InputError(f"{source}: {exc}") from None
-    return TrajectoryDocument(trajectory, float(rate), tuple(limits))
+    return TrajectoryDocument(trajectory, float(rate), tuple(limits), driver)

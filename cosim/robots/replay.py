@@ -13,6 +13,9 @@ Errors, sampled at every step (world frame, SI units):
 * contacts: any contact in the simulation is a collision (the scene excludes the vessel mounts), the first is kept;
 * peak actuator torque as a fraction of each joint's torque limit (1.0 = saturated).
 
+Verdict (:meth:`ReplayReport.failures`): the replay passes a tolerance (m) when every vessel's lip stays within it
+of its commanded path (largest lip path error) and nothing collides; :data:`DEFAULT_TOLERANCE_M` is 2 mm.
+
 Feedforward (:class:`Feedforward`): gravity compensation is part of the model (the servos always get it, computed
 from the model including the rigid payload, as a UR controller does from its configured payload). ``DYNAMICS`` adds
 the inverse-dynamics torque ``M(q_d) qdd_d + c(q_d, qd_d)`` of the commanded motion
@@ -33,6 +36,11 @@ from cosim.io.trajectory_csv import JointTrajectory
 from cosim.robots.interpolation import QuinticInterpolator
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+
+
+# m: the default tolerance of the lips' path error. A pour lip 2 mm off its path moves the stream's landing point by
+# about as much, small against the catcher's opening (0.26 m in the default scene).
+DEFAULT_TOLERANCE_M = 0.002
 
 
 class Feedforward(Enum):
@@ -81,6 +89,19 @@ class ReplayReport:
     def max_error_m(self) -> float:
         """Largest pour-lip position error, m."""
         return self.lip_max_error[self.pour_vessel]
+
+    def failures(self, tolerance: float) -> list[str]:
+        """Why the replay fails at ``tolerance`` (m): one line per vessel lip whose largest path error exceeds it and
+        one for a contact; empty when it passes."""
+        lines = [
+            f"{vessel} lip path error {error * 1000:.3f} mm above {tolerance * 1000:.3f} mm"
+            for vessel, error in self.lip_max_error.items()
+            if error > tolerance
+        ]
+        if self.first_contact is not None:
+            c = self.first_contact
+            lines.append(f"contact at t={c.time:.3f} s: {c.geom1} ({c.body1}) - {c.geom2} ({c.body2})")
+        return lines
 
     def to_json(self) -> dict:
         """JSON-ready dict: ``max_error_m`` (largest pour-lip error, m), per-joint maxima (rad), the rest."""

@@ -5,8 +5,9 @@ Vessel body frame == VesselSpec local frame (origin at the centre of the inner f
 ``data.xfrc_applied`` of a vessel body is a world-frame wrench at the body's centre of mass (``data.xipos``).
 
 A scene file written by :mod:`cosim.robots.scene_builder` records its mapping in custom fields
-(``cosim/<role>/joints``, ``.../vessel``, ``.../flange_link``, ``.../max_joint_speed``) and has a ``home`` keyframe, so
-:class:`RobotScene` loads the default scene and any user scene the builder wrote the same way.
+(``cosim/<role>/joints``, ``.../driver_joints``, ``.../vessel``, ``.../flange_link``, ``.../max_joint_speed``) and has a
+``home`` keyframe, so :class:`RobotScene` loads the default scene and any user scene the builder wrote the same way (a
+scene without ``driver_joints`` exports the arm's MJCF joint names).
 
 Servo law. Each arm joint has a position servo ``tau = kp (u - q) - kv qdot`` (MuJoCo ``position`` actuator), plus
 the model's gravity compensation routed through the actuators (body ``gravcomp``, joint ``actuatorgravcomp``), the
@@ -63,6 +64,7 @@ class ArmInfo:
 
     role: ArmRole
     joints: tuple[str, ...]  # full joint names, e.g. "pour_arm/shoulder_pan"
+    driver_joints: tuple[str, ...]  # the same joints as the arm's ROS 2 driver names them, e.g. "shoulder_pan_joint"
     qpos_adr: np.ndarray
     dof_adr: np.ndarray
     ctrl_adr: np.ndarray
@@ -139,6 +141,12 @@ def _servo(model: mujoco.MjModel, joint_id: int, joint: str, source: str) -> tup
 def _arm_info(model: mujoco.MjModel, home: mujoco.MjData, role: ArmRole, source: str) -> ArmInfo:
     base = f"{CUSTOM_PREFIX}/{role.value}"
     joints = tuple(_text(model, f"{base}/joints", source).split())
+    has_driver_names = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, f"{base}/driver_joints") >= 0
+    prefix = f"{role.value}/"
+    driver_joints = (tuple(_text(model, f"{base}/driver_joints", source).split()) if has_driver_names
+                     else tuple(j.removeprefix(prefix) for j in joints))
+    if len(driver_joints) != len(joints):
+        raise InputError(f"{source}: {base}/driver_joints names {len(driver_joints)} joints, the arm has {len(joints)}")
     vessel = _parse_vessel(_text(model, f"{base}/vessel", source), source)
     qpos_adr, dof_adr, ctrl_adr, kp, kv = [], [], [], [], []
     for joint in joints:
@@ -164,6 +172,7 @@ def _arm_info(model: mujoco.MjModel, home: mujoco.MjData, role: ArmRole, source:
     return ArmInfo(
         role=role,
         joints=joints,
+        driver_joints=driver_joints,
         qpos_adr=qpos_adr_arr,
         dof_adr=np.array(dof_adr),
         ctrl_adr=np.array(ctrl_adr),

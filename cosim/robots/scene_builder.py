@@ -8,8 +8,9 @@ What it builds (world z up, SI units):
 * on each arm's attachment site a mount body ``<role>/mount`` (an aluminium adapter plate along the flange axis) and
   the vessel body (:func:`cosim.robots.vessel_mjcf.add_vessel_body`) with the held wall against the plate at half
   the wall height; vessel contacts with the flange link are excluded (the vessel's own gripper/mount);
-* custom ``text``/``numeric`` fields ``cosim/...`` recording the mapping (arm joints, vessel, vessel geometry, joint
-  speed limits), so :class:`cosim.robots.scene.RobotScene` can load any scene file this module wrote;
+* custom ``text``/``numeric`` fields ``cosim/...`` recording the mapping (arm joints, the names the arms' ROS 2
+  drivers give them, vessel, vessel geometry, joint speed limits), so :class:`cosim.robots.scene.RobotScene` can load
+  any scene file this module wrote;
 * a ``home`` keyframe: each arm's posture that puts its vessel frame at ``vessel_home`` aligned with the world axes,
   solved by inverse kinematics from ``home_seed``; servo targets equal to that posture.
 """
@@ -176,6 +177,7 @@ def _add_mapping(scene: mujoco.MjSpec, placement: ArmPlacement, flange_link: str
     role = placement.role.value
     joints = " ".join(f"{role}/{j}" for j in placement.arm.joints)
     scene.add_text(name=f"{CUSTOM_PREFIX}/{role}/joints", data=joints)
+    scene.add_text(name=f"{CUSTOM_PREFIX}/{role}/driver_joints", data=" ".join(placement.arm.exported_joints))
     scene.add_text(name=f"{CUSTOM_PREFIX}/{role}/vessel", data=_vessel_record(placement.vessel))
     scene.add_text(name=f"{CUSTOM_PREFIX}/{role}/flange_link", data=flange_link)
     scene.add_numeric(

@@ -18,7 +18,7 @@ from enum import Enum
 
 from cosim.checks import check_choice, check_number, check_positive, check_vector
 from cosim.errors import InputError
-from cosim.robots.ur10e import UR10E_JOINTS, UR10E_MAX_JOINT_SPEED
+from cosim.robots.ur10e import UR10E_DRIVER_JOINTS, UR10E_JOINTS, UR10E_MAX_JOINT_SPEED
 from cosim.vessel import VesselSpec, default_catching_vessel, seed_pouring_vessel
 
 
@@ -46,12 +46,15 @@ class ArmModel:
     attachment_site: a site on the last link whose z axis points out of the tool flange; the vessel mount is built
         on it.
     max_joint_speed: rad/s per joint (n,), for trajectory generation (MuJoCo models have no speed limits).
+    driver_joints: the same joints as the arm's ROS 2 driver names them (n, without its tf prefix), for the exported
+        trajectories; empty: the MJCF's names.
     """
 
     mjcf: str
     joints: tuple[str, ...]
     attachment_site: str
     max_joint_speed: tuple[float, ...]
+    driver_joints: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.mjcf, str) or not self.mjcf:
@@ -67,11 +70,23 @@ class ArmModel:
             check_positive(f"arm.max_joint_speed[{i}]", v, "rad/s", 50.0)
         object.__setattr__(self, "joints", tuple(self.joints))
         object.__setattr__(self, "max_joint_speed", speeds)
+        driver = tuple(self.driver_joints)
+        named = all(isinstance(j, str) and j and not any(c.isspace() for c in j) for j in driver)
+        if driver and (not named or len(driver) != len(self.joints) or len(set(driver)) != len(driver)):
+            raise InputError(
+                f"arm.driver_joints: must name the arm's {len(self.joints)} joints once each, without spaces, got {list(driver)}"
+            )
+        object.__setattr__(self, "driver_joints", driver)
+
+    @property
+    def exported_joints(self) -> tuple[str, ...]:
+        """The joint names the exported trajectories use (before the prefix): :attr:`driver_joints`, else the MJCF's."""
+        return self.driver_joints or self.joints
 
 
 def ur10e_arm() -> ArmModel:
     """The project's UR10e-class arm (``models/ur10e/ur10e.xml``)."""
-    return ArmModel("ur10e/ur10e.xml", UR10E_JOINTS, "flange", UR10E_MAX_JOINT_SPEED)
+    return ArmModel("ur10e/ur10e.xml", UR10E_JOINTS, "flange", UR10E_MAX_JOINT_SPEED, UR10E_DRIVER_JOINTS)
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,8 @@ Sources (Universal Robots):
   alpha = (pi/2, 0, 0, pi/2, -pi/2, 0), theta offsets 0.
 * UR10e data sheet / user manual: payload 12.5 kg, reach 1300 mm, working range +-360 deg on all joints, maximum
   joint speed 120 deg/s (base, shoulder) and 180 deg/s (elbow, wrist 1-3).
+* Universal Robots' ROS 2 description (UniversalRobots/Universal_Robots_ROS2_Description, ``urdf/ur_macro.xacro``):
+  the joint names the ROS 2 driver and its controllers use, ``<tf_prefix>shoulder_pan_joint`` and so on.
 
 ``models/ur10e/ur10e.xml`` is written from these numbers; ``tests/test_robot_kinematics.py`` checks that its forward
 kinematics equals :func:`dh_forward_kinematics` (no MuJoCo here: numpy only).
@@ -19,6 +21,10 @@ import numpy as np
 
 # UR joint names, base to flange, as used in models/ur10e/ur10e.xml (joints and actuators).
 UR10E_JOINTS: tuple[str, ...] = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
+# The same joints as Universal Robots' ROS 2 driver names them (without its tf_prefix), base to flange.
+UR10E_DRIVER_JOINTS: tuple[str, ...] = (
+    "shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint", "wrist_1_joint", "wrist_2_joint", "wrist_3_joint",
+)
 
 # Standard DH parameters (m, rad), UR10e rows of Universal Robots' DH table.
 UR10E_DH_D: tuple[float, ...] = (0.1807, 0.0, 0.0, 0.17415, 0.11985, 0.11655)

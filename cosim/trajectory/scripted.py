@@ -9,7 +9,7 @@ both arms to rest on the last target, samples at ``sample_rate_hz`` and checks t
 Target ``k`` is sent at ``k * target_period`` as the path's state at that time, like a live target; the generator
 extrapolates it one period ahead, so the trajectory follows the script without lag.
 
-``python -m cosim.trajectory.scripted --out DIR`` writes ``DIR/trajectory.csv`` and ``DIR/trajectory.json`` of a
+``python -m cosim.trajectory.scripted --out DIR`` writes ``DIR/trajectory.csv``, ``.json`` and ``.mcap`` of a
 smooth 10 s pour (:mod:`cosim.robots.pour_motion`: tilt about the lip and back, the catcher moving along x) and prints
 the lips' deviation from the scripted path; ``cosim replay DIR/trajectory.csv`` then measures how the servos track it.
 """
@@ -34,6 +34,7 @@ from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
 from cosim.trajectory.deviation import path_deviation
+from cosim.trajectory.driver_names import JointPrefix, driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
 from cosim.trajectory.limits import ArmLimits, scene_limits
@@ -153,8 +154,8 @@ def pour_path(scene: RobotScene, spec: PourMotionSpec) -> dict[ArmRole, Callable
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description="Write the checked trajectory CSV and JSON of a scripted pour.")
-    parser.add_argument("--out", required=True, help="folder for trajectory.csv and trajectory.json")
+    parser = argparse.ArgumentParser(description="Write the checked trajectory CSV, JSON and MCAP of a scripted pour.")
+    parser.add_argument("--out", required=True, help="folder for trajectory.csv, trajectory.json and trajectory.mcap")
     parser.add_argument("--duration", type=float, default=10.0, help="s (default 10)")
     parser.add_argument("--tilt-deg", type=float, default=100.0, help="peak tilt about the lip, deg (default 100)")
     parser.add_argument("--catcher-dx", type=float, default=0.15, help="catcher travel at peak, m (default 0.15)")
@@ -165,11 +166,14 @@ def main(argv: list[str] | None = None) -> int:
         spec = PourMotionSpec(args.duration, math.radians(args.tilt_deg), Pivot.LIP, args.catcher_dx)
         run = generate_scripted(scene, pour_poses(scene, spec), sample_rate_hz=args.sample_rate)
         out = Path(args.out)
-        write_trajectory_files(run.trajectory, run.limits, run.sample_rate_hz, out / "trajectory.csv", out / "trajectory.json")
+        write_trajectory_files(
+            run.trajectory, run.limits, run.sample_rate_hz, driver_joint_names(scene, JointPrefix()),
+            out / "trajectory.csv", out / "trajectory.json", out / "trajectory.mcap",
+        )
     except (InputError, SimulationError) as exc:
         print(f"scripted: error: {exc}", file=sys.stderr)
         return 2
-    print(f"wrote {out}/trajectory.csv and trajectory.json: {run.trajectory.time.size} samples, {run.trajectory.duration:.3f} s")
+    print(f"wrote {out}/trajectory.csv, .json and .mcap: {run.trajectory.time.size} samples, {run.trajectory.duration:.3f} s")
     paths = pour_path(scene, spec)
     for role in ArmRole:
         deviation = path_deviation(scene, role, run.trajectory, paths[role])
