@@ -108,7 +108,7 @@ class CoupledPour:
     ):
         self.scene, self.fluid, self.controller = scene, fluid, controller
         dt = float(scene.model.opt.timestep)
-        gen_settings = GeneratorSettings(cycle_time=dt, control_period=controller.dt)
+        gen_settings = GeneratorSettings(cycle_time=dt, control_period=controller.dt, stop_beyond_velocity_limit=True)
         self.generators = {r: TrajectoryGenerator(limits[r], scene.joint_positions(r), gen_settings) for r in ROLES}
         self.recorder = TrajectoryRecorder([self.generators[r] for r in ROLES], sample_rate_hz)
         self.filters = {
