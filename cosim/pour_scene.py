@@ -188,7 +188,8 @@ class ControllerSettings:
 class TrajectorySettings:
     """sample_rate_hz: Hz, rate of the exported joint trajectories. (0, 10000]
     limits: per-joint overrides of the arms' limits, keyed '<arm>/<joint>' (e.g. 'pour_arm/elbow'), each with
-      max_velocity (rad/s), max_acceleration (rad/s^2), max_jerk (rad/s^3), min_position, max_position (rad).
+      max_velocity (rad/s), max_acceleration (rad/s^2), max_jerk (rad/s^3), min_position, max_position (rad),
+      rated_torque (N m).
     """
 
     sample_rate_hz: float = 500.0
