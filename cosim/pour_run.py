@@ -2,10 +2,12 @@
 
 Outputs, in a new run folder (``recordings/<UTC time>-<scene name>/``, never an earlier run's) or ``--out DIR``:
 ``pour.rrd`` (Rerun recording, unless logging is off), ``trajectory.csv``, ``trajectory.json`` and ``trajectory.mcap``
-(the arms' checked jerk-limited joint trajectories; the MCAP as ROS 2 ``JointTrajectory`` messages,
-:mod:`cosim.io.trajectory_mcap`), ``series.csv`` (per-control-step signals, :mod:`cosim.io.pour_series`),
-``summary.json`` (volumes, the volume left in the pourer and a partial pour's error first, phases, timings,
-versions, the scene). Everything is
+(the arms' checked jerk-limited joint trajectories, the MCAP as ROS 2 ``JointTrajectory`` messages,
+:mod:`cosim.io.trajectory_mcap`; the torques their inverse dynamics needs with the liquid's measured wrench are
+checked against the joints' rated torques too), ``series.csv`` (per-control-step signals,
+:mod:`cosim.io.pour_series`), ``summary.json`` (volumes, the volume left in the pourer and a partial pour's error
+first, phases, timings, the arms' load: vessel deviation caused by the liquid, peak servo and required torques against
+the rated ones; versions, the scene). Everything is
 written into a hidden temporary folder next to the destination and renamed into place only when the run
 succeeded, so a failed or interrupted run leaves no half-written folder behind.
 """
@@ -39,9 +41,11 @@ from cosim.pour_scene import PourScene
 from cosim.reproducibility import blas_description
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.checks import check_torques
 from cosim.trajectory.driver_names import driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.limits import scene_limits
+from cosim.trajectory.torques import required_torques
 
 if TYPE_CHECKING:
     from cosim.io.recording import PourRecorder
@@ -202,6 +206,16 @@ def package_versions() -> dict[str, str]:
     return out
 
 
+def _add_torque_report(arm_load: dict, joint_names, torques: np.ndarray, limits) -> None:
+    """Per arm of ``arm_load`` (the pour summary's), each joint's peak required torque (N m) and rated torque."""
+    rated = {j.name: j.rated_torque for arm in limits for j in arm.joints}
+    peaks = dict(zip(joint_names, np.abs(torques).max(axis=0).tolist()))
+    for arm, record in arm_load.items():
+        names = [n for n in joint_names if n.startswith(f"{arm}/")]
+        record["peak_required_torque"] = {n: peaks[n] for n in names}
+        record["rated_torque"] = {n: rated[n] for n in names}
+
+
 def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -> tuple[Path, dict]:
     """Run ``scene`` and write its outputs; returns (run folder, summary)."""
     if scene.logging.enabled and find_spec("rerun") is None:
@@ -252,6 +266,9 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
             recorder.close()
         write_series_csv(pour.log.rows, work / "series.csv")
         trajectory = pour.recorder.trajectory()
+        torques = required_torques(pour.scene, trajectory, pour.sample_wrenches(trajectory.time))
+        check_torques(trajectory, torques, pour.recorder.limits)
+        _add_torque_report(summary["arm_load"], trajectory.joint_names, torques, pour.recorder.limits)
         write_trajectory_files(
             trajectory, pour.recorder.limits, pour.recorder.sample_rate_hz,
             driver_joint_names(pour.scene, scene.trajectory.joint_prefix),

@@ -190,7 +190,8 @@ class ControllerSettings:
 class TrajectorySettings:
     """sample_rate_hz: Hz, rate of the exported joint trajectories. (0, 10000]
     limits: per-joint overrides of the arms' limits, keyed '<arm>/<joint>' (e.g. 'pour_arm/elbow'), each with
-      max_velocity (rad/s), max_acceleration (rad/s^2), max_jerk (rad/s^3), min_position, max_position (rad).
+      max_velocity (rad/s), max_acceleration (rad/s^2), max_jerk (rad/s^3), min_position, max_position (rad),
+      rated_torque (N m).
     joint_prefix: per arm, the prefix of its joint names in trajectory.json and trajectory.mcap (the names its ROS 2
       driver uses, e.g. 'shoulder_pan_joint'), as the driver's tf_prefix.
     """

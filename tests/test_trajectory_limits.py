@@ -10,7 +10,7 @@ import pytest
 from cosim.errors import InputError
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
-from cosim.robots.ur10e import UR10E_JOINT_RANGE, UR10E_MAX_JOINT_SPEED
+from cosim.robots.ur10e import UR10E_JOINT_RANGE, UR10E_MAX_JOINT_SPEED, UR10E_RATED_TORQUE
 from cosim.trajectory.generator import GeneratorSettings
 from cosim.trajectory.limits import (
     DEFAULT_MAX_ACCELERATION,
@@ -46,6 +46,7 @@ def test_defaults_come_from_the_data_sheet_and_the_model(scene):
         np.testing.assert_array_equal(arm.array("min_position"), ranges[:, 0])
         np.testing.assert_array_equal(arm.array("max_position"), ranges[:, 1])
         np.testing.assert_allclose(ranges, np.tile(UR10E_JOINT_RANGE, (len(ranges), 1)), rtol=SCENE_RTOL)
+        np.testing.assert_array_equal(arm.array("rated_torque"), UR10E_RATED_TORQUE)  # the model's actuator force ranges
 
 
 def test_overrides_replace_single_values_of_single_joints(scene):
@@ -78,6 +79,7 @@ def _joint(**kwargs) -> JointLimits:
     [
         ({"max_velocity": -1.0}, "limits.pour_arm/elbow.max_velocity: must be in (0, 50] rad/s, got -1"),
         ({"max_velocity": math.nan}, "limits.pour_arm/elbow.max_velocity: must be a finite number, got nan"),
+        ({"rated_torque": 0.0}, "limits.pour_arm/elbow.rated_torque: must be in (0, 100000] N m, got 0"),
         ({"max_acceleration": 0.0}, "limits.pour_arm/elbow.max_acceleration: must be in (0, 1000] rad/s^2, got 0"),
         ({"max_jerk": "fast"}, "limits.pour_arm/elbow.max_jerk: must be a number, got 'fast' (str)"),
         ({"max_jerk": 2e6}, "limits.pour_arm/elbow.max_jerk: must be in (0, 1e+06] rad/s^3, got 2e+06"),

@@ -4,13 +4,18 @@ Exchange order of one MuJoCo step n (t_n -> t_n+1 = t_n + dt, dt = the model's t
 
   1. every control period (10 ms): measure the liquid at t_n -> controller -> vessel targets -> IK -> the arms'
      trajectory generators get new joint targets;
-  2. each arm's generator advances one dt -> desired q, qd for the servos (plus, with two-way coupling and
-     feedforward, -J^T w of the liquid wrench measured over the previous interval);
+  2. each arm's generator advances one dt -> desired q, qd for the servos (plus, with two-way coupling, the
+     compensation of the liquid the arm's controller knows of: by default its payload setting, the liquid at the
+     start; :mod:`cosim.coupling.compensation`);
   3. two-way: the liquid's wrench on each vessel averaged over [t_n-1, t_n] goes into ``xfrc_applied``;
   4. ``mj_step``: the arms and vessels move to t_n+1;
   5. the vessel poses at t_n+1 go to the fluid, which moves the walls from their t_n poses to them at constant
      velocity over as many substeps as its CFL step needs; the wrench averaged over those substeps is kept for
      step n+1 (explicit staggered coupling).
+
+Alongside, :class:`cosim.coupling.arm_load.ArmLoadMonitor` steps a twin of the arms without the liquid to measure the
+vessel deviation the liquid causes and records the drives' peak torques, and the wrench of every step is kept for the
+inverse dynamics of the exported trajectory (:meth:`CoupledPour.sample_wrenches`).
 """
 
 from __future__ import annotations
@@ -28,12 +33,14 @@ from controllers.geometry import VesselGeometry
 from controllers.measurement import PourCommand
 from controllers.pour import PourController
 from controllers.catcher import fall_time
+from cosim.coupling.arm_load import ArmLoadMonitor
+from cosim.coupling.compensation import Payload, compensation_torque, liquid_payload
 from cosim.coupling.exchange import ROLES, vessel_poses, wrench_at_body_com
 from cosim.coupling.landing import landing_accuracy
 from cosim.coupling.outflow import outflow_timing
 from cosim.coupling.measure import LiquidProbe, MeasurementGeometry
 from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
-from cosim.coupling.settings import Coupling, CouplingSettings
+from cosim.coupling.settings import Compensation, Coupling, CouplingSettings
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
@@ -58,16 +65,19 @@ def coupled_step(
     wrench: np.ndarray,
     targets: dict[ArmRole, tuple[np.ndarray, np.ndarray | None]],
     settings: CouplingSettings,
+    payloads: dict[ArmRole, Payload] | None = None,
 ) -> np.ndarray:
     """Steps 2-5 of the exchange order above for one MuJoCo step: servo targets ``(q, qd)`` per arm (+ the
-    feedforward of ``wrench``, the liquid's (2, 6) wrench from the previous interval), the wrench into MuJoCo
-    (two-way), ``mj_step``, then the fluid over the same dt; returns the new averaged wrench (2, 6)."""
+    compensation ``settings.compensation`` of ``wrench``, the liquid's (2, 6) wrench from the previous interval, or of
+    the arms' ``payloads``), the wrench into MuJoCo (two-way), ``mj_step``, then the fluid over the same dt; returns
+    the new averaged wrench (2, 6)."""
     two_way = settings.coupling is Coupling.TWO_WAY
     poses = fluid.vessel_poses()
     for k, role in enumerate(ROLES):
         q, qd = targets[role]
         force, torque = wrench_at_body_com(scene, role, poses[k], wrench[k])
-        tau_ff = -scene.wrench_joint_torque(role, force, torque) if two_way and settings.wrench_feedforward else None
+        payload = payloads.get(role) if payloads else None
+        tau_ff = compensation_torque(scene, role, settings.compensation, force, torque, payload) if two_way else None
         scene.set_joint_targets(role, q, qd, tau_ff)
         if two_way:
             scene.apply_vessel_wrench(role, force, torque)
@@ -108,7 +118,7 @@ class CoupledPour:
     ):
         self.scene, self.fluid, self.controller = scene, fluid, controller
         dt = float(scene.model.opt.timestep)
-        gen_settings = GeneratorSettings(cycle_time=dt, control_period=controller.dt)
+        gen_settings = GeneratorSettings(cycle_time=dt, control_period=controller.dt, stop_beyond_velocity_limit=True)
         self.generators = {r: TrajectoryGenerator(limits[r], scene.joint_positions(r), gen_settings) for r in ROLES}
         self.recorder = TrajectoryRecorder([self.generators[r] for r in ROLES], sample_rate_hz)
         self.filters = {
@@ -129,6 +139,13 @@ class CoupledPour:
         self.log = PourLog()
         self.wall_time = 0.0
         self._seed = {role: scene.joint_positions(role) for role in ROLES}
+        self.payloads = {role: self._payload(role, volume) for role, volume in zip(ROLES, (geometry.initial_volume, 0.0))}
+        self.arm_load = ArmLoadMonitor(scene)
+        self.wrench_history: list[np.ndarray] = []  # (2, 6) the liquid's wrench acting during each MuJoCo step
+
+    def _payload(self, role: ArmRole, volume: float) -> Payload:
+        """The payload setting of ``role``'s arm for ``volume`` (m^3) of liquid in its vessel."""
+        return liquid_payload(self.scene.arms[role].vessel, volume, self.fluid.config.rest_density)
 
     # ---- one MuJoCo step -----------------------------------------------------------------------------------------
     def step(self) -> None:
@@ -141,7 +158,9 @@ class CoupledPour:
             q, qd, _ = self.generators[role].step()
             targets[role] = (q, qd)
         self.recorder.record()
-        self.wrench = coupled_step(scene, self.fluid, self.wrench, targets, self.settings)
+        self.wrench_history.append(self.wrench)
+        self.wrench = coupled_step(scene, self.fluid, self.wrench, targets, self.settings, self.payloads)
+        self.arm_load.step(targets)
         self.steps += 1
         self.time = self.steps * self.dt
         if self.command is not None and self.command.done and self.done_at is None:
@@ -153,6 +172,8 @@ class CoupledPour:
         poses = fluid.vessel_poses()
         last = fluid.last_report.last if fluid.last_report else None
         in_pourer = last.volume_in_vessel[0] if last else self.geometry.initial_volume
+        if last and self.settings.compensation is Compensation.UPDATED_PAYLOAD:
+            self.payloads = {role: self._payload(role, volume) for role, volume in zip(ROLES, last.volume_in_vessel)}
         state = fluid.state  # the device arrays as they are: the probe reads them where they live
         m = self.probe.measure(self.time, poses[0], poses[1], state.x, state.v, state.active, in_pourer)
         cmd = self.controller.step(m)
@@ -216,6 +237,14 @@ class CoupledPour:
             return outflow_timing([], [], [], 0.0)
         return outflow_timing(rows["t"], rows["poured_volume"], rows["phase"] == "cfs", self.controller.config.start_time)
 
+    def sample_wrenches(self, times: np.ndarray) -> dict[ArmRole, np.ndarray]:
+        """Per arm, (T, 6): the liquid's wrench (as :meth:`FluidSolver.vessel_wrenches`) acting on the vessel at each
+        of ``times`` (s, on the generators' clock): that of the MuJoCo step starting there (the last step's at the
+        end)."""
+        history = np.array(self.wrench_history)
+        index = np.clip(np.floor(np.asarray(times) / self.dt + 1e-6).astype(int), 0, len(history) - 1)
+        return {role: history[index, k] for k, role in enumerate(ROLES)}
+
     def summary(self) -> dict:
         """Volumes (m^3), phases (name, start s, end s), times (s) of the run so far; ``energy_created``: the most
         energy the SPH numerics had created at any time, over M g L (``cosim.fluid.energy``; the run stops with an
@@ -256,6 +285,15 @@ class CoupledPour:
             "sph_steps": self.fluid.step_count,
             "particles": self.fluid.n_particles,
             "energy_created": self.fluid.energy_account.peak_created,
+            "arm_load": {
+                role.value: {
+                    "compensation": self.settings.compensation.value if self.settings.coupling is Coupling.TWO_WAY else "one_way",
+                    "liquid_deviation_mm": 1e3 * self.arm_load.max_position[role],
+                    "liquid_deviation_deg": math.degrees(self.arm_load.max_rotation[role]),
+                    "peak_servo_torque": dict(zip(self.scene.arms[role].joints, self.arm_load.peak_torque[role].tolist())),
+                }
+                for role in ROLES
+            },
         }
 
 

@@ -272,13 +272,20 @@ class RobotScene:
     ) -> None:
         """Command the arm's servos to desired joint positions ``q`` (n,) rad and velocities ``qd`` (n,) rad/s, with an
         optional feedforward torque ``tau_ff`` (n,) N m (see the module docstring for the servo law)."""
+        self.data.ctrl[self.arms[role].ctrl_adr] = self.servo_controls(role, q, qd, tau_ff)
+
+    def servo_controls(
+        self, role: ArmRole, q: np.ndarray, qd: np.ndarray | None = None, tau_ff: np.ndarray | None = None
+    ) -> np.ndarray:
+        """The arm's servo controls (n,) ``u = q + (kv qd + tau_ff) / kp`` for :meth:`set_joint_targets`' arguments
+        (for an ``MjData`` of this model other than the live one)."""
         arm = self.arms[role]
         u = np.asarray(q, dtype=float).copy()
         if qd is not None:
             u += arm.kv * np.asarray(qd, dtype=float) / arm.kp
         if tau_ff is not None:
             u += np.asarray(tau_ff, dtype=float) / arm.kp
-        self.data.ctrl[arm.ctrl_adr] = u
+        return u
 
     def dynamics_feedforward(self, role: ArmRole, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
         """Inverse-dynamics feedforward torque (n,) N m for desired ``q``, ``qd``, ``qdd`` (n,) of the arm.

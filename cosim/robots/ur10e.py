@@ -8,6 +8,8 @@ Sources (Universal Robots):
   joint speed 120 deg/s (base, shoulder) and 180 deg/s (elbow, wrist 1-3).
 * Universal Robots' ROS 2 description (UniversalRobots/Universal_Robots_ROS2_Description, ``urdf/ur_macro.xacro``):
   the joint names the ROS 2 driver and its controllers use, ``<tf_prefix>shoulder_pan_joint`` and so on.
+* e-Series joint torques by joint size (Universal Robots' "max joint torques" support article): size 4 (UR10e base and
+  shoulder) 330 N m, size 3 (elbow) 150 N m, size 2 (wrists) 56 N m; the model's actuator force ranges.
 
 ``models/ur10e/ur10e.xml`` is written from these numbers; ``tests/test_robot_kinematics.py`` checks that its forward
 kinematics equals :func:`dh_forward_kinematics` (no MuJoCo here: numpy only).
@@ -35,6 +37,8 @@ UR10E_DH_ALPHA: tuple[float, ...] = (math.pi / 2, 0.0, 0.0, math.pi / 2, -math.p
 UR10E_JOINT_RANGE: tuple[float, float] = (-2.0 * math.pi, 2.0 * math.pi)
 # Data sheet: maximum joint speed, rad/s (120 deg/s base and shoulder, 180 deg/s elbow and wrists).
 UR10E_MAX_JOINT_SPEED: tuple[float, ...] = tuple(math.radians(v) for v in (120.0, 120.0, 180.0, 180.0, 180.0, 180.0))
+# Rated joint torque, N m (size 4, 4, 3, 2, 2, 2): the most each joint's drive may deliver.
+UR10E_RATED_TORQUE: tuple[float, ...] = (330.0, 330.0, 150.0, 56.0, 56.0, 56.0)
 # Data sheet: rated payload, kg.
 UR10E_PAYLOAD_KG = 12.5
 

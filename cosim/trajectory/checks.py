@@ -102,3 +102,15 @@ def check_trajectory(trajectory: JointTrajectory, limits: Sequence[ArmLimits]) -
         if bad is not None:
             i, j = bad
             raise _error(names[j], t[i], f"|{what}| {abs(values[i, j]):.6g} {unit} above {field} {limit[j]:.6g} {unit}")
+
+
+def check_torques(trajectory: JointTrajectory, torques: np.ndarray, limits: Sequence[ArmLimits]) -> None:
+    """Raise :class:`UnsafeTrajectoryError` (one line: arm, joint, time, torque, rating) unless every joint's
+    required torque ``torques`` (samples x joints, N m, :func:`cosim.trajectory.torques.required_torques`) stays
+    within its ``rated_torque`` (relative slack :data:`LIMIT_RTOL`)."""
+    rated = _joint_limits(trajectory, limits)["rated_torque"]
+    bad = _first(np.abs(torques) > rated * (1.0 + LIMIT_RTOL))
+    if bad is not None:
+        i, j = bad
+        name = trajectory.joint_names[j]
+        raise _error(name, trajectory.time[i], f"|required torque| {abs(torques[i, j]):.6g} N m above rated_torque {rated[j]:.6g} N m")

@@ -35,8 +35,20 @@ not take the vessel off its path; :attr:`TrajectoryGenerator.late_targets` and
 ruckig's profiles use the jerk limit or zero jerk in each phase, so the sampled jerk of a tracked path often sits at
 ``max_jerk`` in short pulses while the acceleration stays within about path jerk x ``T`` of the smooth path's.
 
-Everything the arm is sent is within the limits: ruckig enforces velocity, acceleration and jerk. ruckig's community
-build ignores position limits, so targets outside the joint range are clamped onto it (that joint then at rest) and
+Everything the arm is sent is within the limits, by construction. ruckig keeps velocity, acceleration and jerk
+within them between two admissible states, but it accepts a target state from which no jerk-limited motion can
+continue within them: at ``v`` with acceleration ``a`` (same sign), bringing ``a`` to zero at the jerk limit ``j``
+adds ``a |a| / (2 j)`` to the velocity. Arriving at ``v = max_velocity`` with ``a > 0`` (a path clipped to the limit
+while still accelerating), the next plan starts from a state that must overshoot by ``a^2 / (2 j)`` (1e-4 rad/s for
+0.15 rad/s^2 at 100 rad/s^3). So every target state is made admissible: ``|a| <= sqrt(2 j (max_velocity -+ v))``
+(:func:`_admissible_acceleration`), and the arm's state stays one from which the limits can be held.
+
+A path the arm cannot follow within its velocity limit (its velocity, given or estimated, above ``max_velocity``)
+is clipped to the limit and the arm falls behind; with :attr:`GeneratorSettings.stop_beyond_velocity_limit` (the
+arms' generators in a pour) :meth:`TrajectoryGenerator.set_target` raises :class:`UntrackablePathError` at the first
+such target instead, naming arm, joint, time and limit, so a run never continues on a path it cannot follow.
+
+ruckig's community build ignores position limits, so targets outside the joint range are clamped onto it (that joint then at rest) and
 counted in :attr:`clamped_targets`, and a joint whose time-optimal stop (plus one target interval of travel) would
 end beyond its range is sent to rest on the boundary, so the motion itself stays in range.
 
@@ -53,6 +65,7 @@ the exact motion at any time inside the last step, for sampling at rates other t
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,10 +89,13 @@ MAX_HORIZON = 0.3
 class GeneratorSettings:
     """cycle_time: s, the generator's step (the MuJoCo time step). (0, 0.1]
     control_period: s, expected interval between targets; used as the first target's minimum duration. [cycle_time, 1]
+    stop_beyond_velocity_limit: raise :class:`UntrackablePathError` when a target path moves a joint faster than its
+        ``max_velocity`` (an arm that must stay on its path); False: clip the path's velocity and catch up (a filter).
     """
 
     cycle_time: float = 0.002
     control_period: float = 0.01
+    stop_beyond_velocity_limit: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "cycle_time", check_positive("trajectory.cycle_time", self.cycle_time, "s", 0.1))
@@ -89,6 +105,22 @@ class GeneratorSettings:
                 f"trajectory.control_period: must be in [{self.cycle_time:g}, 1] s (at least the cycle time), got {period:g}"
             )
         object.__setattr__(self, "control_period", period)
+
+
+class UntrackablePathError(SimulationError):
+    """A target path needs a joint faster than its velocity limit; the message is one line naming arm, joint, time and
+    limit."""
+
+
+def _admissible_acceleration(v: float, a: float, vmax: float, jmax: float) -> float:
+    """The acceleration (rad/s^2) of a state at velocity ``v`` (rad/s, within +-``vmax``), reduced so that bringing it
+    to zero at the jerk limit ``jmax`` (rad/s^3), which changes the velocity by ``a |a| / (2 jmax)``, ends within
+    +-``vmax``: ``a`` unchanged when it does, else ``+-sqrt(2 jmax (vmax -+ v))``."""
+    if a > 0.0 and v + a * a / (2.0 * jmax) > vmax:
+        return math.sqrt(2.0 * jmax * (vmax - v))
+    if a < 0.0 and v - a * a / (2.0 * jmax) < -vmax:
+        return -math.sqrt(2.0 * jmax * (vmax + v))
+    return a
 
 
 def _quadratic_derivatives(times: list[float], points: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
@@ -138,6 +170,7 @@ class TrajectoryGenerator:
         self._lo, self._hi = limits.array("min_position"), limits.array("max_position")
         self._vmax, self._amax = limits.array("max_velocity"), limits.array("max_acceleration")
         self._lo_floats, self._hi_floats, self._vmax_floats = self._lo.tolist(), self._hi.tolist(), self._vmax.tolist()
+        self._jmax_floats = limits.array("max_jerk").tolist()
         q0 = _vector(f"{limits.arm}: start position", q0, n)
         outside = np.flatnonzero((q0 < self._lo) | (q0 > self._hi))
         if outside.size:
@@ -206,6 +239,8 @@ class TrajectoryGenerator:
         est_qd, est_qdd = _quadratic_derivatives(times, self._history_q)
         qd = est_qd if qd is None else _vector(f"{self.limits.arm}: target velocity", qd, n)
         qdd = est_qdd if qdd is None else _vector(f"{self.limits.arm}: target acceleration", qdd, n)
+        if self.settings.stop_beyond_velocity_limit:
+            self._check_trackable(qd, clamped)
         qd = np.where(clamped, 0.0, np.clip(qd, -self._vmax, self._vmax))
         qdd = np.where(clamped, 0.0, np.clip(qdd, -self._amax, self._amax))
         self._path = self._stop_at_range(q, qd, qdd, interval)
@@ -217,6 +252,18 @@ class TrajectoryGenerator:
         inp.minimum_duration = horizon
         inp.target_position, inp.target_velocity, inp.target_acceleration = self._predict(horizon)
         self._new_target = True
+
+    def _check_trackable(self, qd: np.ndarray, clamped: np.ndarray) -> None:
+        """Raise :class:`UntrackablePathError` for the first joint (not clamped onto its range) whose path velocity
+        ``qd`` (n,) rad/s is above its ``max_velocity``."""
+        beyond = np.flatnonzero(~clamped & (np.abs(qd) > self._vmax))
+        if beyond.size:
+            j = int(beyond[0])
+            joint = self.limits.joints[j].name.partition("/")[2]
+            raise UntrackablePathError(
+                f"untrackable path: arm {self.limits.arm}, joint {joint}, t={self.time:.4f} s: the target path moves at "
+                f"{abs(qd[j]):.6g} rad/s, above max_velocity {self._vmax[j]:.6g} rad/s"
+            )
 
     def _stop_at_range(
         self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, interval: float
@@ -241,22 +288,25 @@ class TrajectoryGenerator:
 
     def _predict(self, tau: float) -> tuple[list[float], list[float], list[float]]:
         """The target path's state ``tau`` s ahead, extrapolated at constant acceleration, made admissible: velocity
-        and acceleration clamped to the limits, positions clamped to the joint range (those joints then at rest).
+        and acceleration clamped to the limits, the acceleration then to what the velocity limit leaves
+        (:func:`_admissible_acceleration`), positions clamped to the joint range (those joints then at rest).
 
         Plain Python floats, one joint at a time (the interception search calls this up to a dozen times per target;
         numpy's per-call cost on six numbers was most of it), with the operations, their order and the clamps'
         tie-breaking of numpy's ``clip`` (``_clip``): the same bits as the array expressions."""
         pos, vel, acc = [], [], []
-        for q, qd, qdd, lo, hi, vmax in zip(*self._path_floats, self._lo_floats, self._hi_floats, self._vmax_floats):
+        limits = zip(self._lo_floats, self._hi_floats, self._vmax_floats, self._jmax_floats)
+        for q, qd, qdd, (lo, hi, vmax, jmax) in zip(*self._path_floats, limits):
             p = q + qd * tau + 0.5 * qdd * tau * tau
             if p < lo or p > hi:
                 pos.append(_clip(p, lo, hi))
                 vel.append(0.0)
                 acc.append(0.0)
             else:
+                v = _clip(qd + qdd * tau, -vmax, vmax)
                 pos.append(p)
-                vel.append(_clip(qd + qdd * tau, -vmax, vmax))
-                acc.append(qdd)
+                vel.append(v)
+                acc.append(_admissible_acceleration(v, qdd, vmax, jmax))
         return pos, vel, acc
 
     def _reachable(self, tau: float) -> bool:

@@ -1,6 +1,6 @@
 """Per-joint kinematic limits of an arm for trajectory generation and checking.
 
-Units: positions rad, velocities rad/s, accelerations rad/s^2, jerks rad/s^3; all limits are symmetric
+Units: positions rad, velocities rad/s, accelerations rad/s^2, jerks rad/s^3, torques N m; all limits are symmetric
 (``|qd| <= max_velocity`` and so on); joint positions must stay in ``[min_position, max_position]``.
 
 Defaults for a UR10e-class arm (:func:`arm_limits`):
@@ -15,6 +15,9 @@ Defaults for a UR10e-class arm (:func:`arm_limits`):
   for its ruckig smoothing (moveit/moveit, ``moveit_core/trajectory_processing/src/ruckig_traj_smoothing.cpp``,
   ``DEFAULT_MAX_JERK``), far below the thousands of rad/s^3 that arms with published jerk limits allow. It ramps the
   acceleration from 0 to 5 rad/s^2 in 50 ms.
+* ``rated_torque``: the torque the joint's drive may deliver, the model's joint actuator force range
+  (``actuatorfrcrange``; UR10e: :data:`cosim.robots.ur10e.UR10E_RATED_TORQUE`, 330 N m base and shoulder, 150 N m
+  elbow, 56 N m wrists). The inverse dynamics of a trajectory (:mod:`cosim.trajectory.torques`) is checked against it.
 * ``min_position``/``max_position``: the MuJoCo model's joint range (UR10e: +-360 deg). ruckig's community build
   ignores position limits, so :class:`cosim.trajectory.generator.TrajectoryGenerator` clamps its targets to them
   and :func:`cosim.trajectory.checks.check_trajectory` verifies the result.
@@ -47,9 +50,10 @@ DEFAULT_ARM_MODEL = "UR10e"  # the arm of the project's scene (models/ur10e/ur10
 MAX_VELOCITY_BOUND = 50.0
 MAX_ACCELERATION_BOUND = 1000.0
 MAX_JERK_BOUND = 1.0e6
+MAX_TORQUE_BOUND = 1.0e5
 POSITION_BOUND = 100.0  # |min_position|, |max_position|
 
-LIMIT_FIELDS = ("max_velocity", "max_acceleration", "max_jerk", "min_position", "max_position")
+LIMIT_FIELDS = ("max_velocity", "max_acceleration", "max_jerk", "min_position", "max_position", "rated_torque")
 
 
 @dataclass(frozen=True)
@@ -57,7 +61,8 @@ class JointLimits:
     """Limits of one joint. name: full joint name ``<arm>/<joint>``.
 
     max_velocity: rad/s, (0, 50]. max_acceleration: rad/s^2, (0, 1000]. max_jerk: rad/s^3, (0, 1e6].
-    min_position < max_position: rad, within [-100, 100].
+    min_position < max_position: rad, within [-100, 100]. rated_torque: N m, (0, 1e5], or inf for a coordinate that is
+    no motor's (a task-space filter's).
     """
 
     name: str
@@ -66,6 +71,7 @@ class JointLimits:
     max_jerk: float
     min_position: float
     max_position: float
+    rated_torque: float = math.inf
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -77,6 +83,8 @@ class JointLimits:
             check_positive(f"{p}.max_acceleration", self.max_acceleration, "rad/s^2", MAX_ACCELERATION_BOUND),
         )
         object.__setattr__(self, "max_jerk", check_positive(f"{p}.max_jerk", self.max_jerk, "rad/s^3", MAX_JERK_BOUND))
+        if self.rated_torque != math.inf:
+            object.__setattr__(self, "rated_torque", check_positive(f"{p}.rated_torque", self.rated_torque, "N m", MAX_TORQUE_BOUND))
         lo = check_range(f"{p}.min_position", self.min_position, -POSITION_BOUND, POSITION_BOUND, "rad")
         hi = check_range(f"{p}.max_position", self.max_position, lo, POSITION_BOUND, "rad", lo_open=True)
         object.__setattr__(self, "min_position", lo)
@@ -130,12 +138,22 @@ class JointLimitOverride:
     max_jerk: float | None = None
     min_position: float | None = None
     max_position: float | None = None
+    rated_torque: float | None = None
 
     def __post_init__(self) -> None:
         for f in fields(self):
             value = getattr(self, f.name)
             if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
                 raise InputError(f"limits override {f.name}: must be a number or None, got {value!r}")
+
+
+def _model_torque(scene: RobotScene, joint: str) -> float:
+    """N m, the largest torque the model's actuators may put on ``joint`` (its actuator force range), inf if unlimited."""
+    model = scene.model
+    jid = model.joint(joint).id
+    if not model.jnt_actfrclimited[jid]:
+        return math.inf
+    return float(np.max(np.abs(model.jnt_actfrcrange[jid])))
 
 
 def _model_range(scene: RobotScene, joint: str) -> tuple[float, float]:
@@ -179,12 +197,15 @@ def arm_limits(
             "max_jerk": DEFAULT_MAX_JERK,
             "min_position": lo,
             "max_position": hi,
+            "rated_torque": _model_torque(scene, name),
         }
         values.update({f: getattr(override, f) for f in LIMIT_FIELDS if getattr(override, f) is not None})
         for f in ("min_position", "max_position"):
             if not math.isfinite(values[f]) and getattr(override, f) is None:
                 raise InputError(f"limits.{name}.{f}: the model's joint has no range; give one in the overrides")
             check_range(f"limits.{name}.{f}", values[f], lo, hi, "rad (the model's joint range)")
+        if not math.isfinite(values["rated_torque"]):
+            raise InputError(f"limits.{name}.rated_torque: the model's joint has no actuator force range; give one in the overrides")
         joints.append(JointLimits(name=name, **values))
     return ArmLimits(arm=role.value, arm_model=arm_model, joints=tuple(joints))
 

@@ -91,7 +91,7 @@ def generate_scripted(
     per_target = round(target_period / cycle)
     if per_target < 1 or abs(per_target * cycle - target_period) > 1e-9:
         raise InputError(f"scripted target_period: must be a multiple of the time step {cycle:g} s, got {target_period:g} s")
-    settings = GeneratorSettings(cycle_time=cycle, control_period=per_target * cycle)
+    settings = GeneratorSettings(cycle_time=cycle, control_period=per_target * cycle, stop_beyond_velocity_limit=True)
 
     solvers = {r: scene.ik(r, SCRIPT_IK) for r in roles}
     targets: dict[ArmRole, list[np.ndarray]] = {r: [] for r in roles}

@@ -1,7 +1,7 @@
 """Static coupling: the pour arm holds its full vessel still; the liquid's weight must reach the arm.
 
 Two-way coupled run at the home posture: the SPH liquid fills the pourer to ``fill``; the arms hold their home
-joint targets with the measured liquid wrench fed forward. After ``duration`` the liquid's vertical force on the
+joint targets with the measured liquid wrench fed forward (ideal force-torque compensation: the arm holds still). After ``duration`` the liquid's vertical force on the
 pourer (averaged over the last ``AVERAGE_WINDOW``) is compared with the liquid's weight, and the pour arm's
 actuator torques (servo + gravity compensation, ``qfrc_actuator``, averaged likewise) with those of the same
 scene holding an equal rigid payload (a block of water of the liquid's mass filling the vessel to the liquid's
@@ -20,7 +20,7 @@ import numpy as np
 from cosim.checks import check_positive
 from cosim.coupling.exchange import ROLES, vessel_poses
 from cosim.coupling.loop import coupled_step, pour_fluid_config
-from cosim.coupling.settings import CouplingSettings
+from cosim.coupling.settings import Compensation, CouplingSettings
 from cosim.fluid.config import GRAVITY, FluidConfig
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
@@ -89,7 +89,7 @@ def run(p: Params) -> CaseResult:
     cfg = pour_fluid_config(scene, FluidConfig(dim=p.dim, spacing=spacing, pressure_solver=p.solver, **dict(p.numerics)), p.fill)
     poses = vessel_poses(scene)
     fluid = FluidSolver(cfg, [scene.arms[r].vessel for r in ROLES], poses, fill_vessel(pourer, p.fill, cfg, poses[0]), device=p.device)
-    settings = CouplingSettings()
+    settings = CouplingSettings(compensation=Compensation.IDEAL_FORCE_TORQUE)
     dt = float(scene.model.opt.timestep)
     steps = int(round(p.duration / dt))
     window = max(1, int(round(AVERAGE_WINDOW / dt)))
