@@ -21,13 +21,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import control as ct
 import numpy as np
 
 from controllers.checks import check_range
 from controllers.errors import ControllerInputError
 from controllers.slosh import SloshModel
+
+if TYPE_CHECKING:  # python-control (and scipy) take seconds to load: imported by the functions that build
+    import control as ct  # transfer functions, so that reading a configuration stays fast
 
 SETTLING_BAND = 0.02  # 2 % band for the settling time reported by the design (python-control's default)
 # Relative tolerance between placed and computed closed-loop poles: the design has a double real pole, which
@@ -63,6 +66,8 @@ class PidGains:
 
     def transfer_function(self) -> ct.TransferFunction:
         """Continuous C(s)."""
+        import control as ct
+
         s = ct.tf("s")
         return self.kp + self.ki / s + self.kd * s / (self.tf * s + 1.0)
 
@@ -71,6 +76,8 @@ class PidGains:
 
         kp + ki dt / (z - 1) + kd (z - 1) / ((tf + dt) z - tf).
         """
+        import control as ct
+
         integ = ct.tf([self.ki * dt], [1.0, -1.0], dt)
         deriv = ct.tf([self.kd, -self.kd], [self.tf + dt, -self.tf], dt)
         return ct.tf([self.kp], [1.0], dt) + integ + deriv
@@ -122,6 +129,8 @@ class PidDesign:
 
     def closed_loop(self) -> ct.TransferFunction:
         """theta1 / r of the continuous loop."""
+        import control as ct
+
         return ct.feedback(self.gains.transfer_function() * self.model.plant(), 1)
 
 
@@ -129,6 +138,8 @@ def sampled_plant(model: SloshModel, dt: float) -> ct.TransferFunction:
     """Gp as the controller sees it at sample time ``dt`` (s): the tilt command is held over each period (zero-order
     hold) and theta1 is measured just before the next command, so Gp's direct feed-through b2/l1 acts one sample
     late: Gz = (ZOH(Gp) - b2/l1) + (b2/l1) z^-1."""
+    import control as ct
+
     zoh = ct.c2d(model.plant(), dt, "zoh")
     num, den = np.asarray(zoh.num[0][0], dtype=float), np.asarray(zoh.den[0][0], dtype=float)
     d = model.b2 / model.l1
@@ -153,6 +164,8 @@ def design_filtered_pid(model: SloshModel, spec: PidDesignSpec = PidDesignSpec()
     (:class:`PidGains`), if python-control finds a closed-loop pole off the target or in the right half-plane,
     or (with ``dt`` in s) if the sampled loop is not stable at that control period.
     """
+    import control as ct
+
     g, l1, b2 = model.gravity, model.l1, model.b2
     target = spec.target_poles(model.omega1)
     _, c3, c2, c1, c0 = np.real(np.poly(target))

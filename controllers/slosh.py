@@ -43,11 +43,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
-import control as ct
 import numpy as np
 
 from controllers.checks import check_range
+
+if TYPE_CHECKING:  # python-control (and scipy) take seconds to load: imported by the functions that build
+    import control as ct  # transfer functions, so that reading a configuration stays fast
 
 GRAVITY = 9.81  # m/s^2, as in the seed (its SPH gravity vector is [0, 9.81, 0] m/s^2)
 
@@ -130,6 +133,8 @@ class SloshModel:
         and any vessel-frame pivot, the linearised plant is this one with
         pivot_height = hinge_height + :meth:`pivot_above_hinge` (pivot, theta0).
         """
+        import control as ct
+
         return ct.tf([self.b2 + pivot_height, 0.0, self.gravity], [self.l1, 0.0, self.gravity])
 
     def pivot_above_hinge(self, pivot: tuple[float, float], tilt: float) -> float:
@@ -159,5 +164,7 @@ class SloshModel:
         and small angles this is (M); for large tilts it keeps the hinge's exact motion. State
         q = sigma + x_h / l1 and its rate: q'' = -w^2 q + (w^2 / l1) x_h, sigma = q - x_h / l1, w^2 = g / l1.
         """
+        import control as ct
+
         w2 = self.gravity / self.l1
         return ct.ss([[0.0, 1.0], [-w2, 0.0]], [[0.0], [w2 / self.l1]], [[1.0, 0.0]], [[-1.0 / self.l1]])

@@ -14,6 +14,7 @@ import json
 import os
 import platform
 import shutil
+import sys
 import tempfile
 from dataclasses import asdict, replace
 from datetime import datetime, timezone
@@ -31,6 +32,7 @@ from cosim.atomic_files import check_output_folder
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour, build_pour
 from cosim.errors import InputError
+from cosim.fluid.runtime import kernel_modules, load_kernels, resolve_device
 from cosim.frames import tilt_about_y
 from cosim.io.pour_series import write_series_csv
 from cosim.pour_scene import PourScene
@@ -45,6 +47,10 @@ if TYPE_CHECKING:
 
 DEFAULT_RECORDINGS = Path("recordings")
 VERSIONED_PACKAGES = ("cosim", "warp-lang", "mujoco", "numpy", "control", "ruckig", "rerun-sdk")
+# Shown before the pour's warp kernels load: warp compiles them on a machine's first run (every kernel module at
+# once, 2-D and 3-D alike: the dimension is a run-time parameter) and reads them from its kernel cache afterwards.
+KERNELS_NOTICE = ("loading the liquid's kernels: compiled on the first run on this machine (about a minute, longer on "
+                  "a busy CPU), from warp's kernel cache in seconds afterwards ...")
 
 
 def cfs_head_reference(scene: PourScene, spacing: float) -> float:
@@ -207,6 +213,11 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -
     final = destination(out, scene.name)
     field = "--out" if out is not None else "--out (default recordings/)"
     check_output_folder(final.parent, field)
+    if progress:
+        print(KERNELS_NOTICE, file=sys.stderr, flush=True)
+    seconds = load_kernels(resolve_device(scene.device), kernel_modules("cosim"))
+    if progress:
+        print(f"kernels ready in {seconds:.1f} s", file=sys.stderr, flush=True)
     pour = prepare(scene)
     try:
         final.parent.mkdir(parents=True, exist_ok=True)

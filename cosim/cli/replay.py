@@ -12,16 +12,19 @@ import argparse
 import json
 import math
 
-from cosim.io.trajectory_csv import read_trajectory_csv
+from typing import TYPE_CHECKING
+
+from cosim.robots.feedforward import Feedforward
 from cosim.robots.payload import PayloadMode
-from cosim.robots.replay import Feedforward, ReplayReport, replay
-from cosim.robots.scene import RobotScene
+
+if TYPE_CHECKING:
+    from cosim.robots.replay import ReplayReport
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction, summary: str) -> None:
     parser = subparsers.add_parser(
         "replay",
-        help="play a joint trajectory CSV in MuJoCo (no liquid) and report tracking error",
+        help=summary,
         description="Play a joint trajectory CSV through the arms' position servos in MuJoCo without liquid (the "
         "liquid as a rigid payload) and report per-joint tracking error and the pour-lip path error.",
     )
@@ -57,6 +60,10 @@ def _print_table(report: ReplayReport) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from cosim.io.trajectory_csv import read_trajectory_csv
+    from cosim.robots.replay import replay
+    from cosim.robots.scene import RobotScene
+
     scene = RobotScene.load(args.model, PayloadMode(args.payload))
     joints = [name for arm in scene.arms.values() for name in arm.joints]
     trajectory = read_trajectory_csv(args.trajectory, known_joints=joints)

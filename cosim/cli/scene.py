@@ -7,11 +7,10 @@ from pathlib import Path
 
 from cosim.atomic_files import check_output_folder, write_text_atomic
 from cosim.errors import InputError
-from cosim.pour_scene import PourScene, dump_scene, load_scene
 
 
-def register(subparsers) -> None:
-    p = subparsers.add_parser("scene", help="print the default scene as TOML, or check a scene file", description=__doc__)
+def register(subparsers, summary: str) -> None:
+    p = subparsers.add_parser("scene", help=summary, description=__doc__)
     action = p.add_mutually_exclusive_group(required=True)
     action.add_argument("--dump", action="store_true", help="print the default scene (or write it with --out)")
     action.add_argument("--check", type=Path, metavar="FILE", help="validate a scene file and print it in full")
@@ -20,6 +19,8 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
+    from cosim.pour_scene import PourScene, dump_scene, load_scene
+
     if args.out is not None:
         if args.out.is_dir():
             raise InputError(f"--out: {args.out} is a folder; give the scene file's name")

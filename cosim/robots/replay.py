@@ -23,23 +23,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from enum import Enum
 
 import mujoco
 import numpy as np
 
 from cosim.errors import InputError, SimulationError
 from cosim.io.trajectory_csv import JointTrajectory
+from cosim.robots.feedforward import Feedforward
 from cosim.robots.interpolation import QuinticInterpolator
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
-
-
-class Feedforward(Enum):
-    """Closed choice of servo feedforward on top of the PD law."""
-
-    GRAVITY = "gravity"  # model gravity compensation only
-    DYNAMICS = "dynamics"  # plus inverse dynamics of the commanded motion
 
 
 @dataclass(frozen=True)
