@@ -31,6 +31,7 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--duration", type=float, help="longest simulated time, s (overrides coupling.max_duration)")
     p.add_argument("--no-log", action="store_true", help="skip the Rerun recording")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--yes", action="store_true", help="run even when the run is estimated at over an hour of wall time")
     p.set_defaults(func=run)
 
 
@@ -56,7 +57,7 @@ def run(args) -> int:
     scene = scene_from_args(args)  # a bad scene is refused before the simulation's libraries load
     from cosim.pour_run import run_pour
 
-    folder, summary = run_pour(scene, args.out, progress=not args.quiet)
+    folder, summary = run_pour(scene, args.out, progress=not args.quiet, long_run_ok=args.yes)
     initial = summary["initial_volume"]
     ml = 1e6
     print(f"wrote {folder}: {', '.join(summary['outputs'])}")
