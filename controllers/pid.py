@@ -28,14 +28,16 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import control as ct
 import numpy as np
-import scipy.optimize
 
 from controllers.checks import check_range
 from controllers.errors import ControllerInputError
 from controllers.slosh import SloshModel
+
+if TYPE_CHECKING:  # python-control (and scipy) take seconds to load: imported by the functions that use them,
+    import control as ct  # so that reading a configuration stays fast
 
 SETTLING_BAND = 0.02  # 2 % band for the settling time reported by the design (python-control's default)
 # Relative tolerance between placed and computed closed-loop poles: the design has a double real pole, which
@@ -71,6 +73,8 @@ class PidGains:
 
     def transfer_function(self) -> ct.TransferFunction:
         """Continuous C(s)."""
+        import control as ct
+
         s = ct.tf("s")
         return self.kp + self.ki / s + self.kd * s / (self.tf * s + 1.0)
 
@@ -79,6 +83,8 @@ class PidGains:
 
         kp + ki dt / (z - 1) + kd (z - 1) / ((tf + dt) z - tf).
         """
+        import control as ct
+
         integ = ct.tf([self.ki * dt], [1.0, -1.0], dt)
         deriv = ct.tf([self.kd, -self.kd], [self.tf + dt, -self.tf], dt)
         return ct.tf([self.kp], [1.0], dt) + integ + deriv
@@ -157,6 +163,8 @@ class PidDesign:
 
     def closed_loop(self) -> ct.TransferFunction:
         """theta1 / r of the continuous loop."""
+        import control as ct
+
         return ct.feedback(self.gains.transfer_function() * self.model.plant(), 1)
 
 
@@ -164,6 +172,8 @@ def sampled_plant(model: SloshModel, dt: float) -> ct.TransferFunction:
     """Gp as the controller sees it at sample time ``dt`` (s): the tilt command is held over each period (zero-order
     hold) and theta1 is measured just before the next command, so Gp's direct feed-through b2/l1 acts one sample
     late: Gz = (ZOH(Gp) - b2/l1) + (b2/l1) z^-1."""
+    import control as ct
+
     zoh = ct.c2d(model.plant(), dt, "zoh")
     num, den = np.asarray(zoh.num[0][0], dtype=float), np.asarray(zoh.den[0][0], dtype=float)
     d = model.b2 / model.l1
@@ -183,6 +193,8 @@ def _pole_mismatch(poles: np.ndarray, target: np.ndarray) -> float:
 
 def delayed_loop(gains: PidGains, model: SloshModel, dt: float, delay_steps: int) -> ct.TransferFunction:
     """The open loop C(z) Gz(z) z^-delay_steps the controller closes at sample time ``dt`` (s)."""
+    import control as ct
+
     return gains.discrete_tf(dt) * sampled_plant(model, dt) * ct.tf([1.0], [1.0] + [0.0] * delay_steps, dt)
 
 
@@ -214,6 +226,8 @@ def delayed_loop_figures(gains: PidGains, model: SloshModel, dt: float, delay_st
     over the closed-loop poles (-inf if unstable); the margins from python-control's crossings as distances from
     the critical point: the gain margin closest to 0 dB (up or down) over every phase crossover, the phase margin
     closest to 0 over every gain crossover (inf where the loop has none)."""
+    import control as ct
+
     loop = delayed_loop(gains, model, dt, delay_steps)
     radius = float(np.max(np.abs(ct.poles(ct.feedback(loop, 1)))))
     if radius >= 1.0:
@@ -257,6 +271,8 @@ def _search(model: SloshModel, spec: PidDesignSpec, dt: float, delay_steps: int)
     """The gains whose delayed sampled loop decays fastest within the spec's margins: the best pole placement over
     the damping and bandwidth grid, refined by Nelder-Mead on (kp, ki, kd, ln tf) with the margins as penalties.
     Returns the gains and the placement's target poles it started from."""
+    import scipy.optimize
+
     zoh = sampled_plant(model, dt)
     plant = (np.asarray(zoh.num[0][0], dtype=float), np.asarray(zoh.den[0][0], dtype=float))
     frequencies = np.linspace(1e-4, math.pi, 3000)
@@ -301,6 +317,8 @@ def design_filtered_pid(model: SloshModel, spec: PidDesignSpec = PidDesignSpec()
     finds a placed pole off its target or any in the right half-plane, or if the sampled loop with the delay is
     unstable or (searched) short of the margins.
     """
+    import control as ct
+
     searched = dt is not None and (spec.damping is None or spec.bandwidth_ratio is None)
     if dt is not None:
         check_range("control_rate period", dt, 0.0, 0.1, "s", lo_open=True)

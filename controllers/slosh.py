@@ -61,11 +61,14 @@ import math
 from dataclasses import dataclass
 from enum import Enum
 from functools import cached_property
+from typing import TYPE_CHECKING
 
-import control as ct
 import numpy as np
 
 from controllers.checks import check_choice, check_range
+
+if TYPE_CHECKING:  # python-control (and scipy) take seconds to load: imported by the functions that use them,
+    import control as ct  # so that reading a configuration stays fast
 
 GRAVITY = 9.81  # m/s^2
 J1_PRIME_FIRST_ROOT = 1.8411837813406593  # first positive root of J1'(x), the cylinder's first antisymmetric mode
@@ -148,6 +151,8 @@ class SloshModel:
         tilt theta0 and any vessel-frame pivot, the linearised plant is this one with
         pivot_height = hinge_height + :meth:`pivot_above_hinge` (pivot, theta0).
         """
+        import control as ct
+
         c = self._damping()
         return ct.tf([self.b2 + pivot_height, c, self.gravity], [self.l1, c, self.gravity])
 
@@ -176,6 +181,8 @@ class SloshModel:
         and q = sigma + x_h / l1, (M) reads q'' + d q' + w2 q = (w2 x_h + d x_h') / l1: the state is z, z' with
         z'' + d z' + w2 z = x_h, and sigma = (w2 z + d z') / l1 - x_h / l1.
         """
+        import control as ct
+
         w2 = self.gravity / self.l1
         d = 2.0 * self.damping_ratio * self.omega1
         return ct.ss([[0.0, 1.0], [-w2, -d]], [[0.0], [1.0]], [[w2 / self.l1, d / self.l1]], [[-1.0 / self.l1]])

@@ -3,10 +3,10 @@
 Layers (dependency direction is fixed): ``controllers`` (pure numpy + python-control) and ``cosim.fluid``
 (warp) know nothing of each other or of MuJoCo; ``cosim.robots`` is the MuJoCo side; ``cosim.coupling``
 wires them; ``cosim.io`` observes. SI units everywhere, z-up world, quaternions [w, x, y, z].
+
+Importing the package changes nothing outside it: the ``cosim`` command pins numpy's BLAS kernels
+(:func:`cosim.reproducibility.pin_openblas_core`) and configures warp (:func:`cosim.fluid.runtime.init_warp`)
+itself, when it runs.
 """
-
-from cosim.reproducibility import pin_openblas_core
-
-pin_openblas_core()  # before anything imports numpy: the same BLAS kernels, so the same bits, on every AVX2 machine
 
 __version__ = "0.1.0"

@@ -18,11 +18,11 @@ import json
 import os
 import platform
 import shutil
+import sys
 import tempfile
 from dataclasses import asdict, replace
 from datetime import datetime, timezone
 from importlib import metadata
-from importlib.util import find_spec
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -35,16 +35,16 @@ from cosim.atomic_files import check_output_folder
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour, build_pour
 from cosim.errors import InputError
+from cosim.fluid.runtime import kernel_modules, load_kernels, resolve_device
 from cosim.frames import tilt_about_y
 from cosim.io.pour_series import write_series_csv
+from cosim.pour_checks import PourPlan, check_pour
 from cosim.pour_scene import PourScene
 from cosim.reproducibility import blas_description
-from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_torques
 from cosim.trajectory.driver_names import driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
-from cosim.trajectory.limits import scene_limits
 from cosim.trajectory.torques import required_torques
 
 if TYPE_CHECKING:
@@ -52,6 +52,10 @@ if TYPE_CHECKING:
 
 DEFAULT_RECORDINGS = Path("recordings")
 VERSIONED_PACKAGES = ("cosim", "warp-lang", "mujoco", "numpy", "control", "ruckig", "rerun-sdk")
+# Shown before the pour's warp kernels load: warp compiles them on a machine's first run (every kernel module at
+# once, 2-D and 3-D alike: the dimension is a run-time parameter) and reads them from its kernel cache afterwards.
+KERNELS_NOTICE = ("loading the liquid's kernels: compiled on the first run on this machine (about a minute, longer on "
+                  "a busy CPU), from warp's kernel cache in seconds afterwards ...")
 
 
 def cfs_head_reference(scene: PourScene, spacing: float) -> float:
@@ -83,26 +87,13 @@ def _controller_config(scene: PourScene, spacing: float):
     return make
 
 
-def prepare(scene: PourScene) -> CoupledPour:
-    """Build the pour (robots, liquid, controller, trajectory generators) for ``scene``; InputError on bad input."""
-    robots = RobotScene.load(scene.robots.scene or None)
-    pourer = robots.arms[ArmRole.POUR].vessel
-    if not scene.liquid.fill_depth < pourer.inner_height:
-        raise InputError(
-            f"liquid.fill_depth: must be in (0, {pourer.inner_height:g}) m (below the pourer's rim), got {scene.liquid.fill_depth:g}"
-        )
-    overrides = {}
-    for name, override in scene.trajectory.limits.items():
-        arm = name.split("/", 1)[0]
-        roles = {r.value: r for r in ArmRole}
-        if arm not in roles or "/" not in name:
-            raise InputError(f"trajectory.limits.{name}: must be '<arm>/<joint>' with <arm> one of {', '.join(roles)}")
-        overrides.setdefault(roles[arm], {})[name] = override
-    limits = scene_limits(robots, overrides)
-    base = scene.fluid.fluid_config(pourer.inner_width)
+def prepare(scene: PourScene, plan: PourPlan | None = None) -> CoupledPour:
+    """Build the pour (robots, liquid, controller, trajectory generators) for ``scene`` from its checked ``plan``
+    (:func:`cosim.pour_checks.check_pour`, run here when not given, any estimated run time accepted)."""
+    plan = plan or check_pour(scene, long_run_ok=True)
     return build_pour(
-        robots, base, _controller_config(scene, base.spacing), limits, scene.liquid.fill_depth, scene.coupling,
-        scene.device, scene.controller.pose_filter, scene.trajectory.sample_rate_hz,
+        plan.robots, plan.fluid_base, _controller_config(scene, plan.fluid_base.spacing), plan.limits, scene.liquid.fill_depth,
+        scene.coupling, scene.device, scene.controller.pose_filter, scene.trajectory.sample_rate_hz,
     )
 
 
@@ -216,15 +207,21 @@ def _add_torque_report(arm_load: dict, joint_names, torques: np.ndarray, limits)
         record["rated_torque"] = {n: rated[n] for n in names}
 
 
-def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True) -> tuple[Path, dict]:
-    """Run ``scene`` and write its outputs; returns (run folder, summary)."""
-    if scene.logging.enabled and find_spec("rerun") is None:
-        raise InputError("logging.enabled: the Rerun recording needs rerun-sdk, which is not installed "
-                         "(install it, or run without the recording: --no-log or logging.enabled = false)")
+def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, long_run_ok: bool = False) -> tuple[Path, dict]:
+    """Run ``scene`` and write its outputs; returns (run folder, summary). The scene's checks
+    (:func:`cosim.pour_checks.check_pour`; ``long_run_ok`` accepts a run estimated at over an hour) come first, and
+    with ``progress``, their particle counts and run-time estimate are printed before the first step."""
     final = destination(out, scene.run_name)
     field = "--out" if out is not None else "--out (default recordings/)"
     check_output_folder(final.parent, field)
-    pour = prepare(scene)
+    plan = check_pour(scene, long_run_ok)
+    if progress:
+        print(plan.summary(), file=sys.stderr, flush=True)
+        print(KERNELS_NOTICE, file=sys.stderr, flush=True)
+    seconds = load_kernels(resolve_device(scene.device), kernel_modules("cosim"))
+    if progress:
+        print(f"kernels ready in {seconds:.1f} s", file=sys.stderr, flush=True)
+    pour = prepare(scene, plan)
     try:
         final.parent.mkdir(parents=True, exist_ok=True)
         work = Path(tempfile.mkdtemp(prefix=f".{final.name}.partial-", dir=final.parent))

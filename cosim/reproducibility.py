@@ -12,8 +12,10 @@ earlier sessions had found on different machines with the same code. warp's kern
 and numpy without its AVX-512 paths changed nothing (README, Known limitations). So where the CPU has what the
 Haswell kernels need (AVX2 and FMA), they are pinned. Slower kernels for large matrices cost nothing here (the
 matrices are a few rows by a few columns). This only works before numpy is first imported (OpenBLAS reads the
-variable once, when it loads), so ``cosim/__init__.py`` calls :func:`pin_openblas_core` first thing; a user's own
-``OPENBLAS_CORETYPE`` is left alone.
+variable once, when it loads), so the ``cosim`` command (:func:`cosim.cli.main.main`) and the test suite's
+``conftest.py`` call :func:`pin_openblas_core` before anything imports numpy; importing ``cosim`` does not (the other
+entry points, such as ``python -m cosim.bench.host_overhead``, run the kernels ``OPENBLAS_CORETYPE`` names in their
+environment). A user's own ``OPENBLAS_CORETYPE`` is left alone.
 
 The kernels' bits also change with OpenBLAS's version, which numpy's wheel bundles: the default pour under Python
 3.12 with numpy 2.4.6 (OpenBLAS 0.3.31) and with numpy 2.5.2 (OpenBLAS 0.3.34), Haswell kernels in both, gave two

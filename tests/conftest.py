@@ -1,4 +1,6 @@
-"""Imported by pytest before any test module: cosim first, so that it pins numpy's OpenBLAS kernels before numpy is
-loaded (cosim.reproducibility), as the cosim command does."""
+"""Imported by pytest before any test module: pins numpy's OpenBLAS kernels before numpy is loaded
+(cosim.reproducibility), as the cosim command does."""
 
-import cosim  # noqa: F401
+from cosim.reproducibility import pin_openblas_core
+
+pin_openblas_core()

@@ -182,7 +182,7 @@ def test_a_broken_simulation_is_a_failed_row_not_a_crash(monkeypatch):
     def explode(params):
         raise FluidInstabilityError(12, 0.003, "compression 0.4 exceeds fluid.max_density_error = 0.3")
 
-    monkeypatch.setitem(CASES, "hydrostatic", replace(CASES["hydrostatic"], run=explode))
+    monkeypatch.setattr(CASES["hydrostatic"].implementation(), "run", explode)
     result = run_config(BenchConfig(BenchCase.HYDROSTATIC, 8, 0.05))
     assert result["status"] == "failed" and "SPH step 12" in result["message"]
 

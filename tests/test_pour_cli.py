@@ -178,10 +178,10 @@ def test_unreadable_scene_file_and_busy_output_folder(tmp_path, capsys):
 def test_a_recording_without_rerun_sdk_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, monkeypatch):
     # as on the GPU machine, which has no rerun-sdk: the pour with its recording is refused before anything runs,
     # the message saying how to run it without the recording (which needs no rerun-sdk)
-    import cosim.pour_run
+    import cosim.pour_checks
 
-    real = cosim.pour_run.find_spec
-    monkeypatch.setattr(cosim.pour_run, "find_spec", lambda name: None if name == "rerun" else real(name))
+    real = cosim.pour_checks.find_spec
+    monkeypatch.setattr(cosim.pour_checks, "find_spec", lambda name: None if name == "rerun" else real(name))
     out = tmp_path / "out"
     assert main(["pour", "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()

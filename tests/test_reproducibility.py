@@ -41,10 +41,14 @@ def test_a_users_setting_or_a_loaded_numpy_is_left_alone(monkeypatch):
 
 
 def _corename_probe() -> str:
-    """A program printing the core numpy's OpenBLAS runs, after importing cosim (or '?' where the build does not
-    say)."""
+    """A program printing the core numpy's OpenBLAS runs after the cosim command's start (``cosim --version``, run
+    in the same process), or '?' where the build does not say."""
     return """
-import cosim, ctypes, glob, os, numpy
+import contextlib, ctypes, glob, io, os
+from cosim.cli.main import main
+with contextlib.suppress(SystemExit), contextlib.redirect_stdout(io.StringIO()):
+    main(["--version"])
+import numpy
 names = ("scipy_openblas_get_corename64_", "scipy_openblas_get_corename", "openblas_get_corename64_", "openblas_get_corename")
 for path in glob.glob(os.path.join(os.path.dirname(numpy.__file__), os.pardir, "numpy.libs", "*openblas*")):
     lib = ctypes.CDLL(path)

@@ -6,7 +6,8 @@ import csv
 
 import pytest
 
-import cosim.cli.stress as stress_cli
+import cosim.stress.matrix
+import cosim.stress.runner
 from cosim.cli.main import main
 from cosim.stress.classify import DENSITY_ERROR_BOUND, ENERGY_EXCESS_BOUND
 from cosim.stress.matrix import DURATION, quick_matrix
@@ -54,7 +55,7 @@ def test_rerun_resumes_and_docs_writes_from_the_csv(quick_run, tmp_path, monkeyp
     def must_not_run(config, device):
         raise AssertionError(f"{config.id} was already done")
 
-    monkeypatch.setattr(stress_cli, "measure", must_not_run)
+    monkeypatch.setattr(cosim.stress.runner, "measure", must_not_run)
     main(["stress", "--quick", "--out", str(out)])
     assert "3 already in" in capsys.readouterr().err
     assert (out / "stress.csv").read_text() == before
@@ -71,8 +72,8 @@ def test_unexpected_exception_is_an_error_row_and_the_run_goes_on(tmp_path, monk
             raise RuntimeError("boom")
         return CLEAN
 
-    monkeypatch.setattr(stress_cli, "measure", flaky)
-    monkeypatch.setattr(stress_cli, "quick_matrix", lambda: configs[:2])
+    monkeypatch.setattr(cosim.stress.runner, "measure", flaky)
+    monkeypatch.setattr(cosim.stress.matrix, "quick_matrix", lambda: configs[:2])
     assert main(["stress", "--quick", "--out", str(tmp_path)]) == 1
     rows = {r["id"]: r for r in _rows(tmp_path)}
     assert rows[configs[0].id]["outcome"] == "error" and "RuntimeError: boom" in rows[configs[0].id]["message"]

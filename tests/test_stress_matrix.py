@@ -10,7 +10,8 @@ import pytest
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig, PressureSolver
 from cosim.stress.classify import DENSITY_ERROR_BOUND, ENERGY_EXCESS_BOUND, Outcome, classify
-from cosim.stress.matrix import Motion, StressConfig, build_matrix, select, solver_field
+from cosim.stress.filters import select
+from cosim.stress.matrix import Motion, StressConfig, build_matrix, solver_field
 from cosim.validation.scripted import LeakMonitor, WallRegions
 from tests.support.stress import CLEAN
 

@@ -24,19 +24,14 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from cosim.atomic_files import check_output_folder, write_text_atomic
-from cosim.bench.cache import ResultCache
-from cosim.bench.plan import build_plan
-from cosim.bench.report import build_rows, markdown, plot_case, rows_csv, skip_table, update_document
-from cosim.bench.run import run_plan
 from cosim.errors import InputError
 
 DEFAULT_OUT = Path("recordings") / "bench"
 PLANS = ("full", "smoke", "targets")
 
 
-def register(subparsers) -> None:
-    p = subparsers.add_parser("bench", help="wall time against error: resolutions, numerics, skip options (CSV, PNG, Markdown)",
-                              description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def register(subparsers, summary: str) -> None:
+    p = subparsers.add_parser("bench", help=summary, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--plan", default="full", help="which configurations: full (default), smoke (seconds, for checks) or targets (issue 7's speed targets on "
                    "this machine's devices, measured afresh: no cache)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for bench.csv, bench.md and the plots (default {DEFAULT_OUT})")
@@ -66,6 +61,7 @@ def _header(command: str, code_versions: dict) -> str:
 
 def _run_targets(args) -> int:
     """``--plan targets``: issue 7's speed targets measured on this machine (:mod:`cosim.bench.targets`)."""
+    from cosim.bench.report import update_document
     from cosim.bench.targets import measure_all, write_report
     from cosim.fluid.runtime import cuda_available
 
@@ -98,6 +94,11 @@ def run(args) -> int:
         check_output_folder(args.cache, "--cache")
     if args.plan == "targets":
         return _run_targets(args)
+    from cosim.bench.cache import ResultCache
+    from cosim.bench.plan import build_plan
+    from cosim.bench.report import build_rows, markdown, plot_case, rows_csv, skip_table, update_document
+    from cosim.bench.run import run_plan
+
     plan = build_plan(args.plan)
     cache = ResultCache(args.cache or args.out / "cache")
     outcome = run_plan(plan, cache, fresh=args.fresh, progress=not args.quiet)

@@ -1,10 +1,14 @@
 """Entry point of the ``cosim`` command.
 
-Each subcommand lives in its own module under ``cosim.cli`` and provides ``register(subparsers)`` (adds its parser,
-sets ``func``) and a ``run(args) -> int``. Bad input (:class:`InputError`, or the controllers' own
+Each subcommand lives in its own module under ``cosim.cli`` and provides ``register(subparsers, summary)`` (adds its
+parser with that one-line help, sets ``func``) and a ``run(args) -> int``. Bad input (:class:`InputError`, or the controllers' own
 ``ControllerInputError``) prints one line and exits with 2; a simulation that broke (:class:`SimulationError`, the
 controllers' ``MeasurementError``) prints one line and exits with 1; Ctrl-C exits with 130, SIGTERM (a batch
 scheduler's stop) with 143, both through the same clean-up, so neither leaves a half-written output behind.
+
+Only what ``--help`` needs is imported up front: each subcommand module imports its libraries (warp, MuJoCo,
+python-control, Rerun) inside ``run``, so help and bad-input errors come back in a fraction of a second
+(tests/test_cli_startup.py checks it).
 """
 
 from __future__ import annotations
@@ -17,23 +21,32 @@ import sys
 import threading
 from typing import Iterator
 
-from controllers.errors import ControllerInputError, MeasurementError
 from cosim import __version__
 from cosim.errors import InputError, SimulationError
+from cosim.reproducibility import pin_openblas_core
 
-# Subcommand modules, in the order `cosim --help` lists them.
-SUBCOMMAND_MODULES: list[str] = [
-    "cosim.cli.pour",
-    "cosim.cli.scene",
-    "cosim.cli.validate",
-    "cosim.cli.bench",
-    "cosim.cli.stress",
-    "cosim.cli.replay",
-    "cosim.cli.view",
-]
+# Subcommands, in the order `cosim --help` lists them: name -> (its module, the line `cosim --help` shows).
+SUBCOMMANDS: dict[str, tuple[str, str]] = {
+    "pour": ("cosim.cli.pour", "simulate a robot pour (default scene without a file)"),
+    "scene": ("cosim.cli.scene", "print the default scene as TOML, or check a scene file"),
+    "validate": ("cosim.cli.validate", "run validation cases against analytic and experimental references"),
+    "bench": ("cosim.cli.bench", "wall time against error: resolutions, numerics, skip options (CSV, PNG, Markdown)"),
+    "stress": ("cosim.cli.stress", "numerical-stability matrix of the SPH liquid (CSV + Markdown + PNG)"),
+    "replay": ("cosim.cli.replay", "play a joint trajectory CSV in MuJoCo (no liquid) and report tracking error"),
+    "view": ("cosim.cli.view", "open a run's Rerun recording in the viewer"),
+}
 
 
-def build_parser() -> argparse.ArgumentParser:
+def requested_command(argv: list[str]) -> str | None:
+    """The subcommand ``argv`` names: its first word that is not an option (``cosim`` itself takes only ``--help``
+    and ``--version``, neither with a value), if it is one of :data:`SUBCOMMANDS`."""
+    word = next((a for a in argv if not a.startswith("-")), None)
+    return word if word in SUBCOMMANDS else None
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``cosim`` parser, with ``command``'s full parser (its module imported and registered) and a bare entry
+    for every other subcommand: only the command that runs is imported."""
     parser = argparse.ArgumentParser(
         prog="cosim",
         description="Simulate robot pours: MuJoCo arms holding vessels, a warp-lang SPH liquid, "
@@ -41,8 +54,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"cosim {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in SUBCOMMAND_MODULES:
-        importlib.import_module(name).register(subparsers)
+    for name, (module, summary) in SUBCOMMANDS.items():
+        if name == command:
+            importlib.import_module(module).register(subparsers, summary)
+        else:
+            subparsers.add_parser(name, help=summary)
     return parser
 
 
@@ -69,11 +85,15 @@ def _sigterm_unwinds() -> Iterator[None]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    pin_openblas_core()  # before any subcommand imports numpy
+    argv = sys.argv[1:] if argv is None else argv
+    parser = build_parser(requested_command(argv))
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    from controllers.errors import ControllerInputError, MeasurementError  # after --help: the package loads numpy
+
     try:
         with _sigterm_unwinds():
             return int(args.func(args) or 0)

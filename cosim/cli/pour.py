@@ -14,15 +14,17 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+from typing import TYPE_CHECKING
+
 from cosim.checks import check_device, check_int, check_positive
 from cosim.fluid.config import MAX_CPU_THREADS
-from cosim.pour_run import run_pour
-from cosim.pour_scene import PourScene, load_scene
+
+if TYPE_CHECKING:
+    from cosim.pour_scene import PourScene
 
 
-def register(subparsers) -> None:
-    p = subparsers.add_parser("pour", help="simulate a robot pour (default scene without a file)", description=__doc__,
-                              formatter_class=argparse.RawDescriptionHelpFormatter)
+def register(subparsers, summary: str) -> None:
+    p = subparsers.add_parser("pour", help=summary, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("scene", nargs="?", type=Path, help="scene TOML file (default: the embedded default scene)")
     p.add_argument("--out", type=Path, help="output folder (must not exist or be empty; default: a new folder under recordings/)")
     p.add_argument("--device", help="cpu or cuda[:N] (overrides the scene)")
@@ -31,10 +33,13 @@ def register(subparsers) -> None:
     p.add_argument("--duration", type=float, help="longest simulated time, s (overrides coupling.max_duration)")
     p.add_argument("--no-log", action="store_true", help="skip the Rerun recording")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--yes", action="store_true", help="run even when the run is estimated at over an hour of wall time")
     p.set_defaults(func=run)
 
 
 def scene_from_args(args) -> PourScene:
+    from cosim.pour_scene import PourScene, load_scene
+
     scene = load_scene(args.scene).named_after(args.scene) if args.scene is not None else PourScene()
     if args.device is not None:
         scene = replace(scene, device=check_device("--device", args.device))
@@ -51,8 +56,10 @@ def scene_from_args(args) -> PourScene:
 
 
 def run(args) -> int:
-    scene = scene_from_args(args)
-    folder, summary = run_pour(scene, args.out, progress=not args.quiet)
+    scene = scene_from_args(args)  # a bad scene is refused before the simulation's libraries load
+    from cosim.pour_run import run_pour
+
+    folder, summary = run_pour(scene, args.out, progress=not args.quiet, long_run_ok=args.yes)
     initial = summary["initial_volume"]
     ml = 1e6
     print(f"wrote {folder}: {', '.join(summary['outputs'])}")

@@ -15,19 +15,22 @@ import argparse
 import json
 import math
 
+from typing import TYPE_CHECKING
+
 from cosim.checks import check_positive
-from cosim.io.trajectory_csv import read_trajectory_csv
+from cosim.robots.feedforward import DEFAULT_TOLERANCE_M, Feedforward
 from cosim.robots.payload import PayloadMode
-from cosim.robots.replay import DEFAULT_TOLERANCE_M, Feedforward, ReplayReport, replay
-from cosim.robots.scene import RobotScene
+
+if TYPE_CHECKING:
+    from cosim.robots.replay import ReplayReport
 
 MAX_TOLERANCE_MM = 1000.0
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction, summary: str) -> None:
     parser = subparsers.add_parser(
         "replay",
-        help="play a joint trajectory CSV in MuJoCo (no liquid): tracking error and a pass/fail verdict",
+        help=summary,
         description="Play a joint trajectory CSV through the arms' position servos in MuJoCo without liquid (the "
         "liquid as a rigid payload), report per-joint tracking error and the vessel lips' path errors, and end with "
         "PASS (every lip within the tolerance of its commanded path, no contact) or FAIL. Exit status: 0 pass, "
@@ -69,6 +72,10 @@ def _print_table(report: ReplayReport) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from cosim.io.trajectory_csv import read_trajectory_csv
+    from cosim.robots.replay import replay
+    from cosim.robots.scene import RobotScene
+
     tolerance = check_positive("--tolerance-mm", args.tolerance_mm, "mm", MAX_TOLERANCE_MM) / 1000.0
     scene = RobotScene.load(args.model, PayloadMode(args.payload))
     joints = [name for arm in scene.arms.values() for name in arm.joints]

@@ -17,24 +17,23 @@ import sys
 import traceback
 from collections import Counter
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from cosim.atomic_files import check_output_folder, write_text_atomic
 from cosim.checks import check_device
 from cosim.errors import InputError
-from cosim.stress.classify import FAILURES, Outcome, classify
-from cosim.stress.matrix import FILTER_FIELDS, build_matrix, quick_matrix, select
-from cosim.stress.report import write_report
-from cosim.stress.runner import measure
-from cosim.stress.store import ResultStore, make_row
+from cosim.stress.filters import FILTER_FIELDS, select
+
+if TYPE_CHECKING:  # the matrix, the runner and the report import warp and MuJoCo: imported by run
+    from cosim.stress.store import ResultStore
 
 DEFAULT_OUT = Path("recordings") / "stress"
 RESULTS = "stress.csv"
 COMMANDS = "commands.txt"  # the command lines that produced the results, one a line
 
 
-def register(subparsers) -> None:
-    p = subparsers.add_parser("stress", help="numerical-stability matrix of the SPH liquid (CSV + Markdown + PNG)",
-                              description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def register(subparsers, summary: str) -> None:
+    p = subparsers.add_parser("stress", help=summary, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"result folder (default {DEFAULT_OUT})")
     p.add_argument("--quick", action="store_true", help="three cheap configurations (a smoke run)")
     p.add_argument("--filter", action="append", default=[], metavar="FIELD=VALUE",
@@ -58,6 +57,8 @@ def _command_line(args) -> str:
 
 def _ordered(store: ResultStore) -> list[dict]:
     """Rows in matrix order (then any others, e.g. quick configurations, in completion order)."""
+    from cosim.stress.matrix import build_matrix
+
     order = {c.id: k for k, c in enumerate(build_matrix())}
     return sorted(store.rows.values(), key=lambda r: order.get(r["id"], len(order)))
 
@@ -69,6 +70,10 @@ def _commands(out: Path) -> list[str]:
 
 def _run_one(config, device: str) -> dict:
     """The row of one configuration; an unexpected exception becomes an ``error`` row, not a crash."""
+    from cosim.stress.classify import Outcome, classify
+    from cosim.stress.runner import measure
+    from cosim.stress.store import make_row
+
     try:
         m = measure(config, device)  # returns the solver's instability as a result; Ctrl-C is no Exception
     except InputError as exc:  # refused at set-up with the one-line message a user would get
@@ -81,6 +86,11 @@ def _run_one(config, device: str) -> dict:
 
 
 def run(args) -> int:
+    from cosim.stress.classify import FAILURES, Outcome
+    from cosim.stress.matrix import build_matrix, quick_matrix
+    from cosim.stress.report import write_report
+    from cosim.stress.store import ResultStore
+
     if args.docs is not None:
         store = ResultStore(args.out / RESULTS)
         if not store.rows:

@@ -15,18 +15,21 @@ import json
 import sys
 from pathlib import Path
 
+from typing import TYPE_CHECKING
+
 from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
 from cosim.fluid.config import DensityIteration, PressureSolver
-from cosim.pour_scene import FluidSettings
-from cosim.validation import CASES, DEFAULT_CASES, slosh
-from cosim.validation.common import CaseResult
+from cosim.validation import CASES, DEFAULT_CASES
+
+if TYPE_CHECKING:
+    from cosim.validation.common import CaseResult
+
 DEFAULT_OUT = Path("recordings") / "validate"
 
 
-def register(subparsers) -> None:
-    p = subparsers.add_parser("validate", help="run validation cases against analytic and experimental references",
-                              description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def register(subparsers, summary: str) -> None:
+    p = subparsers.add_parser("validate", help=summary, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("cases", nargs="*", metavar="CASE",
                    help="; ".join(f"{k}: {c.summary}" for k, c in CASES.items()) + f" (default: {' '.join(DEFAULT_CASES)})")
     p.add_argument("--json", action="store_true", help="print machine-readable results (with raw series) on stdout")
@@ -36,12 +39,12 @@ def register(subparsers) -> None:
     p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
     p.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2-D (pour plane) or 3-D (default 2)")
     p.add_argument("--device", default="cpu", help="cpu or cuda[:N] (default cpu)")
-    default_solver = FluidSettings().pressure_solver.value
-    p.add_argument("--solver", choices=[s.value for s in PressureSolver], default=default_solver,
-                   help=f"pressure solver: wcsph (weakly compressible) or dfsph (divergence-free) (default: the default scene's, {default_solver})")
-    default_iteration = FluidSettings().density_iteration.value
-    p.add_argument("--density-iteration", choices=[d.value for d in DensityIteration], default=default_iteration,
-                   help=f"DFSPH's density solve: gauss_seidel or jacobi, each at its own default tolerance (default: {default_iteration})")
+    p.add_argument("--solver", choices=[s.value for s in PressureSolver],
+                   help="pressure solver: wcsph (weakly compressible) or dfsph (divergence-free) (default: the default scene's "
+                   "fluid.pressure_solver, as `cosim scene --dump` prints it)")
+    p.add_argument("--density-iteration", choices=[d.value for d in DensityIteration],
+                   help="DFSPH's density solve: gauss_seidel or jacobi, each at its own default tolerance (default: the default "
+                   "scene's fluid.density_iteration)")
     p.add_argument("--density-tolerance", type=float, help="DFSPH's density solve stops at this average compression "
                    "(default: the density iteration's own, fluid.density_tolerance)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
@@ -51,10 +54,15 @@ def register(subparsers) -> None:
 
 
 def _case_params(name: str, args) -> list:
-    numerics = (("density_iteration", args.density_iteration),)
+    from cosim.pour_scene import FluidSettings
+    from cosim.validation import slosh
+
+    scene = FluidSettings()
+    solver = args.solver or scene.pressure_solver.value
+    numerics = (("density_iteration", args.density_iteration or scene.density_iteration.value),)
     if args.density_tolerance is not None:
         numerics += (("density_tolerance", args.density_tolerance),)
-    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing, "solver": args.solver, "numerics": numerics}
+    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing, "solver": solver, "numerics": numerics}
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
     if name in ("tilt", "shake", "free-fall", "coupling-static"):

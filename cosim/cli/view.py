@@ -23,10 +23,10 @@ WEB_VIEWER_PORT = 9090
 GRPC_PORT = 9876
 
 
-def register(subparsers: argparse._SubParsersAction) -> None:
+def register(subparsers: argparse._SubParsersAction, summary: str) -> None:
     parser = subparsers.add_parser(
         "view",
-        help="open a run's Rerun recording in the viewer",
+        help=summary,
         description="Open a pour's Rerun recording (RUN/pour.rrd, or a .rrd file) in the Rerun viewer.",
     )
     parser.add_argument("run", metavar="RUN", help="run folder containing pour.rrd, or a .rrd file")
@@ -40,9 +40,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def recording_path(run_arg: str) -> Path:
     """The .rrd file RUN designates, checked to be a readable Rerun recording (else InputError)."""
-    # imported here: the other subcommands run where rerun-sdk is not installed (the GPU machine, README)
-    from rerun.chunk import RrdReader
-
     path = Path(run_arg).expanduser()
     if path.is_dir():
         path = path / RECORDING_NAME
@@ -51,6 +48,10 @@ def recording_path(run_arg: str) -> Path:
             raise InputError(f"RUN: {path.parent} is a run without its recording (made with --no-log or logging.enabled "
                              "= false); run the pour again with logging on to view it")
         raise InputError(f"RUN: no recording at {path} (expected a run folder with {RECORDING_NAME}, or a .rrd file)")
+    # imported here, once the file exists: the other subcommands run where rerun-sdk is not installed (the GPU
+    # machine, README), and a wrong path is reported without loading it
+    from rerun.chunk import RrdReader
+
     try:
         with warnings.catch_warnings():  # a file without footer warns before failing; the error below says it all
             warnings.simplefilter("ignore")

@@ -247,6 +247,14 @@ class FluidConfig:
         return self.sound_speed_factor * self.max_expected_speed
 
     @property
+    def fixed_time_step(self) -> float:
+        """s, the time step with ``adaptive_time_step`` off: the CFL condition on the sound speed plus the expected
+        speed (WCSPH) or on the expected speed alone (DFSPH), dt = cfl h / (c0 + v_max) (the solver's viscous
+        criterion, h^2 / nu scaled, can shorten it further: never for water at these resolutions)."""
+        sound = self.sound_speed if self.pressure_solver is PressureSolver.WCSPH else 0.0
+        return self.cfl * self.smoothing_length / (sound + self.max_expected_speed)
+
+    @property
     def particle_mass(self) -> float:
         """SPH mass of one particle: kg (3-D) or kg per metre of depth (2-D)."""
         return self.rest_density * self.spacing**self.dim

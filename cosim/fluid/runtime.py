@@ -1,10 +1,16 @@
-"""warp initialisation and device selection (the only place that calls ``wp.init``)."""
+"""warp initialisation, device selection and kernel loading (the only place that calls ``wp.init``).
+
+Nothing here runs on import: a command that runs warp calls :func:`init_warp` (directly or through
+:func:`resolve_device`), which sets warp's global configuration once.
+"""
 
 from __future__ import annotations
 
 import os
 import sys
 import tempfile
+import time
+from collections.abc import Sequence
 
 import warp as wp
 
@@ -65,3 +71,22 @@ def resolve_device(name: str) -> wp.Device:
 def cuda_available() -> bool:
     init_warp()
     return wp.is_cuda_available()
+
+
+def kernel_modules(package: str) -> list[str]:
+    """The imported Python modules of ``package`` (e.g. 'cosim') that define warp kernels (not those that only import
+    one): warp compiles and caches each as one module, so these are what a run that imported them will load."""
+    prefix = package + "."
+    return sorted(name for name, module in list(sys.modules.items())
+                  if (name == package or name.startswith(prefix)) and module is not None
+                  and any(isinstance(value, wp.Kernel) and value.module.name == name for value in vars(module).values()))
+
+
+def load_kernels(device: wp.Device, modules: Sequence[str]) -> float:
+    """Load the warp modules of the Python modules ``modules`` on ``device`` now rather than at their first launch
+    (``wp.force_load``, which compiles them in parallel): compiled on a machine's first run, read from warp's kernel
+    cache (``wp.config.kernel_cache_dir``) afterwards. Returns the wall time it took, s."""
+    init_warp()
+    start = time.perf_counter()
+    wp.force_load(device=device, modules=[wp.get_module(name) for name in modules])
+    return time.perf_counter() - start

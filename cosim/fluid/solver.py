@@ -294,7 +294,7 @@ class FluidSolver:
         h = cfg.smoothing_length
         sound = cfg.sound_speed if cfg.pressure_solver is PressureSolver.WCSPH else 0.0
         if not cfg.adaptive_time_step:
-            dt = cfg.cfl * h / (sound + cfg.max_expected_speed)
+            dt = cfg.fixed_time_step
         else:
             if cfg.pressure_solver is PressureSolver.WCSPH:
                 signal = sound + self._last_max_speed + wall_speed

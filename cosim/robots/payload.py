@@ -9,11 +9,14 @@ UR controller compensates a payload whose mass and centre of gravity were entere
 from __future__ import annotations
 
 from enum import Enum
+from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
 
 from cosim.vessel import VesselSpec
+
+if TYPE_CHECKING:  # only the annotations name MuJoCo: `cosim replay --help` lists PayloadMode without loading it
+    import mujoco
 
 # Density of the liquid, kg/m^3 (water; DESIGN.md rho0 = 1000).
 LIQUID_DENSITY = 1000.0

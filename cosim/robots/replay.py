@@ -26,28 +26,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from enum import Enum
 
 import mujoco
 import numpy as np
 
 from cosim.errors import InputError, SimulationError
 from cosim.io.trajectory_csv import JointTrajectory
+from cosim.robots.feedforward import DEFAULT_TOLERANCE_M, Feedforward
 from cosim.robots.interpolation import QuinticInterpolator
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
-
-
-# m: the default tolerance of the lips' path error. A pour lip 2 mm off its path moves the stream's landing point by
-# about as much, small against the catcher's opening (0.26 m in the default scene).
-DEFAULT_TOLERANCE_M = 0.002
-
-
-class Feedforward(Enum):
-    """Closed choice of servo feedforward on top of the PD law."""
-
-    GRAVITY = "gravity"  # model gravity compensation only
-    DYNAMICS = "dynamics"  # plus inverse dynamics of the commanded motion
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,6 @@ import math
 from dataclasses import dataclass
 from enum import Enum
 
-from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
 from cosim.fluid.seeding import fill_layers
 from cosim.frames import Pose
@@ -192,27 +191,3 @@ QUICK = (  # a few cheap, coarse configurations of each motion (tests, smoke run
 
 def quick_matrix() -> list[StressConfig]:
     return [StressConfig(m, lv, f, a, c, d, PressureSolver.WCSPH.value) for m, lv, f, a, c, d in QUICK]
-
-
-FILTER_FIELDS = ("motion", "level", "fill", "across", "cfl", "dim", "solver", "id")
-
-
-def _matches(config: StressConfig, name: str, value: str) -> bool:
-    if name == "id":
-        return config.id == value
-    actual = dict(item.split("=", 1) for item in config.key.split(";"))[name]
-    try:
-        return math.isclose(float(actual), float(value))
-    except ValueError:
-        return actual == value
-
-
-def select(configs: list[StressConfig], filters: list[str]) -> list[StressConfig]:
-    """Configurations that match every ``FIELD=VALUE`` filter (e.g. ``motion=tilt``, ``dim=3``, ``level=5``)."""
-    out = configs
-    for f in filters:
-        name, sep, value = f.partition("=")
-        if not sep or name not in FILTER_FIELDS:
-            raise InputError(f"--filter {f!r}: expected FIELD=VALUE with FIELD one of {', '.join(FILTER_FIELDS)}")
-        out = [c for c in out if _matches(c, name, value)]
-    return out

@@ -1,35 +1,51 @@
 """Validation cases of the fluid core (and, once the robots exist, of the coupling) against analytic solutions
 and published experiments. Each case provides frozen, validated parameters, ``run(params) -> CaseResult`` and
-``plot(result, path)``; :data:`CASES` is the registry ``cosim validate`` drives."""
+``plot(result, path)``; :data:`CASES` is the registry ``cosim validate`` drives. A case's module (and with it warp
+and MuJoCo) is imported when the case is used, not when the registry is read."""
 
 from __future__ import annotations
 
+import importlib
 from dataclasses import dataclass
-from typing import Any, Callable
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, Callable
 
-from cosim.validation import coupling_static, dam_break, free_fall, hydrostatic, moving_vessel, slosh
-from cosim.validation.common import CaseResult
+if TYPE_CHECKING:
+    from cosim.validation.common import CaseResult
 
 
 @dataclass(frozen=True)
 class Case:
-    """A validation case: its parameter class, runner and plotter."""
+    """A validation case: the module implementing it (``cosim.validation.<module>``, with its ``Params`` and
+    ``plot``), the name of its runner there, and a one-line summary."""
 
-    params: type
-    run: Callable[[Any], CaseResult]
-    plot: Callable[[CaseResult, Any], None]
+    module: str
+    runner: str
     summary: str
+
+    def implementation(self) -> ModuleType:
+        return importlib.import_module(f"{__name__}.{self.module}")
+
+    @property
+    def params(self) -> type:
+        return self.implementation().Params
+
+    @property
+    def run(self) -> Callable[[Any], CaseResult]:
+        return getattr(self.implementation(), self.runner)
+
+    @property
+    def plot(self) -> Callable[[CaseResult, Any], None]:
+        return self.implementation().plot
 
 
 CASES: dict[str, Case] = {
-    "hydrostatic": Case(hydrostatic.Params, hydrostatic.run, hydrostatic.plot, "resting tank: p = rho0 g (H - z)"),
-    "slosh": Case(slosh.Params, slosh.run, slosh.plot, "first sloshing mode vs seed Eq. 17"),
-    "dam-break": Case(dam_break.Params, dam_break.run, dam_break.plot, "surge front vs Martin & Moyce (1952)"),
-    "tilt": Case(moving_vessel.Params, moving_vessel.run_tilt, moving_vessel.plot, "full vessel tilted about its lip"),
-    "coupling-static": Case(
-        coupling_static.Params, coupling_static.run, coupling_static.plot, "held full vessel: reaction and joint torques"
-    ),
-    "shake": Case(moving_vessel.Params, moving_vessel.run_shake, moving_vessel.plot, "full vessel shaken at resonance"),
-    "free-fall": Case(free_fall.Params, free_fall.run, free_fall.plot, "outflow particles vs their free-fall parabolas (seed Eqs. 6-7)"),
+    "hydrostatic": Case("hydrostatic", "run", "resting tank: p = rho0 g (H - z)"),
+    "slosh": Case("slosh", "run", "first sloshing mode vs seed Eq. 17"),
+    "dam-break": Case("dam_break", "run", "surge front vs Martin & Moyce (1952)"),
+    "tilt": Case("moving_vessel", "run_tilt", "full vessel tilted about its lip"),
+    "coupling-static": Case("coupling_static", "run", "held full vessel: reaction and joint torques"),
+    "shake": Case("moving_vessel", "run_shake", "full vessel shaken at resonance"),
+    "free-fall": Case("free_fall", "run", "outflow particles vs their free-fall parabolas (seed Eqs. 6-7)"),
 }
 DEFAULT_CASES = ("hydrostatic", "slosh", "dam-break", "free-fall", "coupling-static")

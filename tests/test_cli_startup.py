@@ -1,0 +1,79 @@
+"""`cosim --help`, every subcommand's `--help` and refused input answer without loading the heavy libraries (each
+costs a second or more to import), and importing cosim changes nothing outside it."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from cosim.cli.main import SUBCOMMANDS
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("warp", "mujoco", "control", "scipy", "rerun")
+# Runs `cosim ARGS...` in this process, then prints its exit status and the heavy libraries it imported.
+PROBE = f"""
+import contextlib, io, sys
+from cosim.cli.main import main
+with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+    try:
+        status = main(sys.argv[1:])
+    except SystemExit as exc:
+        status = exc.code
+print(status, *sorted(name for name in {HEAVY!r} if name in sys.modules))
+"""
+
+
+def _probe(args: list[str]) -> list[str]:
+    done = subprocess.run([sys.executable, "-c", PROBE, *args], cwd=ROOT, capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert done.returncode == 0, done.stderr
+    return done.stdout.split()
+
+
+@pytest.fixture(scope="module")
+def bad_scene(tmp_path_factory) -> Path:
+    path = tmp_path_factory.mktemp("scenes") / "typo.toml"
+    path.write_text("[fluid]\nparticles_acros = 32\n")
+    return path
+
+
+@pytest.mark.parametrize("args", [["--help"], []] + [[name, "--help"] for name in SUBCOMMANDS],
+                         ids=lambda args: " ".join(args) or "no-args")
+def test_help_loads_no_heavy_library(args):
+    status, *loaded = _probe(args)
+    assert status in ("0", "2") and loaded == []
+
+
+@pytest.mark.parametrize("args", [["pour", "/nonexistent/scene.toml"], ["pour", "BAD"], ["scene", "--check", "BAD"],
+                                  ["pour", "--dim", "4"], ["view", "/nonexistent/run"]], ids=" ".join)
+def test_refused_input_loads_no_heavy_library(args, bad_scene):
+    status, *loaded = _probe([str(bad_scene) if a == "BAD" else a for a in args])
+    assert status == "2" and loaded == []
+
+
+def test_importing_cosim_sets_no_environment_variable_and_no_warp_option():
+    code = """
+import os, warp as wp
+before = {k: v for k, v in vars(wp.config).items() if not k.startswith("_")}
+import cosim, cosim.pour_run, cosim.cli.main, cosim.validation, cosim.stress.matrix
+after = {k: v for k, v in vars(wp.config).items() if not k.startswith("_")}
+print("OPENBLAS_CORETYPE" in os.environ, [k for k in before if before[k] != after.get(k)])
+"""
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_CORETYPE"} | {"PYTHONPATH": str(ROOT)}
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["False", "[]"]
+
+
+def test_the_pour_loads_the_kernel_modules_it_launches():
+    import cosim.pour_run  # noqa: F401  (imports what a pour launches kernels from)
+    from cosim.fluid.runtime import kernel_modules
+
+    modules = kernel_modules("cosim")
+    assert {"cosim.fluid.dfsph", "cosim.fluid.wcsph", "cosim.fluid.neighbors", "cosim.coupling.measure"} <= set(modules)
+    assert "cosim.fluid.sph_kernels" not in modules  # warp functions only: compiled into the kernels that call them
+    assert "cosim.fluid.solver" not in modules  # launches kernels it imports: compiled with the modules defining them

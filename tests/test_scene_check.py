@@ -1,0 +1,74 @@
+"""`cosim scene --check` runs the checks `cosim pour` runs before simulating (cosim.pour_checks.check_pour): the
+two refuse the same scenes with the same line and exit status 2, and write nothing; the estimate gates long runs."""
+
+from __future__ import annotations
+
+import json
+import time
+
+import pytest
+
+import cosim.fluid.memory
+from cosim.cli.main import main
+from cosim.pour_checks import LONG_RUN_S, SECONDS_PER_PARTICLE_STEP, check_pour, estimate_wall_time
+from cosim.pour_scene import PourScene
+
+REFUSED = {
+    "fill above the rim": ("[liquid]\nfill_depth = 0.5\n", "liquid.fill_depth: must be in (0, 0.191) m (below the pourer's rim)"),
+    "3-D needing hundreds of GB": ("[fluid]\ndim = 3\nparticles_across = 400\n", "need at least 285.3 GB, more than the 64.0 GB"),
+    "negative size": ("[liquid]\nfill_depth = -0.1\n", "liquid.fill_depth: must be in (0, 2] m, got -0.1"),
+    "unknown key": ("[fluid]\nparticles_acros = 32\n", "scene.fluid.particles_acros: unknown key"),
+    "joint limit of no arm": ("[trajectory.limits.'left_arm/elbow']\nmax_velocity = 1.0\n", "trajectory.limits.left_arm/elbow"),
+    "3-D estimated over an hour": ("[fluid]\ndim = 3\n", "pass --yes, or make it cheaper"),
+}
+
+
+def _refusal(capsys, argv: list[str], command: str) -> str:
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"cosim {command}: error: "), captured.err
+    return lines[0].removeprefix(f"cosim {command}: error: ")
+
+
+@pytest.mark.parametrize("case", REFUSED)
+def test_scene_check_and_pour_refuse_the_same_scene_with_the_same_line(case, tmp_path, capsys, monkeypatch):
+    toml, expected = REFUSED[case]
+    monkeypatch.chdir(tmp_path)  # a pour without --out would write under ./recordings
+    monkeypatch.setattr(cosim.fluid.memory, "available_bytes", lambda device: 64_000_000_000)  # not the live, moving value
+    (tmp_path / "scene.toml").write_text(toml)
+    start = time.perf_counter()
+    checked = _refusal(capsys, ["scene", "--check", "scene.toml"], "scene")
+    assert time.perf_counter() - start < 60.0  # seconds, not the minutes a fine 3-D liquid takes to seed
+    poured = _refusal(capsys, ["pour", "scene.toml", "--quiet"], "pour")
+    assert checked == poured and expected in checked
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml"]  # nothing written
+
+
+def test_yes_accepts_a_long_run_in_both_commands(tmp_path, capsys):
+    scene = tmp_path / "scene.toml"
+    scene.write_text("[fluid]\ndim = 3\n")
+    assert main(["scene", "--check", str(scene), "--yes"]) == 0
+    err = capsys.readouterr().err
+    assert "liquid particles (3-D" in err and "estimated wall time at most" in err and " h (" in err
+
+
+def test_the_estimate_is_particles_times_substeps_times_the_measured_cost():
+    plan = check_pour(PourScene(), long_run_ok=False)
+    assert plan.particles == 864  # 32 across x 27 layers: the default pour's count
+    assert plan.substeps == round(PourScene().coupling.max_duration / plan.fluid.fixed_time_step)
+    assert plan.wall_time == estimate_wall_time(plan.particles, plan.substeps) == pytest.approx(
+        plan.particles * plan.substeps * SECONDS_PER_PARTICLE_STEP)
+    assert plan.wall_time < LONG_RUN_S
+
+
+def test_pour_prints_the_checks_particle_count_and_estimate_before_its_first_step(tmp_path, capsys):
+    scene = tmp_path / "coarse.toml"
+    scene.write_text("[fluid]\nparticles_across = 8\n[logging]\nenabled = false\n[coupling]\nmax_duration = 0.05\n")
+    assert main(["scene", "--check", str(scene)]) == 0
+    checked = capsys.readouterr().err.strip().splitlines()
+    assert main(["pour", str(scene), "--out", str(tmp_path / "run")]) == 0
+    poured = capsys.readouterr().err.strip().splitlines()
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    assert len(checked) == 1 and poured[0] == checked[0]
+    assert checked[0].startswith(f"{summary['particles']} liquid particles (2-D")  # exact for a box in 2-D
