@@ -1,15 +1,10 @@
 """The same bits on every x86-64 machine with AVX2: numpy's OpenBLAS kernels pinned before numpy loads.
 
 numpy's OpenBLAS is built for many CPUs at once (DYNAMIC_ARCH) and picks its kernels for the CPU it runs on: CPUs
-with AVX-512 (Intel's, and AMD's Zen 4, such as the 2-core AMD EPYC these numbers come from) get its SkylakeX
-kernels, AVX2-only ones its Haswell kernels. Their results differ in the last bit, and a pour is chaotic: the
-controller's and the IK's small matrix products and solves differ in the last bit, and the pour that follows is
-another one. Measured on that EPYC (2026-12-04): the default pour's first 3 s under OpenBLAS's own choice (SkylakeX)
-and under ``OPENBLAS_CORETYPE`` = SkylakeX gave one series.csv, = Haswell another (that machine's environment sets
-``OPENBLAS_CORETYPE=Haswell``, so its documented numbers come from those kernels), = Prescott a third; the WCSPH
-default pour poured 2964 mL in 228,728 substeps under SkylakeX and 2968 mL in 230,643 under Haswell, the two results
-earlier sessions had found on different machines with the same code. warp's kernels built for other instruction sets
-and numpy without its AVX-512 paths changed nothing (README, Known limitations). So where the CPU has what the
+with AVX-512 get its SkylakeX kernels, AVX2-only ones its Haswell kernels. Their results differ in the last bit, and
+a pour is chaotic: the controller's and the IK's small matrix products and solves differ in the last bit, and the
+pour that follows is another one (docs/reproducibility.md has the pours measured under each). warp's kernels built
+for other instruction sets and numpy without its AVX-512 paths changed nothing. So where the CPU has what the
 Haswell kernels need (AVX2 and FMA), they are pinned. Slower kernels for large matrices cost nothing here (the
 matrices are a few rows by a few columns). This only works before numpy is first imported (OpenBLAS reads the
 variable once, when it loads), so the ``cosim`` command (:func:`cosim.cli.main.main`) and the test suite's
@@ -17,10 +12,8 @@ variable once, when it loads), so the ``cosim`` command (:func:`cosim.cli.main.m
 entry points, such as ``python -m cosim.bench.host_overhead``, run the kernels ``OPENBLAS_CORETYPE`` names in their
 environment). A user's own ``OPENBLAS_CORETYPE`` is left alone.
 
-The kernels' bits also change with OpenBLAS's version, which numpy's wheel bundles: the default pour under Python
-3.12 with numpy 2.4.6 (OpenBLAS 0.3.31) and with numpy 2.5.2 (OpenBLAS 0.3.34), Haswell kernels in both, gave two
-trajectories, and numpy 2.4.6 given 2.5.2's OpenBLAS library gave 2.5.2's bit for bit (2026-12-04). So
-:func:`blas_description` names the BLAS and its kernels beside the package versions a pour's summary records.
+The kernels' bits also change with OpenBLAS's version, which numpy's wheel bundles (two numpy releases with two
+OpenBLAS versions give two trajectories; docs/reproducibility.md). So :func:`blas_description` names the BLAS and its kernels beside the package versions a pour's summary records.
 """
 
 from __future__ import annotations

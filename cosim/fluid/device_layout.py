@@ -11,10 +11,8 @@ wrench reduction's 64 sequential chunks (4.8 ms) and integrate's atomics on one 
   (capacity x n) and passed transposed, so ``[i, k]`` of 32 consecutive particles is 32 consecutive addresses. The
   kernels are the same: a warp array's strides carry the layout. Slot-major helps the kernels that read the tables
   in lock step and slows the ones that write them and DFSPH's Gauss-Seidel sweeps (a colour runs a 27th of the
-  cells), so a solver that sweeps keeps a row per particle on CUDA too. Measured on an H200 (``python -m
-  cosim.bench.kernel_profile --pair-layouts rows columns``, 3-D at 1M particles, device ms a substep, rows against
-  columns): WCSPH 13.0 against 11.5, DFSPH with Jacobi iterations 65.3 against 42.2, with Gauss-Seidel sweeps
-  128.8 against 208.3.
+  cells), so a solver that sweeps keeps a row per particle on CUDA too (``python -m cosim.bench.kernel_profile
+  --pair-layouts rows columns`` compares the two; the figures are in docs/performance.md).
 - The wall wrench (a sum over every particle per vessel, in a fixed order): on the CPU :data:`WRENCH_CHUNKS`
   contiguous chunks; on CUDA levels of chunks of :data:`REDUCTION_ITEMS` interleaved items (chunk c sums items c,
   c + chunks, ...: consecutive threads read consecutive addresses), until few enough partial sums remain.
