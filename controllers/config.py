@@ -17,6 +17,13 @@ from controllers.pid import PidDesignSpec
 from controllers.slosh import GRAVITY, SloshModel, potential_flow_model
 
 
+class Handover(Enum):
+    """When SIM's damping phase t2 hands over to the constant-flow stage."""
+
+    DAMPED = "damped"  # once the slosh is damped (|sigma| small for a dwell) or after the timeout
+    CREST = "crest"  # the paper's rule: as soon as liquid runs over the crest (h_q > 0), else as DAMPED
+
+
 class SimMode(Enum):
     """When the slosh induction method runs."""
 
@@ -46,6 +53,16 @@ class SimConfig:
     settle_tolerance: rad, |sigma| below which the slosh counts as damped. (0, 0.2]
     settle_dwell: s, how long |sigma| must stay below the tolerance before t3. [0, 5]
     max_tilt_rate: rad/s, rate limit of the PID's output. (0, 10]
+    handover: :class:`Handover`. ``crest`` (the default) is the paper's t3: CFS starts as the induced wave runs over
+      the crest, and t2 damps toward the tilt that pours at cfs.h_q_ref; on the coupled pour the PID then acts for
+      under a slosh period. ``damped`` holds the level damp_head below the crest until the slosh is damped: it
+      damps the SPH liquid on an arm that tracks its commands (ideal force-torque compensation) but not yet on the
+      default, payload-compensated arm (docs/controller.md).
+    damp_head: m, height over the crest at which t2 holds the resting liquid (negative: below the crest). The PID
+      acts on the pendulum plant only while the slosh stays inside the vessel: once liquid runs over the crest, the
+      crest clamps the surface and theta1 no longer follows Gp. Holding the level below the crest by the wall rise
+      (B/2) tan(sigma) of the induced wave keeps it in: 5 mm is that rise for sigma = 3 deg in the paper's vessel.
+      t2 then ends once the slosh is damped, and CFS starts the outflow from a calm liquid. [-0.05, 0.05]
     pid: :class:`controllers.pid.PidDesignSpec`.
     """
 
@@ -58,6 +75,8 @@ class SimConfig:
     settle_tolerance: float = 0.01
     settle_dwell: float = 0.25
     max_tilt_rate: float = 2.0
+    handover: Handover = Handover.CREST
+    damp_head: float = -0.005
     pid: PidDesignSpec = field(default_factory=PidDesignSpec)
 
     def __post_init__(self) -> None:
@@ -70,6 +89,8 @@ class SimConfig:
         check_range("sim.settle_tolerance", self.settle_tolerance, 0.0, 0.2, "rad", lo_open=True)
         check_range("sim.settle_dwell", self.settle_dwell, 0.0, 5.0, "s")
         check_range("sim.max_tilt_rate", self.max_tilt_rate, 0.0, 10.0, "rad/s", lo_open=True)
+        object.__setattr__(self, "handover", check_choice("sim.handover", self.handover, Handover))
+        check_range("sim.damp_head", self.damp_head, -0.05, 0.05, "m")
         _check_type("sim.pid", self.pid, PidDesignSpec)
 
 

@@ -113,6 +113,9 @@ class PourCommand:
       Before the outflow starts: the prediction for the weir velocity at h_q_ref from the current lip. Once the
       pour is over (return, done) and nothing flows: the last target, held.
     slosh_angle: rad, the measured sigma = theta1 - tilt.
+    feedback: the pourer's target is a feedback command whose timing matters (the slosh damping, SIM_DAMP), already
+      smoothed by the controller (:class:`controllers.motion.CriticallyDampedSmoother`): it goes to the arm without
+      further smoothing lag.
     """
 
     t: float
@@ -122,6 +125,7 @@ class PourCommand:
     reason: str
     landing_x: float
     slosh_angle: float
+    feedback: bool = False
 
     @property
     def done(self) -> bool:

@@ -43,6 +43,36 @@ class RateLimitedTracker:
         return abs(target - self.position) <= tol and abs(self.velocity) <= self.max_accel * self.dt
 
 
+class CriticallyDampedSmoother:
+    """Two first-order low-passes in series at a fixed sample time: y1 += a (x - y1), y2 += a (y1 - y2),
+    a = 1 - exp(-bandwidth dt); output y2. A linear, amplitude-independent smoother (unlike a limit-based one),
+    whose transfer function (:meth:`transfer_function_coefficients`) a feedback design can include: its low-frequency
+    delay is 2 / bandwidth and its output's acceleration stays bounded for bounded input steps.
+    ``bandwidth`` in rad/s, ``dt`` in s; units of x and y are the caller's.
+    """
+
+    def __init__(self, bandwidth: float, dt: float) -> None:
+        check_range("smoother.bandwidth", bandwidth, 0.0, None, "rad/s", lo_open=True)
+        check_range("smoother.dt", dt, 0.0, 1.0, "s", lo_open=True)
+        self.gain = 1.0 - math.exp(-bandwidth * dt)
+        self._first = self._second = 0.0
+
+    def reset(self, value: float) -> None:
+        """Both stages at rest at ``value``."""
+        self._first = self._second = float(value)
+
+    def step(self, x: float) -> float:
+        """One sample of input ``x``; returns the smoothed output."""
+        self._first += self.gain * (x - self._first)
+        self._second += self.gain * (self._first - self._second)
+        return self._second
+
+    def transfer_function_coefficients(self) -> tuple[list[float], list[float]]:
+        """(numerator, denominator) in z, highest power first: a^2 z^2 / (z - (1 - a))^2."""
+        a = self.gain
+        return [a * a, 0.0, 0.0], [1.0, -2.0 * (1.0 - a), (1.0 - a) ** 2]
+
+
 def stop_time(distance: float, max_rate: float, max_accel: float) -> float:
     """Time (s) to travel ``distance`` from rest with the rate and acceleration limits (accelerate, cruise)."""
     d = abs(distance)

@@ -34,6 +34,7 @@ import numpy as np
 
 from controllers.checks import check_range
 from controllers.errors import ControllerInputError
+from controllers.motion import CriticallyDampedSmoother
 from controllers.slosh import SloshModel
 
 if TYPE_CHECKING:  # python-control (and scipy) take seconds to load: imported by the functions that use them,
@@ -108,15 +109,20 @@ class PidDesignSpec:
       verify to better than 1e-4); not set: searched with the bandwidth over :data:`DAMPING_RATIOS`.
     bandwidth_ratio: wn / omega1, [0.3, 3]; not set: searched over :data:`BANDWIDTH_RATIOS`. The search keeps the
       pair whose sampled loop with the delay decays fastest within the margins.
-    actuation_delay: s, from the tilt command to the vessel's tilt, rounded up to whole control periods in the
-      design. [0, 0.5] The default is the lag of the arms' joint generators and servos alone; the coupled pour's
-      task-space filter adds an amplitude-dependent lag at the slosh frequency (docs/controller.md).
+    smoothing_bandwidth: rad/s, of the linear smoother between the PID and the arm
+      (:class:`controllers.motion.CriticallyDampedSmoother`; its delay 2 / bandwidth). It keeps the arm's path
+      smooth (no step-to-step jerk from the sampled PID) with a known transfer function that the design includes.
+      [5, 1000]
+    actuation_delay: s, from the smoothed tilt command to the vessel's tilt (the arms' joint generators and servos),
+      rounded up to whole control periods in the design. [0, 0.5] The default is the coupled pour's, fitted from
+      its series (docs/controller.md).
     min_gain_margin: dB. [0, 40]   min_phase_margin: deg. [0, 90]
     """
 
     damping: float | None = None
     bandwidth_ratio: float | None = None
-    actuation_delay: float = 0.02
+    smoothing_bandwidth: float = 60.0
+    actuation_delay: float = 0.04
     min_gain_margin: float = 6.0
     min_phase_margin: float = 45.0
 
@@ -125,6 +131,7 @@ class PidDesignSpec:
             check_range("pid.damping", self.damping, 0.3, 0.95)
         if self.bandwidth_ratio is not None:
             check_range("pid.bandwidth_ratio", self.bandwidth_ratio, 0.3, 3.0)
+        check_range("pid.smoothing_bandwidth", self.smoothing_bandwidth, 5.0, 1000.0, "rad/s")
         check_range("pid.actuation_delay", self.actuation_delay, 0.0, 0.5, "s")
         check_range("pid.min_gain_margin", self.min_gain_margin, 0.0, 40.0, "dB")
         check_range("pid.min_phase_margin", self.min_phase_margin, 0.0, 90.0, "deg")
@@ -141,9 +148,11 @@ class PidDesignSpec:
 class PidDesign:
     """A filtered PID for one plant, with its verified closed loop.
 
-    closed_loop_poles: rad/s, from python-control's feedback(C Gp, 1) (no delay). min_damping: smallest
-    -Re(p)/|p| over them. settling_time: s, 2 % band of that closed-loop step response. With a sample time ``dt``:
+    closed_loop_poles: rad/s, from python-control's feedback(C Gp, 1) (continuous, no smoother, no delay).
+    min_damping: smallest -Re(p)/|p| over them, and settling_time (s, 2 % band of that closed-loop step response),
+    for a placed design (nan for a searched one, which is judged on its sampled loop). With a sample time ``dt``:
     delay_steps, the actuation delay in control periods; discrete_poles, the z-plane poles of :func:`delayed_loop`
+    (with the smoother and the delay, :func:`actuator`)
     in unity feedback; decay_rate (1/s), -ln(max |z|) / dt, the slowest closed-loop decay; gain_margin (dB) and
     phase_margin (deg) of that loop (python-control's stability_margins).
     """
@@ -191,11 +200,26 @@ def _pole_mismatch(poles: np.ndarray, target: np.ndarray) -> float:
     return worst
 
 
-def delayed_loop(gains: PidGains, model: SloshModel, dt: float, delay_steps: int) -> ct.TransferFunction:
-    """The open loop C(z) Gz(z) z^-delay_steps the controller closes at sample time ``dt`` (s)."""
+Actuator = tuple[list[float], list[float]]  # (numerator, denominator) in z of the chain from PID output to tilt
+
+
+def actuator(spec: PidDesignSpec, dt: float) -> Actuator:
+    """The chain from the PID's output to the vessel's tilt at sample time ``dt`` (s): the smoother's F(z)
+    (:class:`controllers.motion.CriticallyDampedSmoother`) times z^-n, n = the actuation delay in whole periods."""
+    num, den = CriticallyDampedSmoother(spec.smoothing_bandwidth, dt).transfer_function_coefficients()
+    return num, list(np.polymul(den, [1.0] + [0.0] * delay_steps_of(spec, dt)))
+
+
+def delay_steps_of(spec: PidDesignSpec, dt: float) -> int:
+    """The actuation delay in whole control periods, rounded up."""
+    return math.ceil(spec.actuation_delay / dt - 1e-9)
+
+
+def delayed_loop(gains: PidGains, model: SloshModel, dt: float, chain: Actuator) -> ct.TransferFunction:
+    """The open loop C(z) A(z) Gz(z) the controller closes at sample time ``dt`` (s), A the actuation ``chain``."""
     import control as ct
 
-    return gains.discrete_tf(dt) * sampled_plant(model, dt) * ct.tf([1.0], [1.0] + [0.0] * delay_steps, dt)
+    return gains.discrete_tf(dt) * sampled_plant(model, dt) * ct.tf(chain[0], chain[1], dt)
 
 
 def place_filtered_pid(model: SloshModel, target: np.ndarray) -> PidGains | None:
@@ -221,14 +245,14 @@ def place_filtered_pid(model: SloshModel, target: np.ndarray) -> PidGains | None
     return PidGains(kp=float(kp), ki=float(w), kd=float(u - kp * tf), tf=float(tf))
 
 
-def delayed_loop_figures(gains: PidGains, model: SloshModel, dt: float, delay_steps: int) -> tuple[float, float, float]:
+def delayed_loop_figures(gains: PidGains, model: SloshModel, dt: float, chain: Actuator) -> tuple[float, float, float]:
     """(decay rate 1/s, gain margin dB, phase margin deg) of :func:`delayed_loop` in unity feedback: -ln(max |z|)/dt
     over the closed-loop poles (-inf if unstable); the margins from python-control's crossings as distances from
     the critical point: the gain margin closest to 0 dB (up or down) over every phase crossover, the phase margin
     closest to 0 over every gain crossover (inf where the loop has none)."""
     import control as ct
 
-    loop = delayed_loop(gains, model, dt, delay_steps)
+    loop = delayed_loop(gains, model, dt, chain)
     radius = float(np.max(np.abs(ct.poles(ct.feedback(loop, 1)))))
     if radius >= 1.0:
         return -math.inf, -math.inf, -math.inf
@@ -238,7 +262,7 @@ def delayed_loop_figures(gains: PidGains, model: SloshModel, dt: float, delay_st
     return -math.log(radius) / dt, gm_db, pm
 
 
-def _fast_loop_figures(gains: PidGains, plant: tuple[np.ndarray, np.ndarray], dt: float, delay_steps: int,
+def _fast_loop_figures(gains: PidGains, plant: tuple[np.ndarray, np.ndarray], dt: float, chain: Actuator,
                        frequencies: np.ndarray) -> tuple[float, float, float]:
     """:func:`delayed_loop_figures` in numpy, for the design search: closed-loop roots of den + num, and the margins
     from the loop's response at ``frequencies`` (rad/sample) as python-control defines them (the gain margin closest
@@ -247,8 +271,8 @@ def _fast_loop_figures(gains: PidGains, plant: tuple[np.ndarray, np.ndarray], dt
     c_num = np.polyadd(np.polyadd(np.polymul([k.kp], np.polymul([1.0, -1.0], [k.tf + t, -k.tf])),
                                   np.polymul([k.ki * t], [k.tf + t, -k.tf])), np.polymul([k.kd, -k.kd], [1.0, -1.0]))
     c_den = np.polymul([1.0, -1.0], [k.tf + t, -k.tf])
-    num = np.polymul(c_num, plant[0])
-    den = np.polymul(np.polymul(c_den, plant[1]), [1.0] + [0.0] * delay_steps)
+    num = np.polymul(np.polymul(c_num, plant[0]), chain[0])
+    den = np.polymul(np.polymul(c_den, plant[1]), chain[1])
     radius = float(np.max(np.abs(np.roots(np.polyadd(den, num)))))
     if not radius < 1.0:
         return -math.inf, -math.inf, -math.inf
@@ -267,7 +291,7 @@ def _crossings(values: np.ndarray) -> np.ndarray:
     return np.flatnonzero(change & (np.abs(values[1:] - values[:-1]) < math.pi))
 
 
-def _search(model: SloshModel, spec: PidDesignSpec, dt: float, delay_steps: int) -> tuple[PidGains, np.ndarray]:
+def _search(model: SloshModel, spec: PidDesignSpec, dt: float, chain: Actuator) -> tuple[PidGains, np.ndarray]:
     """The gains whose delayed sampled loop decays fastest within the spec's margins: the best pole placement over
     the damping and bandwidth grid, refined by Nelder-Mead on (kp, ki, kd, ln tf) with the margins as penalties.
     Returns the gains and the placement's target poles it started from."""
@@ -278,7 +302,7 @@ def _search(model: SloshModel, spec: PidDesignSpec, dt: float, delay_steps: int)
     frequencies = np.linspace(1e-4, math.pi, 3000)
 
     def score(gains: PidGains) -> float:
-        decay, gm, pm = _fast_loop_figures(gains, plant, dt, delay_steps, frequencies)
+        decay, gm, pm = _fast_loop_figures(gains, plant, dt, chain, frequencies)
         shortfall = (max(spec.min_gain_margin + SEARCH_SLACK_DB - gm, 0.0)
                      + max(spec.min_phase_margin + SEARCH_SLACK_DEG - pm, 0.0) / 10.0)
         return -decay + SEARCH_PENALTY * shortfall if math.isfinite(decay) else math.inf
@@ -322,9 +346,10 @@ def design_filtered_pid(model: SloshModel, spec: PidDesignSpec = PidDesignSpec()
     searched = dt is not None and (spec.damping is None or spec.bandwidth_ratio is None)
     if dt is not None:
         check_range("control_rate period", dt, 0.0, 0.1, "s", lo_open=True)
-    delay_steps = math.ceil(spec.actuation_delay / dt - 1e-9) if dt is not None else 0
+    delay_steps = delay_steps_of(spec, dt) if dt is not None else 0
+    chain = actuator(spec, dt) if dt is not None else None
     if searched:
-        gains, target = _search(model, spec, dt, delay_steps)
+        gains, target = _search(model, spec, dt, chain)
     else:
         target = spec.target_poles(model.omega1, spec.damping or 0.7, spec.bandwidth_ratio or 1.0)
         gains = place_filtered_pid(model, target)
@@ -333,18 +358,20 @@ def design_filtered_pid(model: SloshModel, spec: PidDesignSpec = PidDesignSpec()
 
     loop = ct.feedback(gains.transfer_function() * model.plant(), 1)
     poles = np.sort_complex(ct.poles(loop))
-    if not searched and (poles.size != 4 or _pole_mismatch(poles, target) > POLE_MATCH_RTOL * float(np.max(np.abs(target)))):
-        raise ControllerInputError(f"pid: closed-loop poles {poles} differ from the targets {target}")
-    if np.max(poles.real) >= 0.0:
-        raise ControllerInputError(f"pid: closed loop is unstable, poles {poles}")
-    min_damping = float(np.min(-poles.real / np.abs(poles)))
-    horizon = np.linspace(0.0, 20.0 / float(np.min(-poles.real)), 4001)
-    settling = float(ct.step_info(loop, T=horizon, SettlingTimeThreshold=SETTLING_BAND)["SettlingTime"])
+    min_damping = settling = math.nan
+    if not searched:  # the placed continuous loop is the design; a searched one is judged on its sampled loop below
+        if poles.size != 4 or _pole_mismatch(poles, target) > POLE_MATCH_RTOL * float(np.max(np.abs(target))):
+            raise ControllerInputError(f"pid: closed-loop poles {poles} differ from the targets {target}")
+        if np.max(poles.real) >= 0.0:
+            raise ControllerInputError(f"pid: closed loop is unstable, poles {poles}")
+        min_damping = float(np.min(-poles.real / np.abs(poles)))
+        horizon = np.linspace(0.0, 20.0 / float(np.min(-poles.real)), 4001)
+        settling = float(ct.step_info(loop, T=horizon, SettlingTimeThreshold=SETTLING_BAND)["SettlingTime"])
     if dt is None:
         return PidDesign(gains, model, target, poles, min_damping, settling, dt, None)
 
-    dpoles = ct.poles(ct.feedback(delayed_loop(gains, model, dt, delay_steps), 1))
-    decay, gm_db, pm = delayed_loop_figures(gains, model, dt, delay_steps)
+    dpoles = ct.poles(ct.feedback(delayed_loop(gains, model, dt, chain), 1))
+    decay, gm_db, pm = delayed_loop_figures(gains, model, dt, chain)
     if np.max(np.abs(dpoles)) >= 1.0:
         raise ControllerInputError(
             f"control_rate: {1.0 / dt:g} Hz with an actuation delay of {spec.actuation_delay:g} s is too slow for the "

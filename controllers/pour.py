@@ -31,11 +31,11 @@ import numpy as np
 
 from controllers.catcher import CatcherFollower, landing_x, weir_velocity
 from controllers.cfs import after_flow_volume, cfs_increment, cfs_pivot, crest_lever
-from controllers.config import PourConfig, SimMode
+from controllers.config import Handover, PourConfig, SimMode
 from controllers.errors import ControllerInputError, MeasurementError
 from controllers.geometry import PlanarPose, static_tilt_for_h_q
 from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
-from controllers.motion import RateLimitedTracker, fitted_delay
+from controllers.motion import CriticallyDampedSmoother, RateLimitedTracker, fitted_delay
 from controllers.pid import DiscretePid, PidDesign, design_filtered_pid
 from controllers.slosh_induction import excitation_duration, excitation_tilt, sim_needed
 
@@ -78,9 +78,11 @@ class PourController:
             self.entry_reason = f"sim.mode = {sim.mode.value}"
         self.pid_design: PidDesign | None = None
         self._pid: DiscretePid | None = None
+        self._smoother: CriticallyDampedSmoother | None = None  # between the PID and the arm (SIM_DAMP)
         if self.use_sim:
             self.pid_design = design_filtered_pid(self.model, sim.pid, self.dt)
             self._pid = DiscretePid(self.pid_design.gains, self.dt, 0.0, config.cfs.max_tilt, sim.max_tilt_rate)
+            self._smoother = CriticallyDampedSmoother(sim.pid.smoothing_bandwidth, self.dt)
         self.sim_frequency = sim.frequency_ratio * self.model.omega1  # alpha, rad/s
         self.sim_amplitude = math.nan  # phi, rad; set from the first measurement's volume
         self._approach = RateLimitedTracker(config.approach.max_rate, config.approach.max_accel, self.dt)
@@ -183,6 +185,7 @@ class PourController:
             reason=self.reason,
             landing_x=self._catcher.target_dx + self.config.catcher.home_x if landing is None else landing,
             slosh_angle=m.slosh_angle,
+            feedback=self.phase is Phase.SIM_DAMP,
         )
 
     # ---- bookkeeping ------------------------------------------------------------------------------------------
@@ -206,9 +209,10 @@ class PourController:
         if phase is Phase.SIM_HOLD:
             self._sigma_prev = m.slosh_angle
         elif phase is Phase.SIM_DAMP:
-            assert self._pid is not None
+            assert self._pid is not None and self._smoother is not None
             self._reference = self._damp_reference(m)
             self._pid.reset(u0=self.pose.theta, y0=m.theta1, r0=self._reference)
+            self._smoother.reset(self.pose.theta)
         elif phase is Phase.APPROACH:
             self._reference = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
             self._approach.reset(self.pose.theta)
@@ -231,9 +235,11 @@ class PourController:
         return m.t - self._phase_start
 
     def _damp_reference(self, m: LiquidMeasurement) -> float:
-        """Tilt (rad) at which the current liquid, at rest, would stand h_q_ref over the crest."""
-        cfs = self.config.cfs
-        return min(static_tilt_for_h_q(self.config.vessel, cfs.h_q_ref, self._area(m)), cfs.max_tilt)
+        """Tilt (rad) at which the current liquid, at rest, would stand sim.damp_head over the crest (h_q_ref with
+        the paper's crest hand-over, which damps toward the pouring tilt)."""
+        cfs, sim = self.config.cfs, self.config.sim
+        head = cfs.h_q_ref if sim.handover is Handover.CREST else sim.damp_head
+        return min(static_tilt_for_h_q(self.config.vessel, head, self._area(m)), cfs.max_tilt)
 
     def _head_reference(self, phase: Phase) -> float:
         """h_q (m) that CFS holds in ``phase``: h_q_ref, or its final_head_fraction in a partial pour's final stage."""
@@ -253,9 +259,11 @@ class PourController:
             lever = crest_lever(self.config.vessel, self.pose.theta, self._area(m))
             ret = self.config.returning
             lag = self._lag()
-            after = after_flow_volume(
-                self._outflow_rate, self._h_q, lever, ret.max_rate, ret.max_accel, self._tilt_rate, lag
-            )
+            # Nothing over the crest now: the return only lowers the head, nothing more leaves. (The filtered rate and
+            # head both decay after an earlier spill, and their ratio rate / head^(3/2), which the prediction scales
+            # by, grows without bound as they do.)
+            head = self._h_q if m.h_q > 0.0 else 0.0
+            after = after_flow_volume(self._outflow_rate, head, lever, ret.max_rate, ret.max_accel, self._tilt_rate, lag)
             after = min(after, m.volume_in_pourer)  # what is there is the most that can still leave
             to_go = target - m.poured_volume - after
             if to_go <= 0.0:
@@ -301,12 +309,9 @@ class PourController:
         stop = self._check_stop(m)
         if stop:
             return stop
-        if m.h_q > 0.0:
-            # "at the beginning of t3, where the slosh finds free exit to flow out of the vessel, AFS will end and
-            # CFS will begin" (paper Sec. 3.1). From here the crest clamps the surface, theta1 no longer follows
-            # the pendulum plant Gp, and a PID on theta1 would keep tilting into the outflow.
-            return Phase.CFS, f"t3: the slosh found free exit over the crest (h_q = {1e3 * m.h_q:.2f} mm)"
         sim = self.config.sim
+        if sim.handover is Handover.CREST and m.h_q > 0.0:
+            return Phase.CFS, f"t3: the slosh found free exit over the crest (h_q = {1e3 * m.h_q:.2f} mm)"
         if abs(m.slosh_angle) > sim.settle_tolerance:
             self._since = math.nan
         elif math.isnan(self._since):
@@ -371,9 +376,9 @@ class PourController:
         return self.pose.rotated_about((0.0, 0.0), theta)
 
     def _act_damp(self, m: LiquidMeasurement) -> PlanarPose:
-        assert self._pid is not None
+        assert self._pid is not None and self._smoother is not None
         self._reference = self._damp_reference(m)
-        return self.pose.rotated_about((0.0, 0.0), self._pid.step(self._reference, m.theta1))
+        return self.pose.rotated_about((0.0, 0.0), self._smoother.step(self._pid.step(self._reference, m.theta1)))
 
     def _act_approach(self, m: LiquidMeasurement) -> PlanarPose:
         theta = self._approach.step(self._reference)

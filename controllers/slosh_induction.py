@@ -4,11 +4,13 @@ Timeline (Fig. 7), run by :class:`controllers.pour.PourController` about the cen
   t0  excitation theta = phi sin(alpha t) until theta = phi (a quarter period, pi / (2 alpha));
   t1  hold theta = phi until the slosh angle sigma = theta1 - theta crosses zero toward the lip (the induced wave
       runs toward the lip with its largest speed);
-  t2  PID damping of theta1 (:mod:`controllers.pid`) toward the tilt at which the resting liquid would stand
-      h_ref over the crest;
-  t3  hand-over to the constant-flow stage when "the slosh finds free exit to flow out of the vessel" (liquid
-      over the crest, h_q > 0), or once |sigma| stays small, or after a timeout. On the SPH liquid the first is
-      what happens: the induced wave reaches the crest within about a slosh period of t2's start.
+  t2  PID damping of theta1 (:mod:`controllers.pid`, through the smoother it is designed with) toward the tilt at
+      which the resting liquid would stand sim.damp_head (below the crest) over the crest;
+  t3  hand-over to the constant-flow stage once |sigma| has stayed within sim.settle_tolerance for
+      sim.settle_dwell, or after a timeout. The paper hands over when "the slosh finds free exit to flow out of the
+      vessel" (h_q > 0); from then the crest clamps the surface and theta1 no longer follows Gp, so the PID would
+      not be damping the plant it was designed on. Here the slosh is damped below the crest first, and CFS starts
+      the outflow from a calm liquid.
 
 Fill condition. The seed runs SIM when "h_e <= h_q at theta = 20 deg". Read literally (h_q = 5 mm) it would
 exclude the seed's own vessel. Implemented reading (reference README): SIM is needed when the liquid would reach

@@ -1,12 +1,14 @@
-"""The catcher: landing point from the free-fall parabola (seed Eqs. 6-7) and rate-limited following."""
+"""The catcher: landing point from the free-fall parabola (paper Eqs. 6-7) and rate-limited following; the motion
+helpers it shares with the controller."""
 
 import math
 
+import control as ct
 import numpy as np
 import pytest
 
 from controllers.catcher import CatcherFollower, fall_time, landing_x, weir_velocity
-from controllers.motion import RateLimitedTracker, fitted_delay, stop_time
+from controllers.motion import CriticallyDampedSmoother, RateLimitedTracker, fitted_delay, stop_time
 from controllers.slosh import GRAVITY
 
 EXACT = 1e-12  # m: closed-form identities in float64
@@ -89,3 +91,19 @@ def test_fitted_delay_of_a_delayed_ramp_and_of_a_still_command() -> None:
     response = np.interp(t - 0.08, t, command)
     assert fitted_delay(t, command, response, 0.3, 0.005) == pytest.approx(0.08, abs=1e-9)
     assert fitted_delay(t, np.full_like(t, 0.2), np.full_like(t, 0.2), 0.3, 0.005) == 0.0
+
+
+def test_smoother_is_its_transfer_function() -> None:
+    """CriticallyDampedSmoother's output equals the response of its stated F(z) = a^2 z^2 / (z - (1 - a))^2, and it
+    follows a step to within 1e-6 after 20 / bandwidth."""
+    dt, bandwidth = 0.01, 60.0
+    smoother = CriticallyDampedSmoother(bandwidth, dt)
+    rng = np.random.default_rng(3)
+    x = rng.normal(0.0, 0.01, 200)
+    y = np.array([smoother.step(v) for v in x])
+    num, den = smoother.transfer_function_coefficients()
+    _, y_tf = ct.forced_response(ct.tf(num, den, dt), T=np.arange(x.size) * dt, U=x)
+    assert np.allclose(y, y_tf, rtol=1e-9, atol=1e-15)
+    smoother.reset(0.0)
+    steps = [smoother.step(1.0) for _ in range(int(20.0 / bandwidth / dt) + 1)]
+    assert abs(steps[-1] - 1.0) < 1e-6

@@ -1,4 +1,4 @@
-"""The model figures (seed Figs. 13-16) render from the command line."""
+"""The model figures (the paper's Figs. 13-16) render from the command line, on either slosh model."""
 
 from pathlib import Path
 
@@ -9,8 +9,9 @@ from controllers.figures import main
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
-def test_figures_are_written(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["--out", str(tmp_path)]) == 0
+@pytest.mark.parametrize("plant", ["potential-flow", "printed-paper"])
+def test_figures_are_written(tmp_path: Path, capsys: pytest.CaptureFixture[str], plant: str) -> None:
+    assert main(["--out", str(tmp_path), "--plant", plant]) == 0
     names = sorted(p.name for p in tmp_path.iterdir())
     assert names == [
         "fig13_theta1_ratio.png",
@@ -21,4 +22,5 @@ def test_figures_are_written(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     for name in names:
         assert (tmp_path / name).read_bytes()[:8] == PNG_MAGIC
     out = capsys.readouterr().out
-    assert "closed-loop poles (rad/s):" in out and "settling time" in out
+    assert "closed-loop poles (rad/s):" in out and "gain margin" in out and "phase margin" in out
+    assert ("potential flow" if plant == "potential-flow" else "as printed") in out

@@ -43,3 +43,15 @@ def test_a_ramp_is_followed_with_a_bounded_lag() -> None:
         lags.append(target - f(PlanarPose(0.0, 0.0, target)).theta)
     assert max(lags[100:]) <= lag_bound
     assert min(lags) >= -1e-9  # each target is one to stop at: never ahead of the ramp
+
+
+def test_pass_through_returns_the_command_and_filtering_resumes_from_its_motion() -> None:
+    """A feedback command passes unchanged; afterwards the filter starts from the passed path's position and rate,
+    so the first filtered pose continues it instead of jumping back to where the filter was."""
+    f = _filter()
+    rate = 0.2  # rad/s, a slow ramp, as the smoothed PID command moves
+    passed = [f(PlanarPose(0.0, 0.0, rate * k * PERIOD), pass_through=True).theta for k in range(50)]
+    assert passed == [rate * k * PERIOD for k in range(50)]
+    resumed = f(PlanarPose(0.0, 0.0, rate * 50 * PERIOD)).theta
+    # continues from 49 * rate * PERIOD at about the ramp's rate: within a tenth of one period's travel
+    assert abs(resumed - rate * 50 * PERIOD) <= 0.1 * rate * PERIOD

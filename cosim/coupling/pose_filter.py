@@ -70,14 +70,28 @@ class PoseFilter:
         arm = ArmLimits(name, "task space", tuple(joint(c) for c in coordinates))
         settings = GeneratorSettings(cycle_time=control_period, control_period=control_period)
         self._generator = TrajectoryGenerator(arm, np.zeros(len(coordinates)), settings)
+        self._period = control_period
+        self._passed: list[np.ndarray] = []  # the last pass-through targets (at most three), for their rates
 
-    def __call__(self, target: PlanarPose) -> PlanarPose:
-        """The smoothed pose one control period after the previous call, heading for ``target``."""
+    def __call__(self, target: PlanarPose, pass_through: bool = False) -> PlanarPose:
+        """The smoothed pose one control period after the previous call, heading for ``target``; with
+        ``pass_through`` the target itself (a command the controller has already smoothed, whose timing matters:
+        the slosh damping's feedback), the filter's own state following it (its rates from the last three
+        targets) so that filtering resumes from where the path is."""
+        values = np.array([getattr(target, c) for c in self.coordinates])
+        if pass_through:
+            self._passed = (self._passed + [values])[-3:]
+            rates = np.diff(self._passed, axis=0) / self._period
+            velocity = rates[-1] if len(rates) else np.zeros_like(values)
+            acceleration = (rates[-1] - rates[-2]) / self._period if len(rates) > 1 else np.zeros_like(values)
+            self._generator.reset(values, velocity, acceleration)
+            return target
+        self._passed = []
         # Each target is one to come to rest at. Estimating a path velocity from the targets (what the joint
         # generators do with the already smooth output of this filter) reads the controller's step-to-step
         # corrections of either sign as velocity and drove a +-0.1 rad limit cycle of the tilt in the coupled pour.
         zero = np.zeros(len(self.coordinates))
-        self._generator.set_target(np.array([getattr(target, c) for c in self.coordinates]), zero, zero)
+        self._generator.set_target(values, zero, zero)
         q, _, _ = self._generator.step()
         values = dict(zip(self.coordinates, map(float, q)))
         return PlanarPose(values.get("dx", 0.0), values.get("dz", 0.0), values.get("theta", 0.0))

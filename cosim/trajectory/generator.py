@@ -338,6 +338,26 @@ class TrajectoryGenerator:
             lo, hi = (lo, mid) if self._reachable(mid) else (mid, hi)
         return hi
 
+    def reset(self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> None:
+        """Put the generator at the state ``(q, qd, qdd)`` (n,) (rad, rad/s, rad/s^2), at rest on it as a target, for a
+        caller that moved the path itself for a while (the task-space filter's pass-through); velocity and
+        acceleration are clipped to the limits, positions to the joint range. The next :meth:`set_target` starts a
+        new target stream from that state."""
+        n = len(self.limits.joints)
+        q = np.clip(_vector(f"{self.limits.arm}: reset position", q, n), self._lo, self._hi)
+        qd = np.clip(_vector(f"{self.limits.arm}: reset velocity", qd, n), -self._vmax, self._vmax)
+        qdd = np.clip(_vector(f"{self.limits.arm}: reset acceleration", qdd, n), -self._amax, self._amax)
+        inp = self._input
+        inp.control_interface = ruckig.ControlInterface.Position
+        inp.minimum_duration = None
+        inp.current_position, inp.current_velocity, inp.current_acceleration = list(q), list(qd), list(qdd)
+        inp.target_position, inp.target_velocity, inp.target_acceleration = list(q), [0.0] * n, [0.0] * n
+        self._state = (q.copy(), qd.copy(), qdd.copy())
+        self._path = self._state
+        self._path_floats = tuple(a.tolist() for a in self._path)
+        self._history_steps, self._history_q = [], []
+        self._new_target = True
+
     def hold(self) -> None:
         """Brake to rest, jerk-limited, wherever the arm gets to (ruckig's velocity interface, time-optimal); the next
         :meth:`set_target` starts a new target stream."""
