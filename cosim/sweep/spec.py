@@ -34,6 +34,7 @@ from cosim.errors import InputError
 MODES = ("grid", "sample")
 MAX_POURS = 100_000  # more pours than any cluster runs in one sweep: a typo (a range's num) is refused early
 TOP_LEVEL_KEYS = ("scene", "mode", "samples", "seed", "axes")
+RANGE_DIGITS = 12  # significant digits of a range's float values: clears linspace's last-bit noise
 
 
 @dataclass(frozen=True)
@@ -108,7 +109,8 @@ def _number(field: str, value: Any) -> float | int:
 
 def _range_values(field: str, table: dict) -> tuple:
     """``num`` evenly spaced values from ``start`` to ``stop``, both included; integers where both ends are integers
-    and every step is a whole number (a range of particle counts stays a range of integers)."""
+    and every step is a whole number (a range of particle counts stays a range of integers), else floats rounded to
+    :data:`RANGE_DIGITS` significant digits (0.11, not 0.11000000000000001, as a user would write it)."""
     start, stop = _number(f"{field}.start", table["start"]), _number(f"{field}.stop", table["stop"])
     num = check_int(f"{field}.num", table["num"], 1, MAX_POURS)
     if num == 1:
@@ -118,7 +120,7 @@ def _range_values(field: str, table: dict) -> tuple:
         return tuple(start + k * step for k in range(num))
     import numpy as np
 
-    return tuple(float(v) for v in np.linspace(start, stop, num))
+    return tuple(float(f"{v:.{RANGE_DIGITS}g}") for v in np.linspace(start, stop, num))
 
 
 def _uniform_interval(field: str, bounds: Any) -> tuple[float, float]:
