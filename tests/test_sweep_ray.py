@@ -1,11 +1,15 @@
 """`cosim sweep` on a local Ray with two CPUs: four short pours, one of them refused by its worker (its fill above
 the pourer's rim); the sweep finishes with that pour recorded, a rerun recomputes none of the finished pours, and each
-pour's trajectory is byte-identical to `cosim pour` of the same scene."""
+pour's trajectory is byte-identical to `cosim pour` of the same scene; a worker killed mid-pour is recorded as lost."""
 
 from __future__ import annotations
 
 import csv
 import json
+import os
+import signal
+import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -20,7 +24,7 @@ from cosim.sweep.runner import CodeVersionMismatch, failure_record, pour_task
 from cosim.sweep.spec import load_sweep
 
 FILLS = (0.08, 0.10, 0.12, 0.5)  # m; the pourer is 0.191 m deep inside: 0.5 is refused when its pour is checked
-SWEEP = f"""
+BASE = """
 [scene]
 [scene.fluid]
 particles_across = 8
@@ -28,9 +32,8 @@ particles_across = 8
 max_duration = 1.0
 [scene.logging]
 enabled = false
-[axes]
-"liquid.fill_depth" = {list(FILLS)}
 """
+SWEEP = BASE + f'[axes]\n"liquid.fill_depth" = {list(FILLS)}\n'
 
 
 @pytest.fixture(scope="module")
@@ -116,3 +119,31 @@ def test_a_lost_worker_is_recorded_as_such():
     pour = PlannedPour(SweepPoint(0, {"liquid.fill_depth": 0.1}, PourScene()), "k", None)
     record = failure_record(pour, ray.exceptions.WorkerCrashedError())
     assert record["kind"] == "lost worker" and record["axes"] == {"liquid.fill_depth": 0.1} and record["error"]
+
+
+def _pid_of(title: str) -> int | None:
+    """The process whose command line (Ray sets a running task's to 'ray::<task name>') starts with ``title``."""
+    for proc in Path("/proc").iterdir():
+        try:
+            if proc.name.isdigit() and (proc / "cmdline").read_bytes().startswith(title.encode()):
+                return int(proc.name)
+        except OSError:
+            continue
+    return None
+
+
+def test_a_killed_worker_is_recorded_and_the_sweep_goes_on(local_ray, tmp_path):
+    path = tmp_path / "durations.toml"
+    path.write_text(BASE + '[axes]\n"coupling.max_duration" = [0.3, 60.0]\n')
+    result = {}
+    sweep = threading.Thread(target=lambda: result.update(status=main(["sweep", str(path), "--out", str(tmp_path / "out"), "--quiet"])))
+    sweep.start()
+    deadline = time.monotonic() + 60.0
+    while (pid := _pid_of("ray::pour-1")) is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert pid is not None, "the second pour's worker never showed up"
+    os.kill(pid, signal.SIGKILL)
+    sweep.join(timeout=120.0)
+    rows = _rows(tmp_path / "out")
+    assert result["status"] == 1
+    assert [r["status"] for r in rows] == ["done", "failed"] and rows[1]["failure"] == "lost worker"

@@ -14,7 +14,7 @@ from cosim.pour_scene import PourScene
 from cosim.sweep.expand import axis_points, expand
 from cosim.sweep.resources import PourResources, pour_resources, worker_scene
 from cosim.sweep.spec import load_sweep, parse_sweep
-from cosim.sweep.store import pour_key, scene_json
+from cosim.sweep.store import SweepStore, pour_key, scene_json
 
 
 def _spec(table: dict):
@@ -119,3 +119,11 @@ def test_a_pour_asks_for_its_threads_or_a_gpu():
     assert worker_scene(scene).fluid.cpu_threads == 1
     assert pour_resources(threads) == PourResources(cpus=3, gpus=0) and worker_scene(threads) == threads
     assert pour_resources(gpu) == PourResources(cpus=1, gpus=1) and worker_scene(gpu).device == "cuda"
+
+
+def test_a_rerun_removes_only_the_partial_folders_of_the_pour_it_reruns(tmp_path):
+    store = SweepStore(tmp_path)
+    for name in (".k1.partial-abc", ".k2.partial-def", "k1"):
+        (store.pours / name).mkdir(parents=True)
+    store.remove_partial("k1")
+    assert sorted(p.name for p in store.pours.iterdir()) == [".k2.partial-def", "k1"]

@@ -53,8 +53,7 @@ def failure_record(pour: PlannedPour, exc: BaseException) -> dict:
         kind = "simulation failed"
     elif isinstance(cause, CodeVersionMismatch):
         kind = "code version"
-    elif isinstance(exc, (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError,
-                          ray.exceptions.TaskCancelledError, ray.exceptions.ObjectLostError)):
+    elif isinstance(exc, (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError, ray.exceptions.ObjectLostError)):
         kind = "lost worker"
     else:
         kind = f"error ({type(cause).__name__})"

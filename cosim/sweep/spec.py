@@ -188,14 +188,11 @@ def parse_sweep(table: dict, folder: Path, name: str) -> SweepSpec:
     if mode not in MODES:
         raise InputError(f"mode: must be one of {', '.join(map(repr, MODES))}, got {mode!r}")
     seed = check_int("seed", table.get("seed", 0), 0, 2**63 - 1)
-    if mode == "sample":
-        samples = check_int("samples", table.get("samples"), 1, MAX_POURS) if "samples" in table else None
-        if samples is None:
-            raise InputError(f"samples: mode 'sample' needs the number of pours, in [1, {MAX_POURS}]")
-    elif "samples" in table:
+    if mode == "grid" and "samples" in table:
         raise InputError("samples: only in mode 'sample' (mode 'grid' runs every combination of the axes)")
-    else:
-        samples = 0
+    if mode == "sample" and "samples" not in table:
+        raise InputError(f"samples: mode 'sample' needs the number of pours, in [1, {MAX_POURS}]")
+    samples = check_int("samples", table["samples"], 1, MAX_POURS) if mode == "sample" else 0
     axes_table = table.get("axes")
     if not isinstance(axes_table, dict) or not axes_table:
         raise InputError("axes: needs at least one axis, e.g. [axes] \"liquid.fill_depth\" = [0.08, 0.12]")
