@@ -2,8 +2,8 @@
 
 The sweep file names a base scene and the axes to sweep (docs/sweep.md; examples/fill_sweep.toml). Without
 ``--address`` the pours run on a local Ray started on this machine's cores; ``--address auto`` joins the cluster
-``ray start --head`` started here, ``--address ray://HOST:10001`` a remote one (its workers must see ``--out``:
-shared storage). Each pour's run folder goes to ``--out``/pours/<key> as ``cosim pour`` writes it; rerunning the
+``ray start --head`` started here, ``--address ray://HOST:10001`` a remote one (the workers and this machine must
+all see ``--out``: shared storage). Each pour's run folder goes to ``--out``/pours/<key> as ``cosim pour`` writes it; rerunning the
 same command resumes: done pours are skipped, failed and missing ones run. Results: sweep.csv, plots/<axis>.png and
 library.json (the trajectory library) in ``--out``. Exit status 1 when a pour failed (sweep.csv has its error).
 """
