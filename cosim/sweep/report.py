@@ -101,7 +101,7 @@ def write_plots(plan: SweepPlan, rows: list[dict[str, Any]]) -> list[Path]:
         fig, panels = plt.subplots(len(outcomes), 1, figsize=(6.0, 1.9 * len(outcomes)), sharex=True, squeeze=False)
         for panel, name in zip(panels[:, 0], outcomes):
             points = [(r[axis.key], r[name]) for r in done if r[name] is not None]
-            panel.plot([str(x) if isinstance(x, str) else x for x, _ in points], [y for _, y in points], "o")
+            panel.plot([x for x, _ in points], [y for _, y in points], "o")  # text values: one category each
             panel.set_ylabel(OUTCOMES[name][0], fontsize=8)
             panel.grid(alpha=0.3)
         panels[-1, 0].set_xlabel(axis.key)
