@@ -13,7 +13,7 @@ import pytest
 from cosim.cli.main import SUBCOMMANDS
 
 ROOT = Path(__file__).resolve().parents[1]
-HEAVY = ("warp", "mujoco", "control", "scipy", "rerun")
+HEAVY = ("warp", "mujoco", "control", "scipy", "rerun", "ray")
 # Runs `cosim ARGS...` in this process, then prints its exit status and the heavy libraries it imported.
 PROBE = f"""
 import contextlib, io, sys
@@ -49,7 +49,8 @@ def test_help_loads_no_heavy_library(args):
 
 
 @pytest.mark.parametrize("args", [["pour", "/nonexistent/scene.toml"], ["pour", "BAD"], ["scene", "--check", "BAD"],
-                                  ["pour", "--dim", "4"], ["view", "/nonexistent/run"]], ids=" ".join)
+                                  ["pour", "--dim", "4"], ["view", "/nonexistent/run"],
+                                  ["sweep", "/nonexistent/sweep.toml"], ["sweep", "BAD"]], ids=" ".join)
 def test_refused_input_loads_no_heavy_library(args, bad_scene):
     status, *loaded = _probe([str(bad_scene) if a == "BAD" else a for a in args])
     assert status == "2" and loaded == []

@@ -28,6 +28,7 @@ from cosim.reproducibility import pin_openblas_core
 # Subcommands, in the order `cosim --help` lists them: name -> (its module, the line `cosim --help` shows).
 SUBCOMMANDS: dict[str, tuple[str, str]] = {
     "pour": ("cosim.cli.pour", "simulate a robot pour (default scene without a file)"),
+    "sweep": ("cosim.cli.sweep", "many pours of one scene over axes of scene keys, on a local or remote Ray cluster"),
     "scene": ("cosim.cli.scene", "print the default scene as TOML, or check a scene file"),
     "validate": ("cosim.cli.validate", "run validation cases against analytic and experimental references"),
     "bench": ("cosim.cli.bench", "wall time against error: resolutions, numerics, skip options (CSV, PNG, Markdown)"),
