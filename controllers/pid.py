@@ -226,7 +226,7 @@ def place_filtered_pid(model: SloshModel, target: np.ndarray) -> PidGains | None
     """The filtered PID whose continuous closed loop with Gp has exactly the four poles ``target`` (rad/s) (module
     docstring); None when that needs a derivative filter outside (0, 10] s."""
     g, l1, b2 = model.gravity, model.l1, model.b2
-    c = model._damping()
+    c = model.damping_coefficient
     _, c3, c2, c1, c0 = np.real(np.poly(target))
     # Unknowns (Tf, u, v, w, k): characteristic polynomial (with Gp's damping term c) = k * monic target polynomial.
     m = np.array(

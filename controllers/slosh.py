@@ -139,8 +139,9 @@ class SloshModel:
         """The real right-half-plane zero of the undamped Gp, sqrt(g / -b2) (rad/s); inf when b2 >= 0."""
         return math.sqrt(self.gravity / -self.b2) if self.b2 < 0.0 else math.inf
 
-    def _damping(self) -> float:
-        """2 zeta omega1 l1 (m/s), the first-order coefficient of (M)."""
+    @property
+    def damping_coefficient(self) -> float:
+        """c = 2 zeta omega1 l1 (m/s), the first-order coefficient of (M)."""
         return 2.0 * self.damping_ratio * self.omega1 * self.l1
 
     def plant(self, pivot_height: float = 0.0) -> ct.TransferFunction:
@@ -153,7 +154,7 @@ class SloshModel:
         """
         import control as ct
 
-        c = self._damping()
+        c = self.damping_coefficient
         return ct.tf([self.b2 + pivot_height, c, self.gravity], [self.l1, c, self.gravity])
 
     def pivot_above_hinge(self, pivot: tuple[float, float], tilt: float) -> float:

@@ -19,10 +19,11 @@ from controllers.pid import (
     delayed_loop_figures,
     design_filtered_pid,
     hurwitz_sign_condition,
+    place_filtered_pid,
     ideal_pid_characteristic,
     sampled_plant,
 )
-from controllers.slosh import potential_flow_model, printed_paper_model
+from controllers.slosh import SloshModel, potential_flow_model, printed_paper_model
 
 SEED = potential_flow_model(0.191, 0.1591)  # the paper's vessel and fill (Sec. 4), physical plant
 DT = 0.01  # s, the default 100 Hz control period
@@ -218,3 +219,12 @@ def test_gains_validation() -> None:
     with pytest.raises(ControllerInputError, match=r"^pid\.damping: "):
         PidDesignSpec(damping=1.5)
     assert PidDesignSpec().damping is None  # searched
+
+
+def test_placement_on_a_damped_plant_is_exact() -> None:
+    """An identified plant carries a damping ratio; the placement's linear solve includes Gp's first-order term."""
+    damped = SloshModel(SEED.l1, SEED.hinge_height, 0.05)
+    target = PLACED.target_poles(damped.omega1, 0.7, 1.0)
+    gains = place_filtered_pid(damped, target)
+    poles = ct.poles(ct.feedback(gains.transfer_function() * damped.plant(), 1))
+    assert np.allclose(np.sort_complex(poles), np.sort_complex(target), rtol=1e-6)
