@@ -30,7 +30,7 @@ from cosim.coupling.measure import LiquidProbe, MeasurementGeometry
 from cosim.frames import Pose
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
 from cosim.validation.plant_fit import PlantFit, identify_plant
-from cosim.validation.scripted import PoseScript, run_scripted, tilt_about_axis_point
+from cosim.validation.scripted import run_scripted, tilt_about_axis_point
 from cosim.vessel import VesselShape, VesselSpec
 
 # Acceptance: the identified hinge within 5 mm and omega1 within 2 % of the potential-flow model.
