@@ -55,7 +55,8 @@ def test_a_tank_rounded_to_whole_spacings_says_so(capsys):
 
 
 @pytest.mark.parametrize("argv", [["validate", "nope"], ["validate", "slosh", "--width", "-1"], ["validate", "--spacing", "nan"],
-                                  ["validate", "hydrostatic", "--device", "tpu"], ["validate", "--density-tolerance", "-1"]])
+                                  ["validate", "hydrostatic", "--device", "tpu"], ["validate", "--density-tolerance", "-1"],
+                                  ["validate", "slosh-plant", "--shape", "cylinder"], ["validate", "slosh-plant", "--spacing", "0.05"]])
 def test_bad_input_exits_2_with_one_line(argv, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()

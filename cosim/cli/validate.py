@@ -4,7 +4,9 @@ Human output is a table (case, quantity, measured, reference, error, tolerance, 
 case run; ``--json`` prints a machine-readable document instead (the contract for outside checks):
 ``{"passed": bool, "cases": [{"case", "passed", "wall_time_s", "parameters", "metrics": [...], <raw values>}]}``
 with the raw values of each case (slosh ``frequency_hz``; hydrostatic ``z``, ``pressure``, ``leaked``;
-dam-break ``a``, ``t``, ``front``). A failed validation is reported, not hidden; with ``--strict`` it also makes
+dam-break ``a``, ``t``, ``front``; slosh-plant ``omega1_sph``, ``omega1_model`` (rad/s), ``hinge_height_sph``,
+``hinge_height_model`` (m above the inner floor), ``damping_ratio_sph``, ``pivots``, ``signed_amplitudes``,
+``identified_model``, ``t``, ``sigma``). A failed validation is reported, not hidden; with ``--strict`` it also makes
 the exit status 1.
 """
 
@@ -33,9 +35,11 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("cases", nargs="*", metavar="CASE",
                    help="; ".join(f"{k}: {c.summary}" for k, c in CASES.items()) + f" (default: {' '.join(DEFAULT_CASES)})")
     p.add_argument("--json", action="store_true", help="print machine-readable results (with raw series) on stdout")
-    p.add_argument("--width", type=float, help="tank width B (hydrostatic, slosh) or column width a (dam-break), m")
-    p.add_argument("--fill", type=float, help="fill depth A (hydrostatic, slosh) or column height (dam-break), m; "
+    p.add_argument("--width", type=float, help="tank width B (hydrostatic, slosh, slosh-plant; slosh-plant's cylinder: inner "
+                   "diameter) or column width a (dam-break), m")
+    p.add_argument("--fill", type=float, help="fill depth A (hydrostatic, slosh, slosh-plant) or column height (dam-break), m; "
                    "slosh without --fill runs the seed's fills 0.054, 0.108, 0.162 m")
+    p.add_argument("--shape", choices=("box", "cylinder"), help="slosh-plant's vessel: box or cylinder (3-D only) (default box)")
     p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
     p.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2-D (pour plane) or 3-D (default 2)")
     p.add_argument("--device", default="cpu", help="cpu or cuda[:N] (default cpu)")
@@ -67,6 +71,8 @@ def _case_params(name: str, args) -> list:
     params = CASES[name].params
     if name in ("tilt", "shake", "free-fall", "coupling-static"):
         geometry.pop("width", None)  # the scene's (seed's) vessel
+    if name == "slosh-plant" and args.shape is not None:
+        geometry["shape"] = args.shape
     if name == "slosh" and args.fill is None:
         return [params(**common, **geometry, fill=fill) for fill in slosh.SEED_FILLS]
     return [params(**common, **geometry)]
@@ -111,7 +117,7 @@ def run(args) -> int:
             if asked is not None and built is not None and built != asked:
                 print(f"  {extent} {built:.4g} m: {asked:g} m rounded to whole particle spacings", file=sys.stderr)
         if not args.no_plot:
-            suffix = f"-A{result.parameters['fill']:.3f}" if name == "slosh" else ""
+            suffix = f"-A{result.parameters['fill']:.3f}" if name in ("slosh", "slosh-plant") else ""
             path = args.out / f"{name}{suffix}-{result.parameters['dim']}d.png"
             with atomic_path(path) as tmp:
                 CASES[name].plot(result, tmp)

@@ -46,6 +46,7 @@ CASES: dict[str, Case] = {
     "tilt": Case("moving_vessel", "run_tilt", "full vessel tilted about its lip"),
     "coupling-static": Case("coupling_static", "run", "held full vessel: reaction and joint torques"),
     "shake": Case("moving_vessel", "run_shake", "full vessel shaken at resonance"),
+    "slosh-plant": Case("slosh_plant", "run", "slosh pendulum (omega1, hinge, damping) from tilts vs potential flow"),
     "free-fall": Case("free_fall", "run", "outflow particles vs their free-fall parabolas (seed Eqs. 6-7)"),
 }
 DEFAULT_CASES = ("hydrostatic", "slosh", "dam-break", "free-fall", "coupling-static")

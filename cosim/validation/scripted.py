@@ -1,7 +1,7 @@
 """A liquid-filled vessel moved along a scripted path, with a leak check independent of the solver's own guard.
 
 Shared by the moving-vessel validation cases (``tilt``, ``shake``) and the stability matrix (``cosim stress``):
-the scripted poses (tilt about the pour lip, sideways shaking), the fluid domain around the moving vessel, the
+the scripted poses (tilt about the pour lip or a point on the axis, sideways shaking), the fluid domain around the moving vessel, the
 sampled run loop, and :class:`LeakMonitor`, which classifies particles from positions and poses alone (numpy):
 inside the wall solid the liquid sees, through a wall (inner volume -> outside below the rim between two
 samples), and, where the motion cannot spill, out of the vessel at all.
@@ -35,6 +35,19 @@ def tilt_about_lip(spec: VesselSpec, rate: float, angle: float) -> PoseScript:
     def pose_at(t: float) -> Pose:
         rot = rotation_y(min(rate * t, angle))
         return Pose(lip - rot @ lip, rot)
+
+    return pose_at
+
+
+def tilt_about_axis_point(pivot_height: float, angle: float, duration: float) -> PoseScript:
+    """Rotation about the vessel-frame point (0, 0, ``pivot_height``) (m above the inner floor, on the axis) from
+    upright to ``angle`` (rad) along theta(t) = angle (1 - cos(pi t / duration)) / 2 (zero rate at both ends) over
+    ``duration`` (s), then held."""
+    pivot = np.array([0.0, 0.0, pivot_height])
+
+    def pose_at(t: float) -> Pose:
+        rot = rotation_y(0.5 * angle * (1.0 - math.cos(math.pi * min(t, duration) / duration)))
+        return Pose(pivot - rot @ pivot, rot)
 
     return pose_at
 
