@@ -210,6 +210,9 @@ class PourController:
             self._sigma_prev = m.slosh_angle
         elif phase is Phase.SIM_DAMP:
             assert self._pid is not None and self._smoother is not None
+            # The damping starts from the vessel's measured tilt: a command that ran ahead of the arm (the task-space
+            # filter lags a large excitation) would otherwise be a step in the path it passes to the arm.
+            self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
             self._reference = self._damp_reference(m)
             self._pid.reset(u0=self.pose.theta, y0=m.theta1, r0=self._reference)
             self._smoother.reset(self.pose.theta)

@@ -55,3 +55,14 @@ def test_pass_through_returns_the_command_and_filtering_resumes_from_its_motion(
     resumed = f(PlanarPose(0.0, 0.0, rate * 50 * PERIOD)).theta
     # continues from 49 * rate * PERIOD at about the ramp's rate: within a tenth of one period's travel
     assert abs(resumed - rate * 50 * PERIOD) <= 0.1 * rate * PERIOD
+
+
+def test_pass_through_waits_until_the_filter_has_caught_up() -> None:
+    """A pass-through command far from the filtered pose (the filter still lagging a large move) is filtered, not
+    jumped to, until the filtered pose reaches it."""
+    f = _filter()
+    first = f(PlanarPose(0.0, 0.0, 0.5), pass_through=True).theta
+    assert 0.0 < first < 0.01  # one jerk-limited period of motion from rest, not the 0.5 rad step
+    tilts = [f(PlanarPose(0.0, 0.0, 0.5), pass_through=True).theta for _ in range(300)]
+    assert tilts[-1] == 0.5  # caught up, then passed through exactly
+    assert max(abs(b - a) for a, b in zip(tilts, tilts[1:])) <= PoseFilterLimits().tilt_velocity * PERIOD + 1e-12

@@ -22,6 +22,9 @@ from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
 from cosim.trajectory.limits import ArmLimits, JointLimits
 
 POSE_RANGE = 10.0  # m / rad: the filter's own position bounds (the arms' ranges are checked downstream)
+# m / rad: how close the filtered pose must be to a pass-through command before the filter hands over to it; a
+# step of this size in a 10 ms target is 0.1 m/s or rad/s, well inside the arms' limits.
+PASS_THROUGH_JOIN = 1e-3
 
 
 @dataclass(frozen=True)
@@ -77,8 +80,13 @@ class PoseFilter:
         """The smoothed pose one control period after the previous call, heading for ``target``; with
         ``pass_through`` the target itself (a command the controller has already smoothed, whose timing matters:
         the slosh damping's feedback), the filter's own state following it (its rates from the last three
-        targets) so that filtering resumes from where the path is."""
+        targets) so that filtering resumes from where the path is. Pass-through starts only once the filtered
+        pose is within :data:`PASS_THROUGH_JOIN` of the command (until then it is filtered), so the path never
+        jumps to a command the arm has not caught up with."""
         values = np.array([getattr(target, c) for c in self.coordinates])
+        if pass_through and not self._passed:  # join the command only where the filtered path has reached it
+            position = self._generator.state[0]
+            pass_through = bool(np.all(np.abs(values - position) <= PASS_THROUGH_JOIN))
         if pass_through:
             self._passed = (self._passed + [values])[-3:]
             rates = np.diff(self._passed, axis=0) / self._period
