@@ -1,0 +1,43 @@
+"""The slosh-study table from a sweep's output: a synthetic pour whose numbers are known."""
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from cosim.bench.slosh_study import COLUMNS, study_table
+
+
+def _write_pour(folder: Path) -> None:
+    folder.mkdir(parents=True)
+    t = np.round(np.arange(0.0, 3.0, 0.01), 2)
+    phase = np.where(t < 1.0, "sim_hold", np.where(t < 2.0, "sim_damp", "cfs"))
+    sigma = np.where(phase == "sim_damp", 0.04 * np.exp(-3.0 * (t - 1.0)), 0.0)
+    h_q = np.where(phase == "cfs", 0.015 + 0.002 * (-1.0) ** np.arange(t.size), -0.005)
+    with open(folder / "series.csv", "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["t", "phase", "tilt", "theta1", "h_q"])
+        writer.writerows(zip(t, phase, np.zeros_like(t), sigma, h_q))
+    summary = {
+        "poured_volume": 2e-3, "spilled_volume": 2e-5, "outflow": {"steady_outflow": 1.8},
+        "scene": {"coupling": {"start_delay": 0.2}},
+        "transitions": [{"from": "sim_damp", "to": "cfs", "reason": "t2 done: slosh damped, |sigma| <= 0.01 rad"}],
+        "phases": [{"phase": "done", "start": 2.9, "end": 3.0}],
+    }
+    (folder / "summary.json").write_text(json.dumps(summary))
+
+
+def test_table_from_a_known_pour(tmp_path: Path) -> None:
+    _write_pour(tmp_path / "pours" / "a")
+    with open(tmp_path / "sweep.csv", "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(["liquid.fill_depth", "status", "failure", "error", "poured_mL", "run_folder"])
+        writer.writerow([0.15, "done", "", "", 2000, "pours/a"])
+        writer.writerow([0.18, "failed", "bad input", "liquid.fill_depth: too high", "", ""])
+    lines = study_table([tmp_path]).splitlines()
+    assert lines[0] == "| liquid.fill_depth | " + " | ".join(COLUMNS) + " |"
+    cells = [c.strip() for c in lines[2].strip("|").split("|")]
+    # spill 1 %, steady at 1.8 s, h_q +-2 mm after 2.0 s, t2 1.0 s, sigma 0.040 -> 0.04 e^-2.25 = 0.004 rad (the last half period starts at 1.75 s)
+    assert cells == ["0.15", "1.00", "1.80", "2.00", "1.00", "t2 done", "0.040", "0.004", "2.90"]
+    assert "failed: liquid.fill_depth: too high" in lines[3]
