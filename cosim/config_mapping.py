@@ -15,8 +15,10 @@ import dataclasses
 import enum
 import inspect
 import re
+import tomllib
 import types
 import typing
+from pathlib import Path
 from typing import Any
 
 import tomlkit
@@ -186,3 +188,14 @@ def to_toml(obj: Any, header: str = "") -> str:
         doc.add(tomlkit.comment(line))
     _fill_table(doc, obj)
     return tomlkit.dumps(doc)
+
+
+def read_toml_file(path: Path, what: str) -> dict[str, Any]:
+    """The table of the TOML file ``path``; a file that cannot be read or parsed is one InputError line naming it
+    and what it was meant to be (``what``, e.g. "scene file")."""
+    try:
+        return tomllib.loads(path.read_text())
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read the {what} ({exc.strerror})") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: not a valid TOML file ({exc})") from None

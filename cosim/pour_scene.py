@@ -10,13 +10,12 @@ much to pour), ``fluid`` (SPH resolution and numerics), ``controller`` (the seed
 from __future__ import annotations
 
 import re
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from controllers.config import ApproachConfig, CfsConfig, ReturnConfig, SimConfig
 from cosim.checks import check_device, check_int, check_positive, check_range
-from cosim.config_mapping import from_mapping, to_toml
+from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.pose_filter import PoseFilterLimits
 from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
@@ -268,12 +267,7 @@ class PourScene:
 def load_scene(path: str | Path) -> PourScene:
     """Read a scene TOML file; any problem is one InputError line naming the file and the field."""
     path = Path(path)
-    try:
-        table = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read the scene file ({exc.strerror})") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: not a valid TOML file ({exc})") from None
+    table = read_toml_file(path, "scene file")
     try:
         return from_mapping(PourScene, table, "scene")
     except InputError as exc:

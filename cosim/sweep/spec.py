@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import tomllib
 import types
 import typing
 from dataclasses import dataclass
@@ -29,6 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from cosim.checks import check_int
+from cosim.config_mapping import read_toml_file
 from cosim.errors import InputError
 
 MODES = ("grid", "sample")
@@ -171,11 +171,9 @@ def _base_scene(value: Any, folder: Path) -> tuple[dict, Path | None]:
         raise InputError(f"scene: must be a scene file's path or a [scene] table, got {value!r}")
     path = folder / value
     try:
-        return tomllib.loads(path.read_text()), path
-    except OSError as exc:
-        raise InputError(f"scene: cannot read the scene file {path} ({exc.strerror})") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"scene: {path} is not a valid TOML file ({exc})") from None
+        return read_toml_file(path, "scene file"), path
+    except InputError as exc:
+        raise InputError(f"scene: {exc}") from None
 
 
 def parse_sweep(table: dict, folder: Path, name: str) -> SweepSpec:
@@ -206,12 +204,7 @@ def parse_sweep(table: dict, folder: Path, name: str) -> SweepSpec:
 def load_sweep(path: str | Path) -> SweepSpec:
     """Read a sweep file; any problem is one InputError line naming the file and the key."""
     path = Path(path)
-    try:
-        table = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read the sweep file ({exc.strerror})") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: not a valid TOML file ({exc})") from None
+    table = read_toml_file(path, "sweep file")
     try:
         return parse_sweep(table, path.parent, path.stem)
     except InputError as exc:
