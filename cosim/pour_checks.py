@@ -31,10 +31,10 @@ if TYPE_CHECKING:
     from cosim.robots.scene_config import ArmRole
     from cosim.trajectory.limits import ArmLimits
 
-# s of wall time per liquid particle per solver substep, the MuJoCo arms and the controller included (no recording),
-# measured with the default pour (`cosim pour --no-log`: 2-D, DFSPH, 864 particles, 2 CPU threads, on two CPU cores
-# other jobs kept busy): 161.4 s of wall time for 28,678 substeps, 161.4 / (864 x 28,678) = 6.5e-6 s. It includes the
-# host's fixed share per step, so scenes with more particles per step are overestimated, the safe side for a gate.
+# s of wall time per liquid particle per solver substep, the MuJoCo arms and the controller included (no recording):
+# the default pour's wall time over its particles times substeps (summary.json's wall_time / (particles x
+# sph_steps)) on a loaded 2-core CPU, rounded up (docs/scene_check.md). It includes the host's fixed share per step,
+# so scenes with more particles per step are overestimated, the safe side for a gate.
 SECONDS_PER_PARTICLE_STEP = 6.5e-6
 LONG_RUN_S = 3600.0  # s: a longer estimate is refused unless the caller accepts it (`cosim pour --yes`)
 
