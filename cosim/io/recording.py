@@ -98,7 +98,8 @@ class _Columns:
             rr.TimeColumn(rerun_paths.TIMELINE_STEP, sequence=np.asarray(self.steps, dtype=np.int64)),
         ]
         joined = {
-            name: (sum(rows, []) if isinstance(rows[0], list) else np.concatenate(rows)) for name, rows in self.components.items()
+            name: ([x for row in rows for x in row] if isinstance(rows[0], list) else np.concatenate(rows))
+            for name, rows in self.components.items()
         }
         columns = self.archetype.columns(**joined).partition(np.asarray(self.lengths, dtype=np.int32))
         rec.send_columns(entity, indexes=indexes, columns=columns)

@@ -5,10 +5,10 @@
 Serves the recording with ``rerun --web-viewer`` (on free local ports), opens the viewer in Chromium without a
 display (software WebGL: SwiftShader), and drives it over the Chrome DevTools protocol: it captures the page every
 ``--poll`` s until two captures in a row are identical (the viewer has loaded the recording and drawn it) or
-``--timeout`` s have passed, then writes the last capture. The viewer opens a recording at its last logged time:
-for a picture of the middle of a pour, record a run that stops there (``cosim pour --duration``). It prints how long that took, the load time of the
-recording in a software-rendered browser. Needs ``chromium`` on the PATH and the ``websockets`` package
-(``pip install cosim[screenshot]``). Nothing is written unless a capture was made.
+``--timeout`` s have passed, then writes the last capture, and prints how long that took: the load time of the
+recording in a software-rendered browser. The viewer opens a recording at its last logged time: for a picture of
+the middle of a pour, record a run that stops there (``cosim pour --duration``). Needs ``chromium`` on the PATH
+and the ``websockets`` package (``pip install cosim[screenshot]``). Nothing is written unless a capture was made.
 """
 
 from __future__ import annotations
