@@ -18,6 +18,7 @@ from cosim.io import screenshot
         (["{rrd}", "--size", "wide"], "--size"),
         (["{rrd}", "--poll", "0"], "--poll: must be in (0, 60]"),
         (["{rrd}", "--timeout", "-1"], "--timeout: must be in (0, 3600]"),
+        (["{rrd}", "--settle", "0"], "--settle: must be in (0, 600]"),
         (["{rrd}", "--out", "{tmp}/no/such/folder/x.png"], "--out: folder"),
     ],
 )
