@@ -24,9 +24,7 @@ from dataclasses import asdict, replace
 from datetime import datetime, timezone
 from importlib import metadata
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-import mujoco
 import numpy as np
 
 from controllers.config import CFS_MAX_HEAD, CatcherConfig, PourConfig
@@ -36,19 +34,14 @@ from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour, build_pour
 from cosim.errors import InputError
 from cosim.fluid.runtime import kernel_modules, load_kernels, resolve_device
-from cosim.frames import tilt_about_y
 from cosim.io.pour_series import write_series_csv
 from cosim.pour_checks import PourPlan, check_pour
 from cosim.pour_scene import PourScene
 from cosim.reproducibility import blas_description
-from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_torques
 from cosim.trajectory.driver_names import driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.torques import required_torques
-
-if TYPE_CHECKING:
-    from cosim.io.recording import PourRecorder
 
 DEFAULT_RECORDINGS = Path("recordings")
 VERSIONED_PACKAGES = ("cosim", "warp-lang", "mujoco", "numpy", "control", "ruckig", "rerun-sdk")
@@ -132,58 +125,6 @@ def destination(out: Path | None, name: str) -> Path:
     return out
 
 
-class _SignalLogger:
-    """Feeds the recorder from the pour: states at the recording rate, signals and phases at control steps."""
-
-    def __init__(self, pour: CoupledPour, recorder: PourRecorder):
-        self.pour, self.rec = pour, recorder
-        self.fk = mujoco.MjData(pour.scene.model)
-        self.phase = None
-        self.rows = 0
-
-    def commanded_tilt(self) -> float:
-        """Pourer tilt (rad) of the commanded joint trajectory at its current time (forward kinematics)."""
-        scene, fk = self.pour.scene, self.fk
-        for role in ROLES:
-            fk.qpos[scene.arms[role].qpos_adr] = self.pour.generators[role].state[0]
-        mujoco.mj_kinematics(scene.model, fk)
-        return tilt_about_y(fk.xmat[scene.arms[ArmRole.POUR].vessel_body].reshape(3, 3))
-
-    def __call__(self, pour: CoupledPour) -> None:
-        t, step = pour.time, pour.steps
-        if self.rec.state_due(t):
-            fluid = pour.fluid
-            self.rec.log_state(t, step, pour.scene.data, fluid.positions(), np.linalg.norm(fluid.velocities(), axis=1), active=fluid.active_mask())
-        rows = pour.log.rows
-        if len(rows.get("t", ())) == self.rows:
-            return
-        self.rows = len(rows["t"])
-        values = {
-            "pourer/theta": self.commanded_tilt(),
-            "pourer/theta_measured": rows["tilt"][-1],
-            "pourer/theta1": rows["theta1"][-1],
-            "slosh/h_q": rows["h_q"][-1],
-            "slosh/v_q": rows["v_q"][-1],
-            "volume/in_pourer": rows["volume_in_pourer"][-1],
-            "volume/in_catcher": rows["volume_in_catcher"][-1],
-            "volume/outside": pour.geometry.initial_volume - rows["volume_in_pourer"][-1] - rows["volume_in_catcher"][-1],
-            "catcher/landing_x": rows["landing_x"][-1],
-        }
-        for vessel, w in (("pourer", rows["wrench_pourer"][-1]), ("catcher", rows["wrench_catcher"][-1])):
-            for k, axis in enumerate(("force_x", "force_y", "force_z", "torque_x", "torque_y", "torque_z")):
-                values[f"wrench/{vessel}/{axis}"] = float(w[k])
-        for role in ROLES:
-            q, qd, _ = pour.generators[role].state
-            for j, name in enumerate(pour.scene.arms[role].joints):
-                values[f"joints/{name}.pos"] = float(q[j])
-                values[f"joints/{name}.vel"] = float(qd[j])
-        self.rec.log_scalars(pour.generators[ArmRole.POUR].time, step, values)
-        if rows["phase"][-1] != self.phase:
-            self.phase = rows["phase"][-1]
-            reason = pour.command.reason if pour.command else ""
-            self.rec.log_phase(t, step, self.phase, reason)
-
-
 def package_versions() -> dict[str, str]:
     """Python's version, each of :data:`VERSIONED_PACKAGES`' installed version ('not installed' where absent) and
     numpy's BLAS (:func:`cosim.reproducibility.blas_description`)."""
@@ -238,10 +179,12 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
 
         callbacks = []
         if scene.logging.enabled:
-            from cosim.io.recording import PourRecorder
+            from cosim.pour_recording import PourRecordingFeed, open_recorder
+            from cosim.pour_scene import dump_scene
 
-            recorder = PourRecorder(work / "pour.rrd", pour.scene.model, scene.logging.recording, particle_radius=0.5 * pour.fluid.config.spacing)
-            callbacks.append(_SignalLogger(pour, recorder))
+            recorder = open_recorder(pour, work / "pour.rrd", scene.logging.recording, scene.run_name, dump_scene(scene))
+            feed = PourRecordingFeed(pour, recorder)
+            callbacks.append(feed)
         bar = tqdm(total=round(scene.coupling.max_duration, 3), unit="s sim", disable=not progress, mininterval=1.0,
                    bar_format="{desc}{n:.2f} s simulated (at most {total:.1f}) [{elapsed}{postfix}]")
         shown = [0.0]
@@ -258,8 +201,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
         summary = pour.run(on_step)
         bar.close()
         if recorder is not None:
-            recorder.log_state(pour.time, pour.steps, pour.scene.data, pour.fluid.positions(),
-                               np.linalg.norm(pour.fluid.velocities(), axis=1), active=pour.fluid.active_mask(), force=True)
+            feed.finish()
             recorder.close()
         write_series_csv(pour.log.rows, work / "series.csv")
         trajectory = pour.recorder.trajectory()

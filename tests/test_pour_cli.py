@@ -13,7 +13,7 @@ from controllers.config import CFS_MAX_HEAD
 from cosim.cli.main import main
 from cosim.frames import tilt_about_y
 from cosim.io.pour_series import read_series_csv
-from cosim.io.rerun_read import entity_paths, read_scalar_series
+from cosim.io.rerun_read import blueprint_camera, entity_paths, read_scalar_series, recording_properties, series_names
 from cosim.io.trajectory_csv import read_trajectory_csv
 from cosim.io.trajectory_json import read_trajectory_json
 from cosim.pour_scene import PourScene, load_scene
@@ -74,28 +74,56 @@ def test_outputs_and_summary(run):
     assert series["volume_in_pourer"][0] == pytest.approx(summary["initial_volume"])
 
 
-def test_recording_verifies_and_its_theta_is_the_trajectorys(run):
+def test_recording_verifies_and_its_tilt_is_the_trajectorys(run):
     rrd = run / "pour.rrd"
     verify = subprocess.run([sys.executable, "-m", "rerun", "rrd", "verify", str(rrd)], capture_output=True, text=True)
     assert verify.returncode == 0, verify.stderr
     paths = entity_paths(rrd)
-    assert "/world/liquid" in paths and "/signals/pourer/theta" in paths and "/events/phase" in paths
-    theta = read_scalar_series(rrd, "pourer/theta")
+    assert "/world/liquid" in paths and "/signals/pour/tilt_deg" in paths and "/events/phase" in paths
+    tilt = read_scalar_series(rrd, "pour/tilt_deg", "commanded")
     traj = read_trajectory_csv(run / "trajectory.csv")
     scene = RobotScene.load()
     arm = scene.arms[ArmRole.POUR]
     cols = [traj.joint_names.index(j) for j in arm.joints]
     data = mujoco.MjData(scene.model)
     checked = 0
-    for t, logged in zip(theta.sim_time, theta.values):
+    for t, logged in zip(tilt.sim_time, tilt.values):
         k = int(np.argmin(np.abs(traj.time - t)))
         if abs(traj.time[k] - t) > 1e-9:
             continue
         data.qpos[arm.qpos_adr] = traj.positions[k, cols]
         mujoco.mj_kinematics(scene.model, data)
-        assert logged == pytest.approx(tilt_about_y(data.xmat[arm.vessel_body].reshape(3, 3)), abs=1e-9)
+        assert logged == pytest.approx(np.degrees(tilt_about_y(data.xmat[arm.vessel_body].reshape(3, 3))), abs=1e-7)
         checked += 1
-    assert checked >= 0.9 * len(theta.values) > 50
+    assert checked >= 0.9 * len(tilt.values) > 50
+
+
+def test_recording_holds_what_a_robotics_user_reads(run):
+    """Units in every plot's name, clean entity paths named after bodies and geoms, tool frames, the liquid's force,
+    the run's name and scene as properties, and a camera framed between the vessels."""
+    rrd = run / "pour.rrd"
+    paths = entity_paths(rrd)
+    assert not any("\\" in p or "geom_" in p for p in paths)
+    for entity in ("/world/robot/pour_arm/wrist_3_link", "/world/robot/pourer/front", "/world/robot/catcher/floor",
+                   "/world/scene/table", "/world/frames/pourer/frame", "/world/frames/catcher/frame",
+                   "/world/liquid_force", "/world/lip_path/commanded", "/signals/pour_arm/joint_angle_deg",
+                   "/signals/pourer/liquid_force_N", "/signals/catcher/liquid_torque_N_m", "/signals/pour/volume_mL"):
+        assert entity in paths, entity
+    assert not any(p.startswith("/world/scene/floor") for p in paths)  # the ground plane stays out of the bounds
+    joints = series_names(rrd, "pour_arm/joint_angle_deg")
+    assert joints == [j.split("/")[-1] for j in RobotScene.load().arms[ArmRole.POUR].joints]
+    volume = read_scalar_series(rrd, "pour/volume_mL", "in pourer").values
+    summary = json.loads((run / "summary.json").read_text())
+    assert volume[0] == pytest.approx(1e6 * summary["initial_volume"])  # mL
+    properties = recording_properties(rrd)
+    assert properties["scene_name"] == "test-pour" and "particles_across = 10" in properties["scene_toml"]
+    eye, target = blueprint_camera(rrd)
+    scene = RobotScene.load()
+    mujoco.mj_forward(scene.model, scene.data)
+    pourer, catcher = (scene.data.site_xpos[scene.arms[r].frame_site] for r in (ArmRole.POUR, ArmRole.CATCH))
+    lo, hi = np.minimum(pourer, catcher), np.maximum(pourer, catcher)
+    assert np.all(target[[0, 2]] >= lo[[0, 2]] - 0.1) and np.all(target[[0, 2]] <= hi[[0, 2]] + 0.1)
+    assert 0.3 < np.linalg.norm(eye - target) < 3.0
 
 
 def test_exported_trajectory_differentiates_consistently_and_holds_every_limit(run):

@@ -1,103 +1,119 @@
-"""The default blueprint stored in the recording: a 3-D view of world, the phase log, one plot panel per signal
-group whose contents select exactly that group's signals, and the sim_time timeline."""
+"""The default blueprint stored in the recording: the 3-D view of world framed by the camera given, the controller's
+log and the colour scale, one plot per signal titled with its unit in a tab per group, legends only where a plot
+has several series, and the sim_time timeline."""
 
 from __future__ import annotations
 
 import mujoco
+import numpy as np
 import pytest
 from rerun.chunk import RrdReader
 
-from cosim.io.recording import PourRecorder
-from cosim.io.rerun_read import read_component
+from cosim.io.recording import PourRecorder, RecordingConfig
+from cosim.io.rerun_blueprint import Camera, colour_scale_text, panel_title, split_unit
+from cosim.io.rerun_read import blueprint_camera, read_component
 
-SIGNALS = [
-    "pourer/theta",
-    "pourer/theta1",
-    "slosh/h_q",
-    "slosh/v_q",
-    "volume/in_pourer",
-    "volume/spilled",
-    "wrench/pourer/force_z",
-    "wrench/catcher/force_z",
-    "joints/pour_arm/elbow.pos",
-    "joints/pour_arm/elbow.vel",
-    "joints/pour_arm/shoulder.pos",
-    "joints/catch_arm/shoulder.vel",
-]
-# panel title -> the signals it must plot
+SIGNALS = {
+    "pour/tilt_deg": {"commanded": 1.0, "measured": 2.0},
+    "pour/volume_mL": {"in pourer": 1.0, "in catcher": 0.0, "outside": 0.0},
+    "pour/head_over_crest_mm": 3.0,
+    "pourer/liquid_force_N": {"x": 0.0, "y": 0.0, "z": -9.8},
+    "pourer/liquid_torque_N_m": {"x": 0.0, "y": 0.1, "z": 0.0},
+    "pour_arm/joint_speed_deg_s": {"shoulder_pan": 0.0, "elbow": 1.0},
+}
+# panel title -> (tab, legend shown)
 PANELS = {
-    "pourer": {"pourer/theta", "pourer/theta1"},
-    "slosh": {"slosh/h_q", "slosh/v_q"},
-    "volume": {"volume/in_pourer", "volume/spilled"},
-    "wrench": {"wrench/pourer/force_z", "wrench/catcher/force_z"},
-    "joints .pos": {"joints/pour_arm/elbow.pos", "joints/pour_arm/shoulder.pos"},
-    "joints .vel": {"joints/pour_arm/elbow.vel", "joints/catch_arm/shoulder.vel"},
+    "pour tilt (deg)": ("pour", True),
+    "pour volume (mL)": ("pour", True),
+    "pour head over crest (mm)": ("pour", False),
+    "pourer liquid force (N)": ("pourer", True),
+    "pourer liquid torque (N m)": ("pourer", True),
+    "pour_arm joint speed (deg/s)": ("pour_arm", True),
 }
 SINGLE_BODY = "<mujoco><worldbody><body name='cup'><joint type='hinge'/><geom type='box' size='.1 .1 .1'/></body></worldbody></mujoco>"
+CAMERA = Camera(eye=(0.1, 1.2, 1.5), target=(0.1, 0.0, 1.1))
 
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
     model = mujoco.MjModel.from_xml_string(SINGLE_BODY)
     path = tmp_path_factory.mktemp("blueprint") / "pour.rrd"
-    with PourRecorder(path, model) as rec:
+    with PourRecorder(path, model, RecordingConfig(speed_color_max=1.5), camera=CAMERA, liquid_note="A 2-D slice.") as rec:
         for k in range(3):
-            rec.log_scalars(0.01 * k, k, {name: float(k) for name in SIGNALS})
+            rec.log_scalars(0.01 * k, k, SIGNALS)
         rec.log_phase(0.0, 0, "SIM", "start")
     return path
 
 
-def _blueprint(path) -> tuple[dict[str, dict], dict[str, list]]:
-    """Views (id -> {class, name, origin, query}) and other blueprint entities (path -> components) of the file."""
+def _blueprint(path) -> tuple[dict[str, dict], dict[str, dict]]:
+    """Views and containers (id -> components of the item and its properties, the last row of each) and the other
+    blueprint entities of the file."""
     reader = RrdReader(path)
     (entry,) = reader.blueprints()
-    views: dict[str, dict] = {}
+    items: dict[str, dict] = {}
     other: dict[str, dict] = {}
     for chunk in reader.store(store=entry).stream():
         batch = chunk.to_record_batch()
-        columns = {n: batch.column(n).to_pylist()[-1] for n in batch.schema.names if ":" in n}  # components only
+        columns = {n: batch.column(n).to_pylist()[-1] for n in batch.schema.names if ":" in n}
         parts = chunk.entity_path.strip("/").split("/")
-        if parts[0] == "view":
-            view = views.setdefault(parts[1], {})
-            for key, column in [
-                ("class", "ViewBlueprint:class_identifier"),
-                ("name", "ViewBlueprint:display_name"),
-                ("origin", "ViewBlueprint:space_origin"),
-                ("query", "ViewContents:query"),
-            ]:
-                if column in columns:
-                    view[key] = columns[column]
+        if parts[0] in ("view", "container"):
+            items.setdefault(parts[1], {}).update(columns)
         else:
             other[chunk.entity_path] = columns
-    return views, other
+    return items, other
+
+
+def test_units_are_read_from_the_name():
+    assert split_unit("pour_arm/joint_speed_deg_s") == ("joint_speed", "deg/s")
+    assert split_unit("pourer/liquid_torque_N_m") == ("liquid_torque", "N m")
+    assert split_unit("pour/volume_mL") == ("volume", "mL")
+    assert split_unit("pour/theta1") == ("theta1", "")
+    assert panel_title("catch_arm/joint_angle_deg") == "catch_arm joint angle (deg)"
 
 
 def test_views_of_the_default_blueprint(recording):
-    views, other = _blueprint(recording)
+    items, other = _blueprint(recording)
+    views = [v for v in items.values() if "ViewBlueprint:class_identifier" in v]
     by_class: dict[str, list[dict]] = {}
-    for view in views.values():
-        by_class.setdefault(view["class"][0], []).append(view)
+    for view in views:
+        by_class.setdefault(view["ViewBlueprint:class_identifier"][0], []).append(view)
     (space,) = by_class["3D"]
-    assert space["origin"] == ["world"] and space["query"] == ["$origin/**"]
-    (log,) = by_class["TextLog"]
-    assert log["origin"] == ["events"]
-    assert sorted(v["name"][0] for v in by_class["TimeSeries"]) == sorted(PANELS)
+    assert space["ViewBlueprint:space_origin"] == ["world"]
+    assert [v["ViewBlueprint:space_origin"] for v in by_class["TextLog"]] == [["events"]]
+    assert [v["ViewBlueprint:space_origin"] for v in by_class["TextDocument"]] == [["legend"]]
+    assert sorted(v["ViewBlueprint:display_name"][0] for v in by_class["TimeSeries"]) == sorted(PANELS)
     assert other["/time_panel"]["TimePanelBlueprint:timeline"] == ["sim_time"]
+    tabs = {v["ContainerBlueprint:display_name"][0] for v in items.values() if "ContainerBlueprint:display_name" in v}
+    assert {tab for tab, _ in PANELS.values()} <= tabs
 
 
-def test_each_plot_panel_selects_exactly_its_signals(recording):
-    views, _ = _blueprint(recording)
+def test_each_plot_shows_its_signal_and_a_legend_only_for_several_series(recording):
+    items, _ = _blueprint(recording)
     store = RrdReader(recording).store()
-    for view in views.values():
-        if view["class"] != ["TimeSeries"]:
+    for view in items.values():
+        if view.get("ViewBlueprint:class_identifier") != ["TimeSeries"]:
             continue
-        title = view["name"][0]
-        selected = {c.entity_path for c in store.stream().filter(content=view["query"], is_static=False)}
-        assert selected == {"/signals/" + name for name in PANELS[title]}, title
+        title = view["ViewBlueprint:display_name"][0]
+        origin = view["ViewBlueprint:space_origin"][0]
+        selected = {c.entity_path for c in store.stream().filter(content=f"/{origin}/**", is_static=False)}
+        assert selected == {f"/{origin}"}, title
+        assert view["PlotLegend:visible"] == [PANELS[title][1]], title
 
 
-def test_series_are_labelled_without_their_group(recording):
-    assert read_component(recording, "signals/joints/pour_arm/elbow.pos", "SeriesLines:names").values[0].tolist() == [
-        "pour_arm/elbow.pos"
-    ]
-    assert read_component(recording, "signals/slosh/h_q", "SeriesLines:names").values[0].tolist() == ["h_q"]
+def test_the_camera_is_the_one_given(recording):
+    eye, target = blueprint_camera(recording)
+    np.testing.assert_allclose(eye, CAMERA.eye, rtol=0, atol=1e-6)
+    np.testing.assert_allclose(target, CAMERA.target, rtol=0, atol=1e-6)
+
+
+def test_series_have_names_and_distinct_colours(recording):
+    names = read_component(recording, "signals/pour/volume_mL", "SeriesLines:names").values[0].tolist()
+    assert names == ["in pourer", "in catcher", "outside"]
+    colors = read_component(recording, "signals/pour/volume_mL", "SeriesLines:colors").values[0]
+    assert len(set(colors.tolist())) == 3
+
+
+def test_the_colour_scale_is_stated(recording):
+    text = read_component(recording, "legend", "TextDocument:text").values[0][0]
+    assert text == colour_scale_text("viridis", 1.5, "A 2-D slice.")
+    assert "0 to 1.5 m/s" in text and "`#440154` = 0 m/s" in text and text.endswith("A 2-D slice.")

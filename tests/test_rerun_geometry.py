@@ -45,7 +45,7 @@ MJCF = f"""
 </mujoco>
 """
 
-DRAWN = ("floor", "link", "ball", "egg", "wall", "stem", "tet")
+DRAWN = ("link", "ball", "egg", "wall", "stem", "tet")  # not the floor plane
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +79,7 @@ def test_only_visible_geoms_are_drawn(recorded):
     assert geoms == {f"/world/robot/{_body_of(model, g)}/{g}" for g in DRAWN}
 
 
-@pytest.mark.parametrize("geom", [g for g in DRAWN if g != "floor"])
+@pytest.mark.parametrize("geom", DRAWN)
 def test_body_pose_times_geom_pose_is_where_mujoco_has_the_geom(recorded, geom):
     model, data, path = recorded
     body = _body_of(model, geom)
@@ -112,7 +112,6 @@ def test_shapes_have_mujoco_sizes_and_colours(recorded):
         return read_component(path, entity, component).values[0]
 
     np.testing.assert_allclose(first("world/robot/cup/wall", "Boxes3D:half_sizes"), [[0.05, 0.004, 0.06]], rtol=1e-6)
-    np.testing.assert_allclose(first("world/robot/world/floor", "Boxes3D:half_sizes")[0, 2], 0.0)
     np.testing.assert_allclose(first("world/robot/arm/ball", "Ellipsoids3D:half_sizes"), [[0.04] * 3], rtol=1e-6)
     np.testing.assert_allclose(first("world/robot/arm/egg", "Ellipsoids3D:half_sizes"), [[0.02, 0.03, 0.04]], rtol=1e-6)
     # cylinder and capsule: MuJoCo size = (radius, half length); Rerun wants the full length
@@ -125,3 +124,42 @@ def test_shapes_have_mujoco_sizes_and_colours(recorded):
     assert first("world/robot/cup/wall", "Boxes3D:colors").tolist() == [0x0000FFFF]
     assert first("world/robot/arm/link", "Capsules3D:colors").tolist() == [0xFF0000FF]
     assert first("world/robot/arm/ball", "Ellipsoids3D:colors").tolist() == [0x808080FF]
+
+
+NAMESPACED = """
+<mujoco>
+  <asset><mesh name="ns/shell" vertex="0 0 0 0.1 0 0 0 0.1 0 0 0 0.1"/></asset>
+  <worldbody>
+    <geom name="ground" type="plane" size="4 4 0.1"/>
+    <geom name="table" type="box" size="0.5 0.5 0.02"/>
+    <body name="ns/link">
+      <joint type="hinge"/>
+      <geom name="ns/link_visual" type="box" size="0.1 0.1 0.1"/>
+      <geom type="cylinder" size="0.01 0.02"/>
+      <geom type="cylinder" size="0.01 0.03"/>
+      <geom type="mesh" mesh="ns/shell"/>
+      <body name="ns/link/tip">
+        <joint type="hinge"/>
+        <geom type="sphere" size="0.01"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_entities_are_named_after_bodies_and_geoms_without_escapes(tmp_path):
+    """A body's name is its path; a geom drops the namespace it shares with its body; unnamed geoms take their mesh's
+    name or their type, numbered within the body; a body holding another body's path gets ``_body``; the world body's
+    geoms are the scene; the ground plane is not drawn."""
+    model = mujoco.MjModel.from_xml_string(NAMESPACED)
+    path = tmp_path / "pour.rrd"
+    with PourRecorder(path, model) as rec:
+        rec.log_state(0.0, 0, mujoco.MjData(model))
+    drawn = {p for p in entity_paths(path) if p.startswith(("/world/robot/", "/world/scene/"))}
+    assert drawn == {
+        "/world/scene/table",
+        "/world/robot/ns/link_body", "/world/robot/ns/link_body/link_visual", "/world/robot/ns/link_body/cylinder_1",
+        "/world/robot/ns/link_body/cylinder_2", "/world/robot/ns/link_body/ns_shell",
+        "/world/robot/ns/link/tip", "/world/robot/ns/link/tip/sphere",
+    }

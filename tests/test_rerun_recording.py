@@ -13,8 +13,11 @@ from matplotlib import colormaps
 
 from cosim.errors import InputError
 from cosim.io import rerun_paths
-from cosim.io.recording import FLUSH_ROWS, SPEED_COLORMAP, PourRecorder, RecordingConfig
-from cosim.io.rerun_read import entity_paths, read_component, read_scalar_series
+from cosim.io import recording
+from cosim.io.recording import SPEED_COLORMAP, PourRecorder, RecordingConfig
+from rerun.chunk import RrdReader
+from cosim.frames import quat_wxyz_to_matrix
+from cosim.io.rerun_read import entity_paths, read_component, read_scalar_series, recording_properties, series_names
 
 # s: resolution of the sim_time timeline (integer nanoseconds) -> round-trip tolerance of a time stamp.
 TIME_TOL = 1e-9
@@ -60,17 +63,17 @@ def test_recording_verifies_and_has_the_expected_entities(model, tmp_path):
     assert verify.returncode == 0, verify.stderr
 
     expected = {
-        "/world",
-        "/world/robot/world/floor",
+        "/world",  # the floor plane is not drawn
         "/world/robot/arm",
         "/world/robot/arm/link",
         "/world/robot/cup",
         "/world/robot/cup/cup_floor",
-        "/world/robot/cup/geom_3",  # unnamed geom: its index
+        "/world/robot/cup/cylinder",  # unnamed geom: its type
         "/world/liquid",
         "/signals/pourer/theta",
         "/signals/volume/in_pourer",
         "/events/phase",
+        "/legend",
     }
     assert entity_paths(path) == expected
     # geometry is static; body poses are on both timelines
@@ -82,28 +85,85 @@ def test_recording_verifies_and_has_the_expected_entities(model, tmp_path):
     assert text.values[0].tolist() == ["SIM: start"]
 
 
-def test_scalar_series_read_back_equals_what_was_logged(model, tmp_path):
+def test_scalar_series_read_back_equals_what_was_logged(model, tmp_path, monkeypatch):
+    monkeypatch.setattr(recording, "FLUSH_BYTES", 8 * 1000)  # a flush every 1000 rows of one float64
     path = tmp_path / "pour.rrd"
     rng = np.random.default_rng(1)
-    n = 2 * FLUSH_ROWS + 37  # several column flushes plus a remainder sent at close
+    n = 2 * 1000 + 37  # several column flushes plus a remainder sent at close
     dt = 0.002
     theta = rng.normal(size=n)
-    late = rng.normal(size=n)
+    late = rng.normal(size=(n, 3))
     with PourRecorder(path, model) as rec:
         for k in range(n):
             values = {"pourer/theta": theta[k]}
-            if k >= 500:  # a signal that appears mid-run
-                values["wrench/pourer/force z"] = late[k]
+            if k >= 500:  # a signal with three series that appears mid-run
+                values["wrench/pourer/force N"] = {"x": late[k, 0], "y": late[k, 1], "z": late[k, 2]}
             rec.log_scalars(k * dt, k, values)
     series = read_scalar_series(path, "pourer/theta")
     np.testing.assert_array_equal(series.values, theta)
     np.testing.assert_array_equal(series.step, np.arange(n))
     np.testing.assert_allclose(series.sim_time, np.arange(n) * dt, rtol=0, atol=TIME_TOL)
-    series = read_scalar_series(path, "wrench/pourer/force z")
-    np.testing.assert_array_equal(series.values, late[500:])
-    np.testing.assert_array_equal(series.step, np.arange(500, n))
-    names = read_component(path, rerun_paths.signal_path("wrench/pourer/force z"), "SeriesLines:names")
-    assert names.values[0].tolist() == ["pourer/force z"]
+    assert series_names(path, "wrench/pourer/force N") == ["x", "y", "z"]
+    for j, axis in enumerate("xyz"):
+        series = read_scalar_series(path, "wrench/pourer/force N", axis)
+        np.testing.assert_array_equal(series.values, late[500:, j])
+        np.testing.assert_array_equal(series.step, np.arange(500, n))
+    assert "/signals/wrench/pourer/force_N" in entity_paths(path)  # the space cleaned away, no escapes
+    chunks = [c for c in RrdReader(path).store().stream() if c.entity_path == "/signals/pourer/theta" and not c.is_static]
+    assert [c.num_rows for c in chunks] == [1000, 1000, 37]
+
+
+def test_a_signal_keeps_its_series(model, tmp_path):
+    with pytest.raises(ValueError, match="series"):
+        with PourRecorder(tmp_path / "pour.rrd", model) as rec:
+            rec.log_scalars(0.0, 0, {"pour/volume_mL": {"in pourer": 1.0, "in catcher": 0.0}})
+            rec.log_scalars(0.01, 1, {"pour/volume_mL": {"in pourer": 1.0}})
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_everything_on_the_timelines_is_one_chunk_per_entity(model, tmp_path):
+    path = tmp_path / "pour.rrd"
+    data = posed_data(model, 0.1, 0.2)
+    with PourRecorder(path, model, RecordingConfig(particle_rate_hz=100.0), frames=()) as rec:
+        for k in range(300):
+            t = 0.01 * k
+            rec.log_state(t, k, data, np.zeros((20, 3)) + k, np.ones(20))
+            rec.log_scalars(t, k, {"pour/tilt_deg": {"commanded": k, "measured": k}})
+            rec.log_arrows(t, k, "liquid_force", np.zeros((2, 3)), np.ones((2, 3)), ["a", "b"])
+            rec.log_points(t, k, "landing/measured", np.zeros((k % 2, 3)), 0.01, (255, 0, 0, 255), "measured")
+            rec.log_text(t, k, f"line {k}")
+    temporal = [c for c in RrdReader(path).store().stream() if not c.is_static]
+    per_entity = {}
+    for c in temporal:
+        per_entity[c.entity_path] = per_entity.get(c.entity_path, 0) + 1
+    assert set(per_entity.values()) == {1}, per_entity
+    assert {"/world/liquid", "/world/robot/arm", "/world/liquid_force", "/world/landing/measured", "/events/phase"} <= set(per_entity)
+    landing = read_component(path, "world/landing/measured", "Points3D:positions")
+    assert [len(v) for v in landing.values[:4]] == [0, 1, 0, 1]  # no point where nothing was measured
+    assert read_component(path, "world/liquid_force", "Arrows3D:labels").values[7].tolist() == ["a", "b"]
+
+
+def test_tool_frames_are_drawn_where_mujoco_has_the_sites(tmp_path):
+    model = mujoco.MjModel.from_xml_string(MJCF.replace("<geom name=\"cup_floor\"", "<site name=\"tool/tcp\" pos=\"0.1 0 0.02\" euler=\"0 0.5 0\"/><geom name=\"cup_floor\""))
+    data = posed_data(model, 0.3, -0.6)
+    path = tmp_path / "pour.rrd"
+    with PourRecorder(path, model, frames=["tool/tcp"]) as rec:
+        rec.log_state(0.0, 0, data)
+    pose = read_component(path, "world/frames/tool/tcp", "Transform3D:translation")
+    np.testing.assert_allclose(pose.values[0][0], data.site_xpos[0], atol=1e-6)
+    xyzw = read_component(path, "world/frames/tool/tcp", "Transform3D:quaternion").values[0][0]
+    np.testing.assert_allclose(quat_wxyz_to_matrix(np.asarray(xyzw, float)[[3, 0, 1, 2]]), data.site_xmat[0].reshape(3, 3), atol=2e-6)
+    assert read_component(path, "world/frames/tool/tcp", "TransformAxes3D:axis_length").values[0].tolist() == [pytest.approx(0.08)]
+
+
+def test_name_and_properties_travel_with_the_recording(model, tmp_path):
+    path = tmp_path / "pour.rrd"
+    with PourRecorder(path, model, name="my-run", properties={"scene_toml": "[fluid]\ndim = 3\n", "particles": 12}):
+        pass
+    assert recording_properties(path) == {"scene_toml": "[fluid]\ndim = 3\n", "particles": 12}
+    names = [c.to_record_batch().column("RecordingInfo:name").to_pylist()[-1][0] for c in RrdReader(path).store().stream()
+             if "RecordingInfo:name" in c.to_record_batch().schema.names]
+    assert names == ["my-run"]
 
 
 def test_state_is_rate_limited_in_sim_time(model, tmp_path):

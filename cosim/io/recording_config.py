@@ -13,8 +13,8 @@ class RecordingConfig:
 
     particle_stride: log every k-th liquid particle (by particle index, so the same particles are shown in every
         frame). [1, 1000]
-    particle_rate_hz: Hz of simulated time, at most how often body poses and particles are logged; scalars are
-        logged at every call. (0, 1000]
+    particle_rate_hz: Hz of simulated time, at most how often body poses, tool frames, particles, the liquid's force
+        and the landing points are logged; scalars are logged at every call. (0, 1000]
     speed_color_max: m/s, particle speed at the top of the colour map (faster particles share its top colour).
         (0, 100]
     """

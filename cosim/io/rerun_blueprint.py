@@ -1,65 +1,103 @@
-"""The default Rerun blueprint of a pour: a 3-D view of ``world``, the phase log, one time-series panel per group.
+"""The default Rerun blueprint of a pour: the 3-D view framed on the pour, the controller's log, the liquid's colour
+scale, and one plot panel per scalar signal, in a tab per signal group.
 
-Signals are grouped into panels by the first part of their name, split further by the suffix after the last ``.``
-of the last part (so ``joints/pour_arm/elbow.pos`` and ``joints/pour_arm/elbow.vel`` land in separate panels,
-"joints .pos" and "joints .vel", matching the trajectory CSV's ``<arm>/<joint>.pos|.vel|.acc`` columns). Examples:
-``pourer/theta`` and ``pourer/theta1`` share the panel "pourer"; ``volume/in_pourer`` and ``volume/spilled`` share
-"volume". Within a panel a series is labelled by the rest of its name (``pour_arm/elbow.pos``).
+A signal's name is ``<group>/<quantity>_<unit>`` (``pour_arm/joint_angle_deg``, ``pourer/liquid_force_N``); its
+panel is titled ``<group> <quantity> (<unit>)`` ("pour_arm joint angle (deg)") and sits in the tab ``<group>``.
+Units the title spells out are the keys of :data:`UNITS`; a name without one gets a title without a unit. A
+signal with several series (one entity, ``SeriesLines`` names) shows its legend in the top-left corner; a
+single-series panel needs none, its title says what it plots.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import dataclass
 
+import numpy as np
 import rerun.blueprint as rrb
+from matplotlib import colormaps
 
 from cosim.io import rerun_paths
 
-# Share of the window width given to the 3-D view + phase log column, and to the plot grid.
-_COLUMN_SHARES = [1.0, 1.0]
-# Share of the left column's height given to the 3-D view and to the phase log.
+# Name suffix -> unit as shown, longest suffixes first (``_deg_s`` before ``_deg``, ``_N_m`` before ``_N``).
+UNITS = {"_deg_s": "deg/s", "_mm_s": "mm/s", "_m_s": "m/s", "_N_m": "N m", "_deg": "deg", "_mL": "mL", "_mm": "mm", "_N": "N"}
+# Share of the window width given to the 3-D view column and to the plot tabs.
+_COLUMN_SHARES = [3.0, 2.0]
+# Share of the left column's height given to the 3-D view and to the log + colour scale row.
 _LEFT_ROW_SHARES = [4.0, 1.0]
-# Plot panels per row of the grid.
-_GRID_COLUMNS = 2
+# Plot panels per row of a tab's grid.
+_GRID_COLUMNS = 1
 
 
-def panel_key(name: str) -> tuple[str, str]:
-    """(group, suffix) of a signal: its first name part and the ``.suffix`` of its last part ('' if none)."""
-    parts = rerun_paths.signal_parts(name)
-    last = parts[-1]
-    suffix = last[last.rindex(".") :] if len(parts) > 1 and "." in last else ""
-    return parts[0], suffix
+@dataclass(frozen=True)
+class Camera:
+    """The 3-D view's starting camera: ``eye`` and ``target`` (3,) m, world frame, z up."""
+
+    eye: tuple[float, float, float]
+    target: tuple[float, float, float]
 
 
-def panel_title(key: tuple[str, str]) -> str:
-    """Readable title of a panel, e.g. ``joints .pos`` or ``volume``."""
-    group, suffix = key
-    return f"{group} {suffix}" if suffix else group
+def split_unit(name: str) -> tuple[str, str]:
+    """(quantity, unit) of a signal name's last part: ``joint_speed_deg_s`` -> (``joint_speed``, ``deg/s``);
+    unit '' when the name ends in none of :data:`UNITS`."""
+    last = rerun_paths.name_parts(name)[-1]
+    for suffix, unit in UNITS.items():
+        if last.endswith(suffix) and len(last) > len(suffix):
+            return last[: -len(suffix)], unit
+    return last, ""
 
 
-def series_label(name: str) -> str:
-    """Legend label of a signal within its panel: the name without its group (the whole name if one part)."""
-    parts = rerun_paths.signal_parts(name)
-    return "/".join(parts[1:]) if len(parts) > 1 else parts[0]
+def panel_title(name: str) -> str:
+    """Title of a signal's panel: ``pour_arm joint angle (deg)``."""
+    parts = rerun_paths.name_parts(name)
+    quantity, unit = split_unit(name)
+    words = " ".join([*parts[:-1], quantity.replace("_", " ")])
+    return f"{words} ({unit})" if unit else words
 
 
-def build_blueprint(signal_names: Iterable[str]) -> rrb.Blueprint:
-    """The default blueprint for a recording whose scalar signals are ``signal_names`` (in first-logged order)."""
-    panels: dict[tuple[str, str], list[str]] = {}
+def colour_scale_text(colormap: str, top: float, note: str = "") -> str:
+    """Markdown stating the liquid's colour scale: ``colormap`` from 0 to ``top`` m/s, the colours named by hex
+    code at 0, top/2 and top; ``note`` appended."""
+    cmap = colormaps[colormap]
+    stops = [(0.0, "0"), (0.5, f"{top / 2:g}"), (1.0, f"{top:g}")]
+    colours = ", ".join(f"`#{''.join(f'{c:02x}' for c in np.asarray(cmap(f, bytes=True))[:3])}` = {v} m/s" for f, v in stops)
+    text = f"**Liquid colour: speed**, {colormap} colour map from 0 to {top:g} m/s (faster is {top:g} m/s's colour): {colours}."
+    return f"{text}\n\n{note}" if note else text
+
+
+def _plot(name: str, series: int) -> rrb.TimeSeriesView:
+    legend = rrb.PlotLegend(corner=rrb.components.Corner2D.LeftTop, visible=series > 1)
+    return rrb.TimeSeriesView(origin=rerun_paths.signal_path(name), name=panel_title(name), plot_legend=legend)
+
+
+def build_blueprint(signal_names: Iterable[str], camera: Camera | None = None, series: dict[str, int] | None = None) -> rrb.Blueprint:
+    """The default blueprint for a recording whose scalar signals are ``signal_names`` (in first-logged order).
+
+    camera: the 3-D view's starting eye and target (None: Rerun frames the whole scene). series: signal name ->
+    number of series (a legend is shown where there are several; default 1)."""
+    series = series or {}
+    tabs: dict[str, list[rrb.TimeSeriesView]] = {}
     for name in signal_names:
-        panels.setdefault(panel_key(name), []).append(name)
-    plots = [
-        rrb.TimeSeriesView(
-            origin=rerun_paths.signal_path(key[0]),
-            contents=[f"+ {rerun_paths.absolute(rerun_paths.signal_path(n))}" for n in names],
-            name=panel_title(key),
-        )
-        for key, names in panels.items()
-    ]
+        tabs.setdefault(rerun_paths.name_parts(name)[0], []).append(_plot(name, series.get(name, 1)))
+    eye = None if camera is None else rrb.EyeControls3D(
+        kind=rrb.components.Eye3DKind.Orbital, position=camera.eye, look_target=camera.target, eye_up=(0.0, 0.0, 1.0)
+    )
+    space = rrb.Spatial3DView(
+        origin=rerun_paths.WORLD, name="pour, world frame (m); liquid coloured by speed", eye_controls=eye,
+        line_grid=rrb.LineGrid3D(visible=True, spacing=0.1),
+    )
     left = rrb.Vertical(
-        rrb.Spatial3DView(origin=rerun_paths.WORLD, name="pour (world frame, m)"),
-        rrb.TextLogView(origin=rerun_paths.EVENTS, name="controller phase"),
+        space,
+        rrb.Horizontal(
+            rrb.TextLogView(origin=rerun_paths.EVENTS, name="controller log"),
+            rrb.TextDocumentView(origin=rerun_paths.LEGEND, name="colour scale"),
+            column_shares=[2.0, 1.0],
+        ),
         row_shares=_LEFT_ROW_SHARES,
     )
-    layout = rrb.Horizontal(left, rrb.Grid(*plots, grid_columns=_GRID_COLUMNS), column_shares=_COLUMN_SHARES) if plots else left
-    return rrb.Blueprint(layout, rrb.TimePanel(timeline=rerun_paths.TIMELINE_TIME))
+    grids = [rrb.Grid(*plots, grid_columns=_GRID_COLUMNS, name=group) for group, plots in tabs.items()]
+    layout = rrb.Horizontal(left, rrb.Tabs(*grids), column_shares=_COLUMN_SHARES) if grids else left
+    return rrb.Blueprint(
+        layout, rrb.TimePanel(timeline=rerun_paths.TIMELINE_TIME), rrb.BlueprintPanel(state="collapsed"),
+        rrb.SelectionPanel(state="collapsed"),
+    )

@@ -3,7 +3,17 @@
 Each geom becomes the entity ``world/robot/<body>/<geom>`` holding a static Transform3D (geom frame -> body frame:
 ``model.geom_pos`` m, ``model.geom_quat``) and the geom's shape in its own frame, coloured like MuJoCo colours it
 (``geom_rgba``, or the material's ``mat_rgba`` when the geom keeps the default rgba). The body entity itself moves:
-:class:`cosim.io.recording.PourRecorder` logs its pose on the timelines.
+:class:`cosim.io.recording.PourRecorder` logs its pose on the timelines. The world body's geoms go under
+``world/scene``.
+
+Names: a body's MJCF name is its path under ``world/robot`` (``pour_arm/wrist_1_link``); a geom is named by its MJCF
+name less the namespace it shares with its body (``pourer/floor`` on body ``pourer`` is ``floor``), an unnamed geom
+by its mesh's name or its type (``cylinder``), numbered when a body has several of the same name (``cylinder_1``,
+``cylinder_2``). A body whose path would hold another body's entity gets ``_body`` appended, since Rerun composes
+the transforms of nested entities.
+
+Planes are not drawn: MuJoCo's ground plane is usually kilometres of texture that would only enlarge the 3-D view's
+bounds; the view's grid stands for the ground (:mod:`cosim.io.rerun_blueprint`).
 
 MuJoCo size conventions (``model.geom_size``, m): box = half sizes; sphere = radius; ellipsoid = semi-axes;
 capsule and cylinder = (radius, half length along the geom's z); plane = half sizes in x and y, 0 meaning infinite.
@@ -24,8 +34,6 @@ from cosim.io import rerun_paths
 # MuJoCo's viewer shows geom groups 0, 1 and 2 and hides 3-5 by default (mjvOption.geomgroup); models put
 # collision-only geoms in group 3, so the recording draws what MuJoCo's viewer draws.
 VISIBLE_GEOM_GROUPS = frozenset({0, 1, 2})
-# m: drawn half extent of a plane whose MuJoCo size is 0 (infinite).
-INFINITE_PLANE_HALF_SIZE = 1.5
 # geom_rgba MuJoCo gives a geom without an rgba attribute; with a material, the material colour shows instead.
 _DEFAULT_GEOM_RGBA = np.array([0.5, 0.5, 0.5, 1.0], dtype=np.float32)
 
@@ -58,9 +66,52 @@ def body_name(model: mujoco.MjModel, body_id: int) -> str:
     return model.body(body_id).name or f"body_{body_id}"
 
 
-def geom_name(model: mujoco.MjModel, geom_id: int) -> str:
-    """The geom's MJCF name, or ``geom_<id>`` for an unnamed geom."""
-    return model.geom(geom_id).name or f"geom_{geom_id}"
+def body_paths(model: mujoco.MjModel, body_ids) -> dict[int, str]:
+    """Entity of each body in ``body_ids``: ``world/scene`` for the world body, else its name under ``world/robot``,
+    with ``_body`` appended where another body's entity would lie below it."""
+    paths = {b: rerun_paths.SCENE if b == 0 else rerun_paths.under(rerun_paths.ROBOT, body_name(model, b)) for b in body_ids}
+    taken = set(paths.values())
+    for b, path in paths.items():
+        if b != 0 and any(other.startswith(path + "/") for other in taken):
+            paths[b] = path + "_body"
+    return paths
+
+
+def _own_geom_name(model: mujoco.MjModel, geom_id: int) -> str:
+    """A geom's name before numbering: its MJCF name less the leading parts it shares with its body's name, else its
+    mesh's name or its type."""
+    name = model.geom(geom_id).name
+    if name:
+        parts = rerun_paths.name_parts(name)
+        body = rerun_paths.name_parts(body_name(model, int(model.geom_bodyid[geom_id])))
+        shared = 0
+        while shared < min(len(parts) - 1, len(body)) and parts[shared] == body[shared]:
+            shared += 1
+        return "_".join(parts[shared:])
+    t = int(model.geom_type[geom_id])
+    if t == mujoco.mjtGeom.mjGEOM_MESH:
+        mesh = model.mesh(int(model.geom_dataid[geom_id])).name
+        if mesh:
+            return "_".join(rerun_paths.name_parts(mesh))
+    return mujoco.mjtGeom(t).name.removeprefix("mjGEOM_").lower()
+
+
+def geom_names(model: mujoco.MjModel, geom_ids) -> dict[int, str]:
+    """Name of each geom in ``geom_ids`` within its body (see the module docstring), unique per body."""
+    own = {g: _own_geom_name(model, g) for g in geom_ids}
+    count: dict[tuple[int, str], int] = {}
+    for g, name in own.items():
+        key = (int(model.geom_bodyid[g]), name)
+        count[key] = count.get(key, 0) + 1
+    seen: dict[tuple[int, str], int] = {}
+    out = {}
+    for g, name in own.items():
+        key = (int(model.geom_bodyid[g]), name)
+        if count[key] > 1:
+            seen[key] = seen.get(key, 0) + 1
+            name = f"{name}_{seen[key]}"
+        out[g] = name
+    return out
 
 
 def geom_rgba8(model: mujoco.MjModel, geom_id: int) -> np.ndarray:
@@ -104,9 +155,6 @@ def geom_shape(model: mujoco.MjModel, geom_id: int) -> rr.AsComponents | None:
     G = mujoco.mjtGeom
     if t == G.mjGEOM_BOX:
         return rr.Boxes3D(half_sizes=[size], colors=[color], fill_mode=_SOLID)
-    if t == G.mjGEOM_PLANE:
-        hx, hy = (float(s) if s > 0 else INFINITE_PLANE_HALF_SIZE for s in size[:2])
-        return rr.Boxes3D(half_sizes=[[hx, hy, 0.0]], colors=[color], fill_mode=_SOLID)
     if t == G.mjGEOM_SPHERE:
         return rr.Ellipsoids3D(half_sizes=[[size[0]] * 3], colors=[color], fill_mode=_SOLID)
     if t == G.mjGEOM_ELLIPSOID:
@@ -123,28 +171,29 @@ def geom_shape(model: mujoco.MjModel, geom_id: int) -> rr.AsComponents | None:
 
 
 def geom_visuals(model: mujoco.MjModel) -> tuple[list[GeomVisual], list[int]]:
-    """The drawable visible geoms (group in :data:`VISIBLE_GEOM_GROUPS`, alpha > 0), and the ids of visible geoms
-    skipped because their type is not drawn (height field, SDF)."""
-    visuals: list[GeomVisual] = []
-    skipped: list[int] = []
-    for g in range(model.ngeom):
-        if int(model.geom_group[g]) not in VISIBLE_GEOM_GROUPS or geom_rgba8(model, g)[3] == 0:
-            continue
-        shape = geom_shape(model, g)
-        if shape is None:
-            skipped.append(g)
-            continue
-        b = int(model.geom_bodyid[g])
-        visuals.append(
-            GeomVisual(
-                body_id=b,
-                geom_id=g,
-                path=rerun_paths.geom_path(body_name(model, b), geom_name(model, g)),
-                translation=np.asarray(model.geom_pos[g], dtype=np.float64).copy(),
-                quat_xyzw=xyzw_from_wxyz(model.geom_quat[g]).astype(np.float64),
-                shape=shape,
-            )
+    """The drawable visible geoms (group in :data:`VISIBLE_GEOM_GROUPS`, alpha > 0, not a plane), and the ids of
+    visible geoms skipped because their type is not drawn (height field, SDF)."""
+    shown = [
+        g for g in range(model.ngeom)
+        if int(model.geom_group[g]) in VISIBLE_GEOM_GROUPS and geom_rgba8(model, g)[3] > 0
+        and int(model.geom_type[g]) != mujoco.mjtGeom.mjGEOM_PLANE
+    ]
+    shapes = {g: geom_shape(model, g) for g in shown}
+    skipped = [g for g in shown if shapes[g] is None]
+    drawn = [g for g in shown if shapes[g] is not None]
+    bodies = body_paths(model, {int(model.geom_bodyid[g]) for g in drawn})
+    names = geom_names(model, drawn)
+    visuals = [
+        GeomVisual(
+            body_id=int(model.geom_bodyid[g]),
+            geom_id=g,
+            path=f"{bodies[int(model.geom_bodyid[g])]}/{names[g]}",
+            translation=np.asarray(model.geom_pos[g], dtype=np.float64).copy(),
+            quat_xyzw=xyzw_from_wxyz(model.geom_quat[g]).astype(np.float64),
+            shape=shapes[g],
         )
+        for g in drawn
+    ]
     return visuals, skipped
 
 
@@ -152,5 +201,4 @@ def log_static_geometry(rec: rr.RecordingStream, visuals: list[GeomVisual]) -> N
     """Log every geom once, static: its geom -> body transform and its shape, plus the world's z-up axes."""
     rec.log(rerun_paths.WORLD, rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     for v in visuals:
-        rec.log(v.path, rr.Transform3D(translation=v.translation, quaternion=rr.Quaternion(xyzw=v.quat_xyzw)), static=True)
-        rec.log(v.path, v.shape, static=True)
+        rec.log(v.path, rr.Transform3D(translation=v.translation, quaternion=rr.Quaternion(xyzw=v.quat_xyzw)), v.shape, static=True)

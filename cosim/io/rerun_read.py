@@ -1,7 +1,6 @@
 """Read a finished cosim recording back (``rerun.chunk.RrdReader``), for tests and for checks on a run's outputs.
 
-Entity paths are reported as Rerun writes them: absolute, with ``/`` and escaped name parts
-(``/signals/pourer/theta``). Times are in seconds of simulated time (the ``sim_time`` timeline), steps are the
+Entity paths are reported as Rerun writes them: absolute (``/signals/pour/tilt_deg``). Times are in seconds of simulated time (the ``sim_time`` timeline), steps are the
 ``step`` timeline. Rows come back sorted by sim_time, then step, then logging order.
 """
 
@@ -36,7 +35,7 @@ class Rows:
 
 @dataclass(frozen=True)
 class ScalarSeries:
-    """A scalar signal: sim_time (n,) s, step (n,) int64, values (n,) float64."""
+    """One series of a scalar signal: sim_time (n,) s, step (n,) int64, values (n,) float64."""
 
     sim_time: np.ndarray
     step: np.ndarray
@@ -47,6 +46,31 @@ def entity_paths(path: str | os.PathLike) -> set[str]:
     """Every entity path of the recording (its first recording store), without Rerun's property entity."""
     schema = RrdReader(path).store().schema()
     return {str(p) for p in schema.entity_paths()} - {_PROPERTIES_ENTITY}
+
+
+def recording_properties(path: str | os.PathLike) -> dict[str, object]:
+    """The properties a recorder sent with the recording (``PourRecorder(properties=...)``): name -> value."""
+    out: dict[str, object] = {}
+    for chunk in RrdReader(path).store().stream().filter(content=f"{_PROPERTIES_ENTITY}/**"):
+        batch = chunk.to_record_batch()
+        for name in batch.schema.names:
+            if name != _ROW_ID and chunk.entity_path != _PROPERTIES_ENTITY:
+                out[name.rsplit(":", 1)[-1]] = batch.column(name).to_pylist()[-1][0]
+    return out
+
+
+def blueprint_camera(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
+    """(eye position, look target) (3,) m of the 3-D view in the recording's default blueprint; KeyError if it
+    sets none."""
+    reader = RrdReader(path)
+    for entry in reader.blueprints():
+        for chunk in reader.store(store=entry).stream():
+            batch = chunk.to_record_batch()
+            if "EyeControls3D:position" in batch.schema.names:
+                eye = batch.column("EyeControls3D:position").to_pylist()[-1][0]
+                target = batch.column("EyeControls3D:look_target").to_pylist()[-1][0]
+                return np.array(eye), np.array(target)
+    raise KeyError(f"{path}: the blueprint sets no 3-D eye position")
 
 
 def _batch_numpy(arr: pa.Array) -> np.ndarray:
@@ -91,8 +115,20 @@ def read_component(path: str | os.PathLike, entity: str, component: str) -> Rows
     return Rows(t_ns[order] / 1e9, step[order].astype(np.int64), [values[i] for i in order])
 
 
-def read_scalar_series(path: str | os.PathLike, name: str) -> ScalarSeries:
-    """The scalar signal ``name`` (as passed to ``PourRecorder.log_scalars``) read back from the recording."""
+def series_names(path: str | os.PathLike, name: str) -> list[str]:
+    """The series names of the scalar signal ``name`` (its ``SeriesLines`` names, in logging order)."""
+    return [str(v) for v in read_component(path, rerun_paths.signal_path(name), "SeriesLines:names").values[0]]
+
+
+def read_scalar_series(path: str | os.PathLike, name: str, series: str | None = None) -> ScalarSeries:
+    """The scalar signal ``name`` (as passed to ``PourRecorder.log_scalars``) read back from the recording; for a
+    signal with several series, the one named ``series`` (KeyError if it has no such series)."""
     rows = read_component(path, rerun_paths.signal_path(name), "Scalars:scalars")
-    values = np.array([float(r[0]) for r in rows.values], dtype=np.float64)
+    k = 0
+    if series is not None:
+        names = series_names(path, name)
+        if series not in names:
+            raise KeyError(f"{path}: signal {name} has no series {series!r} (it has {names})")
+        k = names.index(series)
+    values = np.array([float(r[k]) for r in rows.values], dtype=np.float64)
     return ScalarSeries(rows.sim_time, rows.step, values)
