@@ -5,7 +5,8 @@
 Reads each sweep output's sweep.csv (``cosim sweep``, e.g. examples/sim_study.toml and examples/approach_study.toml)
 and, for every pour that ran, its summary.json and series.csv, and prints one Markdown row per pour: its axes, the
 spill (% of what it poured), when the outflow became steady (s after the pour's start), the spread of h_q in CFS
-(standard deviation after the steady outflow, mm), how long t2 lasted and why it ended, the slosh angle's largest
+(median and interquartile range after the steady outflow, mm: robust to the samples near the end where the nearly
+empty vessel has no free surface to measure), how long t2 lasted and why it ended, the slosh angle's largest
 |sigma| over the first and the last half slosh period of t2 (rad), and when the pour was done (s).
 """
 
@@ -22,7 +23,7 @@ import numpy as np
 from cosim.atomic_files import write_text_atomic
 
 HALF_PERIOD_SAMPLES = 25  # control steps (10 ms) in half a slosh period of the paper's vessel (0.50 s period)
-COLUMNS = ("spill (% of poured)", "steady outflow (s)", "h_q spread in CFS (mm)", "t2 (s)", "t2 ended",
+COLUMNS = ("spill (% of poured)", "steady outflow (s)", "h_q in CFS: median, IQR (mm)", "t2 (s)", "t2 ended",
            "|sigma| at t2 start (rad)", "|sigma| at t2 end (rad)", "done at (s)")
 
 
@@ -38,14 +39,16 @@ def pour_row(folder: Path) -> list[str]:
     poured = summary["poured_volume"]
     spill = 100.0 * summary["spilled_volume"] / poured if poured > 0 else math.nan
     steady = summary["outflow"].get("steady_outflow")
-    cfs = (phase == "cfs") & (t >= (steady if steady is not None else math.inf) + summary["scene"]["coupling"]["start_delay"])
+    steady = math.nan if steady is None else steady
+    cfs = (phase == "cfs") & (t >= steady + summary["scene"]["coupling"]["start_delay"])
     damp = np.flatnonzero(phase == "sim_damp")
-    ended = next((tr["reason"].split(":")[0] for tr in summary["transitions"] if tr["from"] == "sim_damp"), "")
+    ended = next((tr["reason"].split(":")[0].split(",")[0] for tr in summary["transitions"] if tr["from"] == "sim_damp"), "")
     done = next((p["start"] for p in summary["phases"] if p["phase"] == "done"), math.nan)
     cells = [
         f"{spill:.2f}",
-        "-" if steady is None else f"{steady:.2f}",
-        f"{1e3 * np.std(h_q[cfs]):.2f}" if cfs.any() else "-",
+        "-" if math.isnan(steady) else f"{steady:.2f}",
+        "{:.1f}, {:.1f}".format(1e3 * np.median(h_q[cfs]), 1e3 * np.subtract(*np.percentile(h_q[cfs], [75, 25])))
+        if cfs.any() else "-",
         f"{t[damp[-1]] - t[damp[0]] + 0.01:.2f}" if damp.size else "-",
         ended or "-",
         f"{np.max(np.abs(sigma[damp[:HALF_PERIOD_SAMPLES]])):.3f}" if damp.size else "-",
