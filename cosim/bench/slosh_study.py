@@ -5,8 +5,8 @@
 Reads each sweep output's sweep.csv (``cosim sweep``, e.g. examples/sim_study.toml and examples/approach_study.toml)
 and, for every pour that ran, its summary.json and series.csv, and prints one Markdown row per pour: its axes, the
 spill (% of what it poured), when the outflow became steady (s after the pour's start), the spread of h_q in CFS
-(median and interquartile range after the steady outflow, mm: robust to the samples near the end where the nearly
-empty vessel has no free surface to measure), how long t2 lasted and why it ended, the slosh angle's largest
+(median and interquartile range after the steady outflow, mm, over the samples with a surface to measure: the probe
+reports -inner height for a vessel too empty for one), how long t2 lasted and why it ended, the slosh angle's largest
 |sigma| over the first and the last half slosh period of t2 (rad), and when the pour was done (s).
 """
 
@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from controllers.config import CFS_MAX_HEAD
 from cosim.atomic_files import write_text_atomic
 
 HALF_PERIOD_SAMPLES = 25  # control steps (10 ms) in half a slosh period of the paper's vessel (0.50 s period)
@@ -40,7 +41,8 @@ def pour_row(folder: Path) -> list[str]:
     spill = 100.0 * summary["spilled_volume"] / poured if poured > 0 else math.nan
     steady = summary["outflow"].get("steady_outflow")
     steady = math.nan if steady is None else steady
-    cfs = (phase == "cfs") & (t >= steady + summary["scene"]["coupling"]["start_delay"])
+    measured = h_q > -CFS_MAX_HEAD  # the probe's "no surface" is -inner height; CFS heads lie within +-CFS_MAX_HEAD
+    cfs = (phase == "cfs") & (t >= steady + summary["scene"]["coupling"]["start_delay"]) & measured
     damp = np.flatnonzero(phase == "sim_damp")
     ended = next((tr["reason"].split(":")[0].split(",")[0] for tr in summary["transitions"] if tr["from"] == "sim_damp"), "")
     done = next((p["start"] for p in summary["phases"] if p["phase"] == "done"), math.nan)
