@@ -53,11 +53,10 @@ class SimConfig:
     settle_tolerance: rad, |sigma| below which the slosh counts as damped. (0, 0.2]
     settle_dwell: s, how long |sigma| must stay below the tolerance before t3. [0, 5]
     max_tilt_rate: rad/s, rate limit of the PID's output. (0, 10]
-    handover: :class:`Handover`. ``crest`` (the default) is the paper's t3: CFS starts as the induced wave runs over
-      the crest, and t2 damps toward the tilt that pours at cfs.h_q_ref; on the coupled pour the PID then acts for
-      under a slosh period. ``damped`` holds the level damp_head below the crest until the slosh is damped: it
-      damps the SPH liquid on an arm that tracks its commands (ideal force-torque compensation) but not yet on the
-      default, payload-compensated arm (docs/controller.md).
+    handover: :class:`Handover`. ``damped`` (the default) holds the level damp_head below the crest until the slosh
+      is damped, then CFS starts the outflow from a calm liquid. ``crest`` is the paper's t3: CFS starts as the
+      induced wave runs over the crest, and t2 damps toward the tilt that pours at cfs.h_q_ref; on the coupled pour
+      the PID then acts for under a slosh period (docs/controller.md).
     damp_head: m, height over the crest at which t2 holds the resting liquid (negative: below the crest). The PID
       acts on the pendulum plant only while the slosh stays inside the vessel: once liquid runs over the crest, the
       crest clamps the surface and theta1 no longer follows Gp. Holding the level below the crest by the wall rise
@@ -75,7 +74,7 @@ class SimConfig:
     settle_tolerance: float = 0.01
     settle_dwell: float = 0.25
     max_tilt_rate: float = 2.0
-    handover: Handover = Handover.CREST
+    handover: Handover = Handover.DAMPED
     damp_head: float = -0.005
     pid: PidDesignSpec = field(default_factory=PidDesignSpec)
 

@@ -25,7 +25,7 @@ from cosim.atomic_files import write_text_atomic
 
 HALF_PERIOD_SAMPLES = 25  # control steps (10 ms) in half a slosh period of the paper's vessel (0.50 s period)
 COLUMNS = ("spill (% of poured)", "steady outflow (s)", "h_q in CFS: median, IQR (mm)", "t2 (s)", "t2 ended",
-           "|sigma| at t2 start (rad)", "|sigma| at t2 end (rad)", "done at (s)")
+           "max sigma, t2 start (rad)", "max sigma, t2 end (rad)", "done at (s)")
 
 
 def pour_row(folder: Path) -> list[str]:
