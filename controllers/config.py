@@ -24,6 +24,14 @@ class Handover(Enum):
     CREST = "crest"  # the paper's rule: as soon as liquid runs over the crest (h_q > 0), else as DAMPED
 
 
+class Damping(Enum):
+    """What SIM's damping phase t2 does with the slosh the excitation left."""
+
+    PID = "pid"  # the filtered PID on theta1 (controllers.pid), the paper's t2
+    HOLD = "hold"  # no feedback: the tilt moves to the same reference through the same smoother and holds it, so
+    # the slosh decays at the liquid's own damping (the comparison case for the PID)
+
+
 class SimMode(Enum):
     """When the slosh induction method runs."""
 
@@ -62,6 +70,8 @@ class SimConfig:
       crest clamps the surface and theta1 no longer follows Gp. Holding the level below the crest by the wall rise
       (B/2) tan(sigma) of the induced wave keeps it in: 5 mm is that rise for sigma = 3 deg in the paper's vessel.
       t2 then ends once the slosh is damped, and CFS starts the outflow from a calm liquid. [-0.05, 0.05]
+    damping: :class:`Damping`. ``pid`` (the default) damps theta1 with the PID; ``hold`` moves to the same tilt
+      reference open loop and lets the liquid's own damping act (the comparison case, docs/controller.md).
     pid: :class:`controllers.pid.PidDesignSpec`.
     """
 
@@ -76,6 +86,7 @@ class SimConfig:
     max_tilt_rate: float = 2.0
     handover: Handover = Handover.DAMPED
     damp_head: float = -0.005
+    damping: Damping = Damping.PID
     pid: PidDesignSpec = field(default_factory=PidDesignSpec)
 
     def __post_init__(self) -> None:
@@ -90,6 +101,7 @@ class SimConfig:
         check_range("sim.max_tilt_rate", self.max_tilt_rate, 0.0, 10.0, "rad/s", lo_open=True)
         object.__setattr__(self, "handover", check_choice("sim.handover", self.handover, Handover))
         check_range("sim.damp_head", self.damp_head, -0.05, 0.05, "m")
+        object.__setattr__(self, "damping", check_choice("sim.damping", self.damping, Damping))
         _check_type("sim.pid", self.pid, PidDesignSpec)
 
 

@@ -31,7 +31,7 @@ import numpy as np
 
 from controllers.catcher import CatcherFollower, landing_x, weir_velocity
 from controllers.cfs import after_flow_volume, cfs_increment, cfs_pivot, crest_lever
-from controllers.config import Handover, PourConfig, SimMode
+from controllers.config import Damping, Handover, PourConfig, SimMode
 from controllers.errors import ControllerInputError, MeasurementError
 from controllers.geometry import PlanarPose, static_tilt_for_h_q
 from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
@@ -111,6 +111,7 @@ class PourController:
         self._cfs_history: deque[tuple[float, float, float]] = deque()  # (t, poured, tilt) over the last hold
         self._tilt_history: deque[tuple[float, float, float]] = deque()  # (t, commanded, measured tilt), LAG_WINDOW
         self._reference = 0.0  # rad, tilt reference of SIM_DAMP / target of APPROACH
+        self._held_tilt = 0.0  # rad, SIM_DAMP's open-loop tilt command (sim.damping = hold)
         self._return_from = PlanarPose()
 
         self._check: dict[Phase, Callable[[LiquidMeasurement], Transition]] = {
@@ -215,6 +216,7 @@ class PourController:
             self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
             self._reference = self._damp_reference(m)
             self._pid.reset(u0=self.pose.theta, y0=m.theta1, r0=self._reference)
+            self._held_tilt = self.pose.theta
             self._smoother.reset(self.pose.theta)
         elif phase is Phase.APPROACH:
             self._reference = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
@@ -381,7 +383,13 @@ class PourController:
     def _act_damp(self, m: LiquidMeasurement) -> PlanarPose:
         assert self._pid is not None and self._smoother is not None
         self._reference = self._damp_reference(m)
-        return self.pose.rotated_about((0.0, 0.0), self._smoother.step(self._pid.step(self._reference, m.theta1)))
+        sim = self.config.sim
+        if sim.damping is Damping.PID:
+            command = self._pid.step(self._reference, m.theta1)
+        else:  # the same reference at the PID's rate limit, without feedback
+            step = sim.max_tilt_rate * self.dt
+            command = self._held_tilt = min(max(self._reference, self._held_tilt - step), self._held_tilt + step)
+        return self.pose.rotated_about((0.0, 0.0), self._smoother.step(command))
 
     def _act_approach(self, m: LiquidMeasurement) -> PlanarPose:
         theta = self._approach.step(self._reference)

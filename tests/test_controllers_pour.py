@@ -14,6 +14,7 @@ from controllers import (
     CatcherConfig,
     CfsConfig,
     ControllerInputError,
+    Damping,
     Handover,
     LiquidMeasurement,
     MeasurementError,
@@ -106,6 +107,29 @@ def test_sim_timeline_on_the_linear_plant() -> None:
     late = (trace.t > t_cfs + CFS_TRANSIENT - 0.5) & (trace.t <= t_cfs + CFS_TRANSIENT)
     assert np.max(np.abs(sigma[late])) < SLOSH_DECAY * induced
     assert t[-1] < 60.0
+
+
+def test_holding_the_tilt_leaves_the_slosh_the_pid_damps() -> None:
+    """The comparison case sim.damping = hold: t2 moves to the PID's reference open loop and holds it. On the
+    model plant (a pendulum without damping) the slosh then stays above a third of its amplitude at t2's start and
+    t2 ends by its timeout, where the PID damps it to a third: the damping is the PID's, not the plant's."""
+    base = _config(target_volume=0.3 * _config().initial_volume)
+    amplitude = {}
+    for damping in (Damping.PID, Damping.HOLD):
+        config = dataclasses.replace(base, sim=SimConfig(damping=damping))
+        controller, _, trace = _run(config)
+        phases = _phases(trace)
+        sigma = trace.series("theta1") - trace.series("tilt")
+        damp = np.flatnonzero(phases == Phase.SIM_DAMP)
+        half_period = int(0.5 * controller.model.period / config.dt)
+        amplitude[damping] = np.max(np.abs(sigma[damp[-half_period:]])) / np.max(np.abs(sigma[damp[:half_period]]))
+        reason = next(tr.reason for tr in controller.transitions if tr.source is Phase.SIM_DAMP)
+        assert ("timeout" in reason) == (damping is Damping.HOLD), reason
+        if damping is Damping.HOLD:  # the open-loop command is rate-limited like the PID's output
+            tilt_rate = np.abs(np.diff(trace.series("tilt")[damp])) / config.dt
+            assert np.max(tilt_rate) <= config.sim.max_tilt_rate * (1 + 1e-9)
+    # the open-loop move to the reference changes the slosh's phase and amplitude once; after it nothing damps
+    assert amplitude[Damping.PID] <= 1.0 / 3.0 < amplitude[Damping.HOLD]
 
 
 def test_partial_pour_reaches_its_target_and_holds_h_q() -> None:
