@@ -92,3 +92,11 @@ def test_the_dump_lists_the_vessels_and_the_placement_with_their_ranges():
                  "wall_thickness = 0.005 # m, floor and walls; less than the inner width (and a box's inner depth). [0.001, 0.05]",
                  "pour_height = 0.401 # m, the pourer's lip above the catcher's rim at home"):
         assert line in text
+
+
+@pytest.mark.parametrize("name", ["small_beaker", "cylinder_cup"])
+def test_the_example_cells_pass_the_checks(name):
+    scene = load_scene(SMALL_BEAKER.with_name(f"{name}.toml"))
+    plan = check_pour(scene)
+    pourer = plan.robots.arms[ArmRole.POUR].vessel
+    assert pourer == scene.vessels.pourer.spec("pourer") and plan.particles > 0
