@@ -239,12 +239,12 @@ class VesselSettings:
       the empty vessel's mass. [100, 25000]
     """
 
-    shape: VesselShape = VesselShape.BOX
-    inner_width: float = seed_pouring_vessel().inner_width
-    inner_depth: float = seed_pouring_vessel().inner_depth
-    inner_height: float = seed_pouring_vessel().inner_height
-    wall_thickness: float = seed_pouring_vessel().wall_thickness
-    wall_density: float = seed_pouring_vessel().wall_density
+    shape: VesselShape = VesselSpec.shape
+    inner_width: float = VesselSpec.inner_width
+    inner_depth: float = VesselSpec.inner_depth
+    inner_height: float = VesselSpec.inner_height
+    wall_thickness: float = VesselSpec.wall_thickness
+    wall_density: float = VesselSpec.wall_density
 
     @classmethod
     def of(cls, spec: VesselSpec) -> "VesselSettings":
