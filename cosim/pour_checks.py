@@ -5,7 +5,7 @@ the robot scene, the joint limits, the liquid's configuration, its particle coun
 the run's wall time. Checked, in order: Rerun present when the recording is on; the device; the robot scene (the
 scene file, or the cell built around the scene's vessels with the arms' home postures solved); the fill below the
 pourer's rim; the catcher holding what is poured; the catcher above the table; each arm's load against its rated
-payload; the joint-limit overrides; the arms' reach over the pour's poses (:func:`check_reach`); the liquid's
+payload; the joint-limit overrides; the arms' reach over the pour's poses, free of collisions (:func:`check_reach`); the liquid's
 resolution (layers deep, particles across); the memory of its pair tables and cell grids
 (:func:`cosim.fluid.memory.check_memory`); and, unless the caller accepts long runs, the estimated wall time against
 :data:`LONG_RUN_S`. Nothing is allocated for the liquid and nothing is written, so a refused scene costs seconds, not
@@ -29,8 +29,11 @@ from typing import TYPE_CHECKING
 from cosim.errors import InputError
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from cosim.fluid.config import FluidConfig
     from cosim.pour_scene import PourScene
+    from cosim.robots.collision import MotionChecker
     from cosim.robots.scene import RobotScene
     from cosim.robots.scene_config import ArmRole
     from cosim.trajectory.limits import ArmLimits
@@ -160,15 +163,20 @@ def check_vessels(scene: PourScene, robots: RobotScene) -> None:
 
 
 def check_reach(robots: RobotScene, max_tilt: float, travel: float) -> None:
-    """Every pose the pour will ask of the arms reachable, before any simulation: the pourer tilted from upright to
-    ``max_tilt`` (rad) about its bottom middle (slosh induction's pivot) and about its lip (the constant-flow stage's
-    pivots lie between the two), the catcher moved ``travel`` (m) each way along the pour direction. Each sweep is
-    solved by inverse kinematics from the arm's home posture on, each solve starting from the last; the first pose
-    out of reach is an InputError naming it."""
+    """Every pose the pour will ask of the arms reachable and free of collisions, before any simulation: the pourer
+    tilted from upright to ``max_tilt`` (rad) about its bottom middle (slosh induction's pivot) and about its lip (the
+    constant-flow stage's pivots lie between the two), the other vessel at home; the catcher moved ``travel`` (m) each
+    way along the pour direction, the pourer upright at home. Each sweep is solved by inverse kinematics from the
+    arm's home posture on, each solve starting from the last; each pose reached, and home, is posed for MuJoCo's
+    collision detection (:class:`cosim.robots.collision.MotionChecker`: vessel-vessel, arm-table, arm-arm, ...). The
+    first pose out of reach or in collision is an InputError naming it."""
+    from cosim.robots.collision import MotionChecker
     from cosim.robots.ik import IKSettings
     from cosim.robots.planar import PlanarPose, tilt_about_pivot
     from cosim.robots.scene_config import ArmRole
 
+    checker = MotionChecker(robots)
+    _check_contact(checker, {}, "the vessels at home")
     pour = robots.arms[ArmRole.POUR]
     steps = max(1, math.ceil(max_tilt / REACH_TILT_STEP))
     tilts = [max_tilt * k / steps for k in range(1, steps + 1)]
@@ -195,6 +203,18 @@ def check_reach(robots: RobotScene, max_tilt: float, travel: float) -> None:
                     f"the vessels nearer the arms (placement.*) or ask less of them"
                 )
             q = result.q
+            _check_contact(checker, {role: q}, label)
+
+
+def _check_contact(checker: MotionChecker, configuration: dict[ArmRole, np.ndarray], label: str) -> None:
+    """InputError naming ``label`` where the arms at ``configuration`` (role -> joint angles, rad; the other arm at
+    home) touch anything (:meth:`cosim.robots.collision.MotionChecker.contact_at`)."""
+    hit = checker.contact_at(configuration)
+    if hit is not None:
+        raise InputError(
+            f"placement: {label}: {hit.geom1} ({hit.body1}) touches {hit.geom2} ({hit.body2}) ({hit.pair}, "
+            f"{-hit.distance * 1e3:.1f} mm deep); place the vessels elsewhere (placement.*) or ask less of the arms"
+        )
 
 
 def check_pour(scene: PourScene, long_run_ok: bool = False) -> PourPlan:

@@ -34,10 +34,15 @@ REFUSED = {
                                           "vessels.pourer.wall_thickness: must be in [0.001, 0.02) m, got 0.03"),
     "pourer tilt out of reach": ("[placement]\npourer_height = 1.0\n", "placement: the pourer tilted 86 deg about its bottom "
                                  "middle (controller.cfs.max_tilt 100 deg) is out of pour_arm's reach"),
-    "catcher travel out of reach": ("[placement]\ncatcher_home_x = 0.6\n", "placement: the catcher moved +0.075 m from its "
-                                    "home (controller.catcher.travel 0.15 m) is out of catch_arm's reach"),
+    "catch arm folding into itself": ("[placement]\ncatcher_home_x = 0.45\n", "placement: the catcher moved +0.050 m from its "
+                                      "home (controller.catcher.travel 0.15 m): geom 47 (catch_arm/upper_arm_link) touches "
+                                      "geom 62 (catch_arm/wrist_2_link) (arm-arm"),
     "catcher below the table": ("[placement]\npour_height = 1.0\n",
                                 "placement.pour_height: 1 m puts the catcher's bottom 474 mm below the table top"),
+    "vessels touching at home": ("[placement]\npour_height = 0.15\n",
+                                 "placement: the vessels at home: pourer/floor (pourer) touches catcher/back (catcher) (vessel-vessel"),
+    "pourer tilting into the catcher": ("[placement]\npour_height = 0.30\n", "placement: the pourer tilted 100 deg about its "
+                                        "bottom middle (controller.cfs.max_tilt 100 deg): pourer/front (pourer) touches catcher/back (catcher)"),
     "vessels with a scene file": ("[robots]\nscene = 'my_scene.xml'\n[vessels.pourer]\ninner_width = 0.1\n",
                                   "robots.scene: a scene file brings its own vessels and placement"),
 }
