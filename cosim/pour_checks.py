@@ -5,8 +5,8 @@ the robot scene, the joint limits, the liquid's configuration, its particle coun
 the run's wall time. Checked, in order: Rerun present when the recording is on; the device; the robot scene (the
 scene file, or the cell built around the scene's vessels with the arms' home postures solved); the fill below the
 pourer's rim; the catcher holding what is poured; the catcher above the table; each arm's load against its rated
-payload; the joint-limit overrides; the arms' reach over the pour's poses, free of collisions (:func:`check_reach`); the liquid's
-resolution (layers deep, particles across); the memory of its pair tables and cell grids
+payload; the joint-limit overrides; the arms' reach over the pour's poses, free of collisions (:func:`check_reach`);
+the liquid's resolution (layers deep, particles across); the memory of its pair tables and cell grids
 (:func:`cosim.fluid.memory.check_memory`); and, unless the caller accepts long runs, the estimated wall time against
 :data:`LONG_RUN_S`. Nothing is allocated for the liquid and nothing is written, so a refused scene costs seconds, not
 the minute a fine 3-D liquid takes to seed. The pour controller's own checks (its PID design) need the seeded liquid's
@@ -240,7 +240,8 @@ def check_pour(scene: PourScene, long_run_ok: bool = False) -> PourPlan:
     base = scene.fluid.fluid_config(pourer.inner_width)
     cfg = pour_fluid_config(robots, base, fill)
     check_resolution(pourer, fill, cfg)
-    particles = round(_liquid_volume(pourer, fill_layers(pourer, fill, cfg.spacing) * cfg.spacing, cfg.dim) / cfg.particle_volume)
+    seeded_depth = fill_layers(pourer, fill, cfg.spacing) * cfg.spacing
+    particles = round(_liquid_volume(pourer, seeded_depth, cfg.dim) / cfg.particle_volume)
     walls = sum(len(sample_vessel_walls(robots.arms[r].vessel, cfg.spacing, cfg.support_radius, cfg.dim)[0]) for r in ArmRole)
     check_memory(cfg, particles, walls, device)
     substeps = round(scene.coupling.max_duration / cfg.fixed_time_step)
