@@ -226,8 +226,8 @@ class PourConfig:
       margin, 13.8 dB gain margin and Ms = 1.47 (50 Hz: 43 deg, 11.6 dB, Ms = 1.70).
     start_time: s, the controller idles (vessel at home, catcher pre-positioned) until this time. [0, 60]
     gravity: m/s^2. (0, 100]
-    slosh: the pourer's first-mode slosh model the controller is designed on; None: potential flow for the box
-      vessel and fill (:func:`controllers.slosh.potential_flow_model`). Set it for a vessel with no closed form, from
+    slosh: the pourer's first-mode slosh model the controller is designed on; None: potential flow for the vessel's
+      shape and fill (:func:`controllers.slosh.potential_flow_model`). Set it for a vessel with no closed form, from
       the SPH identification (``cosim validate slosh-plant``).
     """
 
@@ -264,10 +264,10 @@ class PourConfig:
             _check_type("pour.slosh", self.slosh, SloshModel)
 
     def slosh_model(self) -> SloshModel:
-        """The slosh model the controller is designed on: ``slosh`` if set, else potential flow for the box."""
+        """The slosh model the controller is designed on: ``slosh`` if set, else potential flow for the vessel."""
         if self.slosh is not None:
             return self.slosh
-        return potential_flow_model(self.vessel.inner_width, self.fill_depth, self.gravity)
+        return potential_flow_model(self.vessel.inner_width, self.fill_depth, self.gravity, self.vessel.shape)
 
     @property
     def initial_volume(self) -> float:

@@ -67,7 +67,7 @@ class ModelPlant:
     def __init__(self, config: ModelPlantConfig, dt: float) -> None:
         self.config = config
         geom = config.vessel
-        self.model = config.slosh or potential_flow_model(geom.inner_width, config.fill_depth, config.gravity)
+        self.model = config.slosh or potential_flow_model(geom.inner_width, config.fill_depth, config.gravity, geom.shape)
         self._h = dt / config.substeps
         sysd = ct.c2d(self.model.state_space(), self._h, "zoh")
         self._a, self._b = np.asarray(sysd.A), np.asarray(sysd.B)

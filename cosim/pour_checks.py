@@ -2,12 +2,15 @@
 
 :func:`check_pour` refuses a scene (one :class:`InputError` line naming the field) or returns a :class:`PourPlan`:
 the robot scene, the joint limits, the liquid's configuration, its particle counts, its memory and an estimate of
-the run's wall time. Checked, in order: Rerun present when the recording is on; the device; the robot scene file; the
-fill below the pourer's rim; the joint-limit overrides; the liquid's resolution (layers deep, particles across); the
-memory of its pair tables and cell grids (:func:`cosim.fluid.memory.check_memory`); and, unless the caller accepts
-long runs, the estimated wall time against :data:`LONG_RUN_S`. Nothing is allocated for the liquid and nothing is
-written, so a refused scene costs seconds, not the minute a fine 3-D liquid takes to seed. The pour controller's own
-checks (its PID design) need the seeded liquid's actual fill and run when the pour is built.
+the run's wall time. Checked, in order: Rerun present when the recording is on; the device; the robot scene (the
+scene file, or the cell built around the scene's vessels with the arms' home postures solved); the fill below the
+pourer's rim; the catcher holding what is poured; the catcher above the table; each arm's load against its rated
+payload; the joint-limit overrides; the arms' reach over the pour's poses, free of collisions (:func:`check_reach`);
+the liquid's resolution (layers deep, particles across); the memory of its pair tables and cell grids
+(:func:`cosim.fluid.memory.check_memory`); and, unless the caller accepts long runs, the estimated wall time against
+:data:`LONG_RUN_S`. Nothing is allocated for the liquid and nothing is written, so a refused scene costs seconds, not
+the minute a fine 3-D liquid takes to seed. The pour controller's own checks (its PID design) need the seeded liquid's
+actual fill and run when the pour is built.
 
 The estimate (:func:`estimate_wall_time`) is wall = particles x substeps x :data:`SECONDS_PER_PARTICLE_STEP`, with
 substeps = ``coupling.max_duration`` / the fixed time step (:attr:`cosim.fluid.config.FluidConfig.fixed_time_step`).
@@ -18,6 +21,7 @@ estimate with measured pours).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from importlib.util import find_spec
 from typing import TYPE_CHECKING
@@ -25,11 +29,15 @@ from typing import TYPE_CHECKING
 from cosim.errors import InputError
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from cosim.fluid.config import FluidConfig
     from cosim.pour_scene import PourScene
+    from cosim.robots.collision import MotionChecker
     from cosim.robots.scene import RobotScene
     from cosim.robots.scene_config import ArmRole
     from cosim.trajectory.limits import ArmLimits
+    from cosim.vessel import VesselSpec
 
 # s of wall time per liquid particle per solver substep, the MuJoCo arms and the controller included (no recording):
 # the default pour's wall time over its particles times substeps (summary.json's wall_time / (particles x
@@ -37,6 +45,12 @@ if TYPE_CHECKING:
 # so scenes with more particles per step are overestimated, the safe side for a gate.
 SECONDS_PER_PARTICLE_STEP = 6.5e-6
 LONG_RUN_S = 3600.0  # s: a longer estimate is refused unless the caller accepts it (`cosim pour --yes`)
+# The reach check's sweep: the pourer's tilt in steps of at most this (rad, 5 deg), the catcher's travel in this many
+# steps each way; each inverse-kinematics solve starts from the last, as the pour's own targets follow each other.
+REACH_TILT_STEP = math.radians(5.0)
+REACH_TRAVEL_STEPS = 6
+# m and rad: a pose counts as reached this close (the pour's own solves converge to 1e-5 from reached poses).
+REACH_TOLERANCE = 1e-4
 
 
 @dataclass(frozen=True)
@@ -93,6 +107,116 @@ def _joint_limits(scene: PourScene, robots: RobotScene) -> dict[ArmRole, ArmLimi
     return scene_limits(robots, overrides)
 
 
+def robot_scene(scene: PourScene) -> RobotScene:
+    """The robot scene of ``scene``: its ``robots.scene`` file, else the project's cell around its vessels at its
+    placement (the project's scene file where both are the defaults). A home posture out of reach is an InputError
+    naming the placement."""
+    from cosim.robots.scene import RobotScene
+
+    config = scene.cell_config()
+    if config is None:
+        return RobotScene.load(scene.robots.scene or None)
+    try:
+        return RobotScene.from_config(config)
+    except InputError as exc:
+        raise InputError(f"placement: {exc}") from None
+
+
+def _liquid_volume(vessel: VesselSpec, depth: float, dim: int) -> float:
+    """m^3 of liquid ``depth`` (m) deep in the upright ``vessel`` as the ``dim``-D liquid represents it (in 2-D the
+    pour-plane section times the section depth, a cylinder's too)."""
+    return (vessel.inner_width * vessel.section_depth if dim == 2 else vessel.inner_floor_area) * depth
+
+
+def check_vessels(scene: PourScene, robots: RobotScene) -> None:
+    """The fill below the pourer's rim; the catcher holding all that is poured; in the project's cell, the catcher
+    above the table and each arm's vessel, liquid and mount plate within the arm's rated payload
+    (:data:`cosim.robots.ur10e.UR10E_PAYLOAD_KG`)."""
+    from cosim.robots.payload import LIQUID_DENSITY
+    from cosim.robots.scene_config import ArmRole, MountSpec
+    from cosim.robots.ur10e import UR10E_PAYLOAD_KG
+
+    pourer, catcher = robots.arms[ArmRole.POUR].vessel, robots.arms[ArmRole.CATCH].vessel
+    fill, dim = scene.liquid.fill_depth, scene.fluid.dim
+    if not fill < pourer.inner_height:
+        raise InputError(f"liquid.fill_depth: must be in (0, {pourer.inner_height:g}) m (below the pourer's rim), got {fill:g}")
+    poured = scene.liquid.pour_fraction * _liquid_volume(pourer, fill, dim)
+    holds = _liquid_volume(catcher, catcher.inner_height, dim)
+    if poured > holds:
+        raise InputError(f"vessels.catcher: holds {holds * 1e3:.2f} L up to its rim, less than the {poured * 1e3:.2f} L the pour "
+                         f"pours (a larger catcher, or a smaller liquid.fill_depth or liquid.pour_fraction)")
+    if scene.robots.scene:
+        return  # a user's cell: its table and its arms' payload are not known here
+    catcher_bottom = robots.arms[ArmRole.CATCH].home_pos[2] - catcher.wall_thickness
+    table = scene.placement.table_height
+    if catcher_bottom <= table:
+        raise InputError(f"placement.pour_height: {scene.placement.pour_height:g} m puts the catcher's bottom "
+                         f"{(table - catcher_bottom) * 1e3:.0f} mm below the table top (a smaller pour height, or a higher "
+                         f"placement.pourer_height)")
+    mount = MountSpec()
+    plate = mount.density * (2.0 * mount.half_width) ** 2 * mount.thickness
+    for name, vessel, liquid in (("pourer", pourer, _liquid_volume(pourer, fill, dim)), ("catcher", catcher, poured)):
+        load = vessel.mass + LIQUID_DENSITY * liquid + plate
+        if load > UR10E_PAYLOAD_KG:
+            raise InputError(f"vessels.{name}: {load:.1f} kg with its liquid and mount, more than the arm's rated payload "
+                             f"of {UR10E_PAYLOAD_KG:g} kg (a smaller or lighter vessel, or a smaller liquid.fill_depth)")
+
+
+def check_reach(robots: RobotScene, max_tilt: float, travel: float) -> None:
+    """Every pose the pour will ask of the arms reachable and free of collisions, before any simulation: the pourer
+    tilted from upright to ``max_tilt`` (rad) about its bottom middle (slosh induction's pivot) and about its lip (the
+    constant-flow stage's pivots lie between the two), the other vessel at home; the catcher moved ``travel`` (m) each
+    way along the pour direction, the pourer upright at home. Each sweep is solved by inverse kinematics from the
+    arm's home posture on, each solve starting from the last; each pose reached, and home, is posed for MuJoCo's
+    collision detection (:class:`cosim.robots.collision.MotionChecker`: vessel-vessel, arm-table, arm-arm, ...). The
+    first pose out of reach or in collision is an InputError naming it."""
+    from cosim.robots.collision import MotionChecker
+    from cosim.robots.ik import IKSettings
+    from cosim.robots.planar import PlanarPose, tilt_about_pivot
+    from cosim.robots.scene_config import ArmRole
+
+    checker = MotionChecker(robots)
+    _check_contact(checker, {}, "the vessels at home")
+    pour = robots.arms[ArmRole.POUR]
+    steps = max(1, math.ceil(max_tilt / REACH_TILT_STEP))
+    tilts = [max_tilt * k / steps for k in range(1, steps + 1)]
+    sweeps = [
+        (ArmRole.POUR, [(f"the pourer tilted {math.degrees(t):.0f} deg about its {where} (controller.cfs.max_tilt "
+                         f"{math.degrees(max_tilt):.0f} deg)", tilt_about_pivot(pour.home_quat, pivot, t)) for t in tilts])
+        for where, pivot in (("bottom middle", (0.0, 0.0, 0.0)), ("lip", pour.vessel.lip_local))
+    ]
+    for sign in (1.0, -1.0):
+        offsets = [sign * travel * k / REACH_TRAVEL_STEPS for k in range(1, REACH_TRAVEL_STEPS + 1)]
+        sweeps.append((ArmRole.CATCH, [(f"the catcher moved {dx:+.3f} m from its home (controller.catcher.travel "
+                                        f"{travel:g} m)", PlanarPose(dx=dx)) for dx in offsets]))
+    for role, poses in sweeps:
+        arm = robots.arms[role]
+        ik = robots.ik(role, IKSettings(position_tolerance=REACH_TOLERANCE, rotation_tolerance=REACH_TOLERANCE))
+        q = arm.home_q
+        for label, pose in poses:
+            pos, quat = robots.vessel_target(role, pose)
+            result = ik.solve(pos, quat, q)
+            if not result.converged:
+                raise InputError(
+                    f"placement: {label} is out of {role.value}'s reach (the closest pose found is "
+                    f"{result.position_error * 1e3:.1f} mm and {math.degrees(result.rotation_error):.2f} deg away); place "
+                    f"the vessels nearer the arms (placement.*) or ask less of them"
+                )
+            q = result.q
+            _check_contact(checker, {role: q}, label)
+
+
+def _check_contact(checker: MotionChecker, configuration: dict[ArmRole, np.ndarray], label: str) -> None:
+    """InputError naming ``label`` where the arms at ``configuration`` (role -> joint angles, rad; the other arm at
+    home) touch anything (:meth:`cosim.robots.collision.MotionChecker.contact_at`)."""
+    hit = checker.contact_at(configuration)
+    if hit is not None:
+        raise InputError(
+            f"placement: {label}: {hit.geom1} ({hit.body1}) touches {hit.geom2} ({hit.body2}) ({hit.pair}, "
+            f"{-hit.distance * 1e3:.1f} mm deep); place the vessels elsewhere (placement.*) or ask less of the arms"
+        )
+
+
 def check_pour(scene: PourScene, long_run_ok: bool = False) -> PourPlan:
     """Run every check of ``scene`` a pour needs before it is built (module docstring); InputError on the first
     that fails. ``long_run_ok``: accept an estimated wall time over :data:`LONG_RUN_S`."""
@@ -101,24 +225,23 @@ def check_pour(scene: PourScene, long_run_ok: bool = False) -> PourPlan:
     from cosim.fluid.runtime import resolve_device
     from cosim.fluid.seeding import check_resolution, fill_layers
     from cosim.fluid.wall_sampling import sample_vessel_walls
-    from cosim.robots.scene import RobotScene
     from cosim.robots.scene_config import ArmRole
 
     if scene.logging.enabled and find_spec("rerun") is None:
         raise InputError("logging.enabled: the Rerun recording needs rerun-sdk, which is not installed "
                          "(install it, or run without the recording: --no-log or logging.enabled = false)")
     device = resolve_device(scene.device)
-    robots = RobotScene.load(scene.robots.scene or None)
+    robots = robot_scene(scene)
     pourer = robots.arms[ArmRole.POUR].vessel
     fill = scene.liquid.fill_depth
-    if not fill < pourer.inner_height:
-        raise InputError(f"liquid.fill_depth: must be in (0, {pourer.inner_height:g}) m (below the pourer's rim), got {fill:g}")
+    check_vessels(scene, robots)
     limits = _joint_limits(scene, robots)
+    check_reach(robots, scene.controller.cfs.max_tilt, scene.controller.catcher.travel)
     base = scene.fluid.fluid_config(pourer.inner_width)
     cfg = pour_fluid_config(robots, base, fill)
     check_resolution(pourer, fill, cfg)
-    floor = pourer.inner_width * pourer.section_depth if cfg.dim == 2 else pourer.inner_floor_area
-    particles = round(floor * fill_layers(pourer, fill, cfg.spacing) * cfg.spacing / cfg.particle_volume)
+    seeded_depth = fill_layers(pourer, fill, cfg.spacing) * cfg.spacing
+    particles = round(_liquid_volume(pourer, seeded_depth, cfg.dim) / cfg.particle_volume)
     walls = sum(len(sample_vessel_walls(robots.arms[r].vessel, cfg.spacing, cfg.support_radius, cfg.dim)[0]) for r in ArmRole)
     check_memory(cfg, particles, walls, device)
     substeps = round(scene.coupling.max_duration / cfg.fixed_time_step)

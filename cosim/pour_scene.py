@@ -4,7 +4,8 @@
 commented with its unit and range; a user's file only needs the keys it changes. Sections: ``liquid`` (fill and how
 much to pour), ``fluid`` (SPH resolution and numerics), ``controller`` (the seed's SIM, PID, CFS and catcher, from
 ``controllers.config``), ``coupling``, ``trajectory`` (sampling and joint-limit overrides), ``logging`` (Rerun),
-``robots`` (the MuJoCo scene).
+``vessels`` (the pourer's and the catcher's shape, size and walls), ``placement`` (the table, the pourer's height,
+where vessel B waits, the pour height), ``robots`` (a MuJoCo scene file instead of the project's cell).
 """
 
 from __future__ import annotations
@@ -22,7 +23,11 @@ from cosim.errors import InputError
 from cosim.fluid.config import DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
 from cosim.io.recording_config import RecordingConfig
 from cosim.trajectory.driver_names import JointPrefix
+from cosim.robots.scene_config import (
+    CATCHER_HOME_X, POUR_HEIGHT, POURER_FLOOR_ABOVE_TABLE, TABLE_TOP, SceneConfig, pour_cell_config,
+)
 from cosim.trajectory.limits import JointLimitOverride
+from cosim.vessel import VesselShape, VesselSpec, default_catching_vessel, seed_pouring_vessel
 
 
 @dataclass(frozen=True)
@@ -213,9 +218,95 @@ class LoggingSettings:
     recording: RecordingConfig = field(default_factory=lambda: RecordingConfig(particle_rate_hz=30.0))
 
 
+# Inner sizes of a scene's vessels, m: from a small beaker to the largest vessel the arm's 12.5 kg payload could hold.
+VESSEL_SIZE_RANGE = (0.02, 0.6)
+# Wall thickness, m: at least 1 mm (a thinner wall is not a vessel an arm can hold); at most 5 cm.
+WALL_THICKNESS_RANGE = (0.001, 0.05)
+# Wall material density, kg/m^3: from foamed plastics to tungsten.
+WALL_DENSITY_RANGE = (100.0, 25000.0)
+
+
+@dataclass(frozen=True)
+class VesselSettings:
+    """shape: 'box' or 'cylinder', an open vessel standing on its floor.
+    inner_width: m, inner size along the pour direction (the vessel's x, toward its lip); a cylinder's inner
+      diameter. [0.02, 0.6]
+    inner_depth: m, a box's inner size across the pour plane (a cylinder's is its diameter: this key is not used).
+      [0.02, 0.6]
+    inner_height: m, inner floor to rim. [0.02, 0.6]
+    wall_thickness: m, floor and walls; less than the inner width (and a box's inner depth). [0.001, 0.05]
+    wall_density: kg/m^3, the wall material (acrylic 1180, glass 2500, steel 7850); with the walls' volume it sets
+      the empty vessel's mass. [100, 25000]
+    """
+
+    shape: VesselShape = VesselSpec.shape
+    inner_width: float = VesselSpec.inner_width
+    inner_depth: float = VesselSpec.inner_depth
+    inner_height: float = VesselSpec.inner_height
+    wall_thickness: float = VesselSpec.wall_thickness
+    wall_density: float = VesselSpec.wall_density
+
+    @classmethod
+    def of(cls, spec: VesselSpec) -> "VesselSettings":
+        """The settings of the vessel ``spec``."""
+        return cls(spec.shape, spec.inner_width, spec.inner_depth, spec.inner_height, spec.wall_thickness, spec.wall_density)
+
+    def check(self, prefix: str) -> None:
+        """Range checks, each message naming the field as ``<prefix>.<field>``."""
+        lo, hi = VESSEL_SIZE_RANGE
+        for name in ("inner_width", "inner_depth", "inner_height"):
+            check_range(f"{prefix}.{name}", getattr(self, name), lo, hi, "m")
+        check_range(f"{prefix}.wall_density", self.wall_density, *WALL_DENSITY_RANGE, "kg/m^3")
+        narrowest = min(self.inner_width, self.inner_depth) if self.shape is VesselShape.BOX else self.inner_width
+        hi = min(WALL_THICKNESS_RANGE[1], narrowest)
+        check_range(f"{prefix}.wall_thickness", self.wall_thickness, WALL_THICKNESS_RANGE[0], hi, "m", hi_open=hi < WALL_THICKNESS_RANGE[1])
+
+    def spec(self, name: str) -> VesselSpec:
+        """The :class:`VesselSpec` named ``name`` (a cylinder's depth is its diameter)."""
+        depth = self.inner_depth if self.shape is VesselShape.BOX else self.inner_width
+        return VesselSpec(name, self.shape, self.inner_width, depth, self.inner_height, self.wall_thickness, self.wall_density)
+
+
+@dataclass(frozen=True)
+class VesselsSettings:
+    """pourer: vessel A, which the pour arm tilts (default: the paper's vessel, B = L = 0.191 m, 0.10 m deep).
+    catcher: vessel B, which the catch arm moves under the stream (default: 0.26 m wide, 0.14 m deep, 0.16 m high).
+    """
+
+    pourer: VesselSettings = field(default_factory=lambda: VesselSettings.of(seed_pouring_vessel()))
+    catcher: VesselSettings = field(default_factory=lambda: VesselSettings.of(default_catching_vessel()))
+
+    def __post_init__(self) -> None:
+        self.pourer.check("vessels.pourer")
+        self.catcher.check("vessels.catcher")
+
+
+@dataclass(frozen=True)
+class PlacementSettings:
+    """table_height: m, the top of the table both arms stand on (the height of their bases). [0.3, 1.2]
+    pourer_height: m, the pourer's inner floor above the table top at home. [0.1, 1.0]
+    catcher_home_x: m, where vessel B waits: its centre along the pour direction from the pourer's centre, at home
+      (the catcher moves controller.catcher.travel each way from there). [0, 0.6]
+    pour_height: m, the pourer's lip above the catcher's rim at home (the controller lowers the pourer from there
+      during the pour). [0.05, 1.0]
+    """
+
+    table_height: float = TABLE_TOP
+    pourer_height: float = POURER_FLOOR_ABOVE_TABLE
+    catcher_home_x: float = CATCHER_HOME_X
+    pour_height: float = POUR_HEIGHT
+
+    def __post_init__(self) -> None:
+        check_range("placement.table_height", self.table_height, 0.3, 1.2, "m")
+        check_range("placement.pourer_height", self.pourer_height, 0.1, 1.0, "m")
+        check_range("placement.catcher_home_x", self.catcher_home_x, 0.0, 0.6, "m")
+        check_range("placement.pour_height", self.pour_height, 0.05, 1.0, "m")
+
+
 @dataclass(frozen=True)
 class RobotSettings:
-    """scene: path of a MuJoCo scene written by the project's scene builder ('' = the default two-UR10e scene)."""
+    """scene: a scene written by the project's scene builder, with its own vessels ('' = the cell of [vessels]).
+    """
 
     scene: str = ""
 
@@ -235,6 +326,8 @@ class PourScene:
     coupling: MuJoCo <-> liquid coupling and run length.
     trajectory: exported joint trajectories.
     logging: the Rerun recording.
+    vessels: the pourer and the catcher.
+    placement: where the table, the pourer and the catcher stand.
     robots: the MuJoCo scene.
     """
 
@@ -246,12 +339,26 @@ class PourScene:
     coupling: CouplingSettings = field(default_factory=lambda: CouplingSettings(max_duration=60.0))
     trajectory: TrajectorySettings = field(default_factory=TrajectorySettings)
     logging: LoggingSettings = field(default_factory=LoggingSettings)
+    vessels: VesselsSettings = field(default_factory=VesselsSettings)
+    placement: PlacementSettings = field(default_factory=PlacementSettings)
     robots: RobotSettings = field(default_factory=RobotSettings)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or _NOT_IN_NAMES.search(self.name):
             raise InputError(f"scene.name: must be letters, digits, '-' or '_' (or '': the scene file's name), got {self.name!r}")
         check_device("scene.device", self.device)
+        if self.robots.scene and self.cell_config() is not None:
+            raise InputError("robots.scene: a scene file brings its own vessels and placement; leave [vessels] and "
+                             "[placement] at their defaults with it, or leave robots.scene out")
+
+    def cell_config(self) -> SceneConfig | None:
+        """The robot cell of :attr:`vessels` and :attr:`placement` (:func:`cosim.robots.scene_config.pour_cell_config`);
+        None where both are the defaults: the project's scene file (``models/scene.xml``) is that cell, ready built."""
+        if self.vessels == VesselsSettings() and self.placement == PlacementSettings():
+            return None
+        p = self.placement
+        return pour_cell_config(self.vessels.pourer.spec("pourer"), self.vessels.catcher.spec("catcher"),
+                                p.table_height, p.pourer_height, p.catcher_home_x, p.pour_height)
 
     @property
     def run_name(self) -> str:

@@ -101,6 +101,17 @@ class VesselSpec:
         """m^3, inner volume up to the rim."""
         return self.inner_floor_area * self.inner_height
 
+    def liquid_depth(self, dim: int) -> float:
+        """m, the depth that times the liquid's area in the pour plane gives its volume: the section depth in 2-D (the
+        liquid is the pour-plane slice times it) and for a box; for a 3-D cylinder pi D / 4, the depth of the box of
+        width D with the cylinder's floor area, which holds the same volume at every fill."""
+        return self.section_depth if dim == 2 or self.is_box else self.inner_floor_area / self.inner_width
+
+    def liquid_shape(self, dim: int) -> VesselShape:
+        """The horizontal section of the ``dim``-D liquid, which sets its slosh mode: a 2-D liquid is a pour-plane
+        slice, so a box whatever the vessel; a 3-D liquid takes the vessel's shape."""
+        return VesselShape.BOX if dim == 2 else self.shape
+
     def fill_volume(self, fill_depth: float) -> float:
         """m^3 of liquid that fills the upright vessel to ``fill_depth`` (m); checked against the rim."""
         check_range(f"vessel[{self.name}].fill_depth", fill_depth, 0.0, self.inner_height, "m (rim height)", lo_open=True)

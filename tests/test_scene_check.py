@@ -1,5 +1,6 @@
 """`cosim scene --check` runs the checks `cosim pour` runs before simulating (cosim.pour_checks.check_pour): the
-two refuse the same scenes with the same line and exit status 2, and write nothing; the estimate gates long runs."""
+two refuse the same scenes with the same line and exit status 2, and write nothing (bad fills, vessels, placements,
+out-of-reach poses, memory); the estimate gates long runs."""
 
 from __future__ import annotations
 
@@ -20,6 +21,30 @@ REFUSED = {
     "unknown key": ("[fluid]\nparticles_acros = 32\n", "scene.fluid.particles_acros: unknown key"),
     "joint limit of no arm": ("[trajectory.limits.'left_arm/elbow']\nmax_velocity = 1.0\n", "trajectory.limits.left_arm/elbow"),
     "3-D estimated over an hour": ("[fluid]\ndim = 3\n", "pass --yes, or make it cheaper"),
+    "fill above a smaller pourer's rim": ("[vessels.pourer]\ninner_height = 0.1\n[liquid]\nfill_depth = 0.12\n",
+                                          "liquid.fill_depth: must be in (0, 0.1) m (below the pourer's rim), got 0.12"),
+    "vessel too heavy for the arm": ("[vessels.pourer]\ninner_width = 0.4\ninner_depth = 0.3\ninner_height = 0.4\n"
+                                     "[vessels.catcher]\ninner_width = 0.6\ninner_depth = 0.6\ninner_height = 0.3\n"
+                                     "[liquid]\nfill_depth = 0.3\n", "vessels.pourer: 40.3 kg with its liquid and mount, more than the arm's rated payload of 12.5 kg"),
+    "catcher smaller than the pour": ("[vessels.catcher]\ninner_width = 0.1\ninner_depth = 0.05\ninner_height = 0.05\n",
+                                      "vessels.catcher: holds 0.25 L up to its rim, less than the 3.04 L the pour pours"),
+    "wall thinner than 1 mm": ("[vessels.catcher]\nwall_thickness = 0.0005\n",
+                               "vessels.catcher.wall_thickness: must be in [0.001, 0.05] m, got 0.0005"),
+    "wall thicker than the cup is wide": ("[vessels.pourer]\nshape = 'cylinder'\ninner_width = 0.02\nwall_thickness = 0.03\n",
+                                          "vessels.pourer.wall_thickness: must be in [0.001, 0.02) m, got 0.03"),
+    "pourer tilt out of reach": ("[placement]\npourer_height = 1.0\n", "placement: the pourer tilted 86 deg about its bottom "
+                                 "middle (controller.cfs.max_tilt 100 deg) is out of pour_arm's reach"),
+    "catch arm folding into itself": ("[placement]\ncatcher_home_x = 0.45\n", "placement: the catcher moved +0.050 m from its "
+                                      "home (controller.catcher.travel 0.15 m): geom 47 (catch_arm/upper_arm_link) touches "
+                                      "geom 62 (catch_arm/wrist_2_link) (arm-arm"),
+    "catcher below the table": ("[placement]\npour_height = 1.0\n",
+                                "placement.pour_height: 1 m puts the catcher's bottom 474 mm below the table top"),
+    "vessels touching at home": ("[placement]\npour_height = 0.15\n",
+                                 "placement: the vessels at home: pourer/floor (pourer) touches catcher/back (catcher) (vessel-vessel"),
+    "pourer tilting into the catcher": ("[placement]\npour_height = 0.30\n", "placement: the pourer tilted 100 deg about its "
+                                        "bottom middle (controller.cfs.max_tilt 100 deg): pourer/front (pourer) touches catcher/back (catcher)"),
+    "vessels with a scene file": ("[robots]\nscene = 'my_scene.xml'\n[vessels.pourer]\ninner_width = 0.1\n",
+                                  "robots.scene: a scene file brings its own vessels and placement"),
 }
 
 

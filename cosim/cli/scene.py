@@ -1,8 +1,10 @@
 """``cosim scene --dump``: print the default pour scene as TOML (every field with its unit and range), the
 starting point of a scene file for ``cosim pour SCENE.toml``. ``--check FILE`` runs every check ``cosim pour FILE``
-runs before it simulates (:func:`cosim.pour_checks.check_pour`: the fields, the fill below the rim, the joint
-limits, the liquid's resolution and memory, the run-time estimate), in seconds: a scene it refuses, ``cosim pour``
-refuses with the same line; one it passes, it prints in full with the particle counts and the estimate."""
+runs before it simulates (:func:`cosim.pour_checks.check_pour`: the fields, the robot cell of the scene's vessels and
+placement, the fill below the rim, the catcher's size and height, the arms' payload and reach over the pour's poses,
+the joint limits, the liquid's resolution and memory, the run-time estimate), in seconds: a scene it refuses,
+``cosim pour`` refuses with the same line; one it passes, it prints in full with the particle counts and the
+estimate."""
 
 from __future__ import annotations
 

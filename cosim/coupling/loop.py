@@ -339,8 +339,9 @@ def build_pour(
     pourer = specs[0]
     wall = float(fluid.model.wall_thickness[0])
     initial_volume = fluid.n_particles * cfg.particle_volume
-    actual_fill = initial_volume / (pourer.inner_width * pourer.section_depth)
-    geometry = VesselGeometry(pourer.inner_width, pourer.inner_height, wall, pourer.section_depth)
+    depth = pourer.liquid_depth(cfg.dim)
+    actual_fill = initial_volume / (pourer.inner_width * depth)
+    geometry = VesselGeometry(pourer.inner_width, pourer.inner_height, wall, depth, pourer.liquid_shape(cfg.dim).value)
     catcher = CatcherConfig(home_x=float(scene.arms[ArmRole.CATCH].home_pos[0]), travel_min=-CATCHER_TRAVEL, travel_max=CATCHER_TRAVEL)
     controller = PourController(pour_config(geometry, catcher, actual_fill, initial_volume))
     mgeo = MeasurementGeometry(pourer, wall, specs[1].inner_height, cfg.smoothing_length, cfg.spacing, initial_volume, cfg.dim)

@@ -7,7 +7,8 @@ origin (centre of the inner floor) is at ``vessel_home``.
 
 :func:`default_scene_config` is the project's scene (``models/scene.xml``): two UR10e-class arms on a table, the
 pour arm behind the pourer (at -x) holding it by the back wall, the catch arm beyond the catcher (at +x) holding it
-by the front wall; the catcher's rim lies :data:`CATCHER_RIM_BELOW_POURER_FLOOR` below the pourer's floor.
+by the front wall; the pourer's lip stands :data:`POUR_HEIGHT` above the catcher's rim. :func:`pour_cell_config`
+builds the same cell around other vessels and places them (a scene file's ``[vessels]`` and ``[placement]``).
 """
 
 from __future__ import annotations
@@ -187,40 +188,67 @@ class SceneConfig:
 
 
 # ---- the project's default layout ----------------------------------------------------------------------------------
-# Height of the pourer's inner floor at home, m (table top at 0.75 m).
-POURER_FLOOR_HEIGHT = 1.25
-# The catcher's rim sits this far below the pourer's floor, m. Tilting the pourer 120 deg about its bottom middle
-# brings its lip 0.183 m below the floor (lip_local rotated by R_y(120 deg)); 0.21 m keeps 27 mm of clearance, so
-# the pourer can tilt 0-120 deg about either pivot above the catcher. The lip-to-rim fall at home is then
-# 0.191 + 0.21 = 0.40 m; a controller lowers the pourer (dz < 0) to shorten it.
-CATCHER_RIM_BELOW_POURER_FLOOR = 0.21
+# Height of the table top the arms stand on, m.
+TABLE_TOP = 0.75
+# Height of the pourer's inner floor at home above the table top, m.
+POURER_FLOOR_ABOVE_TABLE = 0.50
+# The default pour height, m: the pourer's lip above the catcher's rim at home. The catcher's rim then sits 0.21 m
+# below the pourer's floor: tilting the pourer 120 deg about its bottom middle brings its lip 0.183 m below the floor
+# (lip_local rotated by R_y(120 deg)), so 0.21 m keeps 27 mm of clearance and the pourer can tilt 0-120 deg about
+# either pivot above the catcher. The lip-to-rim fall at home is 0.191 + 0.21 = 0.401 m; a controller lowers the
+# pourer (dz < 0) to shorten it.
+POUR_HEIGHT = 0.401
 # Catcher centre at home, m along +x from the pourer's centre: under the lip (0.1005 m) plus the stream's throw.
 CATCHER_HOME_X = 0.20
+# The arms' bases in the horizontal plane, m (x, y), and their yaw, rad: the pour arm behind the pourer (-x), its
+# shoulder offset (the UR10e's d4) bringing the wrist into the pour plane; the catch arm beyond the catcher (+x).
+POUR_ARM_BASE_XY = (-0.62, -0.17415)
+CATCH_ARM_BASE_XY = (0.95, 0.17415)
+# The joint configuration both arms' home postures are solved from (picks the elbow-up IK branch), rad.
+HOME_SEED = (0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0)
 
 
-def default_scene_config() -> SceneConfig:
-    """The project's scene: UR10e-class arms, the seed's pouring vessel and the default catching vessel."""
-    pourer, catcher = seed_pouring_vessel(), default_catching_vessel()
-    catcher_floor = POURER_FLOOR_HEIGHT - CATCHER_RIM_BELOW_POURER_FLOOR - catcher.inner_height
+def pour_cell_config(
+    pourer: VesselSpec,
+    catcher: VesselSpec,
+    table_top: float = TABLE_TOP,
+    pourer_floor_above_table: float = POURER_FLOOR_ABOVE_TABLE,
+    catcher_home_x: float = CATCHER_HOME_X,
+    pour_height: float = POUR_HEIGHT,
+) -> SceneConfig:
+    """The project's two-UR10e cell holding ``pourer`` and ``catcher``, placed by (all m): ``table_top``, the height
+    of the table the arms stand on; ``pourer_floor_above_table``, the pourer's inner floor at home above it;
+    ``catcher_home_x``, the catcher's centre at home along the pour direction from the pourer's; ``pour_height``, the
+    pourer's lip above the catcher's rim at home (the catcher's floor is then at the pourer's floor + its inner
+    height - ``pour_height`` - the catcher's inner height)."""
+    pourer_floor = table_top + pourer_floor_above_table
+    catcher_rim = pourer_floor + pourer.inner_height - pour_height
+    catcher_floor = catcher_rim - catcher.inner_height
     return SceneConfig(
         pour=ArmPlacement(
             role=ArmRole.POUR,
             arm=ur10e_arm(),
-            base_pos=(-0.62, -0.17415, 0.75),
+            base_pos=(*POUR_ARM_BASE_XY, table_top),
             base_yaw=math.pi,
             vessel=pourer,
-            vessel_home=(0.0, 0.0, POURER_FLOOR_HEIGHT),
+            vessel_home=(0.0, 0.0, pourer_floor),
             mount_side=MountSide.BACK,
-            home_seed=(0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0),
+            home_seed=HOME_SEED,
         ),
         catch=ArmPlacement(
             role=ArmRole.CATCH,
             arm=ur10e_arm(),
-            base_pos=(0.95, 0.17415, 0.75),
+            base_pos=(*CATCH_ARM_BASE_XY, table_top),
             base_yaw=0.0,
             vessel=catcher,
-            vessel_home=(CATCHER_HOME_X, 0.0, catcher_floor),
+            vessel_home=(catcher_home_x, 0.0, catcher_floor),
             mount_side=MountSide.FRONT,
-            home_seed=(0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0),
+            home_seed=HOME_SEED,
         ),
+        table=TableSpec(top=table_top, half_size=(1.2, 0.6, 0.5 * table_top)),
     )
+
+
+def default_scene_config() -> SceneConfig:
+    """The project's scene: UR10e-class arms, the seed's pouring vessel and the default catching vessel."""
+    return pour_cell_config(seed_pouring_vessel(), default_catching_vessel())
