@@ -121,14 +121,29 @@ def test_a_lost_worker_is_recorded_as_such():
     assert record["kind"] == "lost worker" and record["axes"] == {"liquid.fill_depth": 0.1} and record["error"]
 
 
+def _parent_pid(pid: int) -> int:
+    """The parent of process ``pid`` (0 when it is gone)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return 0
+    return int(stat.rpartition(")")[2].split()[1])
+
+
 def _pid_of(title: str) -> int | None:
-    """The process whose command line (Ray sets a running task's to 'ray::<task name>') starts with ``title``."""
+    """This test's own process (a descendant of the test: its Ray's workers) whose command line is ``title`` (Ray
+    sets a running task's to 'ray::<task name>'); other Ray sessions on the machine are never matched."""
     for proc in Path("/proc").iterdir():
         try:
-            if proc.name.isdigit() and (proc / "cmdline").read_bytes().startswith(title.encode()):
-                return int(proc.name)
-        except OSError:
+            if not proc.name.isdigit() or (proc / "cmdline").read_bytes().split(b"\0")[0].split()[0] != title.encode():
+                continue
+        except (OSError, IndexError):
             continue
+        pid = ancestor = int(proc.name)
+        while ancestor > 1 and ancestor != os.getpid():
+            ancestor = _parent_pid(ancestor)
+        if ancestor == os.getpid():
+            return pid
     return None
 
 
