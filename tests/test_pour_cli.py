@@ -14,11 +14,11 @@ from cosim.cli.main import main
 from cosim.frames import tilt_about_y
 from cosim.io.pour_series import read_series_csv
 from cosim.io.rerun_read import blueprint_camera, entity_paths, read_scalar_series, recording_properties, series_names
-from cosim.io.trajectory_csv import read_trajectory_csv
-from cosim.io.trajectory_json import read_trajectory_json
 from cosim.pour_scene import PourScene, load_scene
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.csv_file import read_trajectory_csv
+from cosim.trajectory.json_file import read_trajectory_json
 
 COARSE = """
 name = "test-pour"

@@ -9,15 +9,15 @@ import pytest
 import ruckig
 
 from cosim.errors import InputError
-from cosim.io.trajectory_csv import JointTrajectory
 from cosim.robots.planar import PlanarPose, tilt_about_pivot
-from cosim.robots.pour_motion import Pivot, PourMotionSpec
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
 from cosim.trajectory.deviation import path_deviation
 from cosim.trajectory.generator import TrajectoryGenerator
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits, JointLimitOverride, JointLimits, arm_limits
+from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
 from cosim.trajectory.recorder import TrajectoryRecorder
 from cosim.trajectory.scripted import generate_scripted, pour_path, pour_poses
 

@@ -23,10 +23,10 @@ import numpy as np
 from controllers.catcher import fall_time
 from cosim.atomic_files import atomic_path
 from cosim.io.pour_series import read_series_csv
-from cosim.io.rerun_read import read_component
 from cosim.io.rerun_paths import LIQUID
-from cosim.io.trajectory_csv import read_trajectory_csv
+from cosim.io.rerun_read import read_component
 from cosim.robots.scene import RobotScene
+from cosim.trajectory.csv_file import read_trajectory_csv
 
 GRAVITY = 9.81  # m/s^2, the scenes' gravity (the controller's model uses the same)
 BOX_CORNERS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]], dtype=float)

@@ -10,7 +10,7 @@ Target ``k`` is sent at ``k * target_period`` as the path's state at that time, 
 extrapolates it one period ahead, so the trajectory follows the script without lag.
 
 ``python -m cosim.trajectory.scripted --out DIR`` writes ``DIR/trajectory.csv``, ``.json`` and ``.mcap`` of a
-smooth 10 s pour (:mod:`cosim.robots.pour_motion`: tilt about the lip and back, the catcher moving along x) and prints
+smooth 10 s pour (:mod:`cosim.trajectory.pour_motion`: tilt about the lip and back, the catcher moving along x) and prints
 the lips' deviation from the scripted path; ``cosim replay DIR/trajectory.csv`` then measures how the servos track it.
 """
 
@@ -26,10 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from cosim.errors import InputError, SimulationError
-from cosim.io.trajectory_csv import JointTrajectory
 from cosim.robots.ik import IKSettings
 from cosim.robots.planar import PlanarPose
-from cosim.robots.pour_motion import Pivot, PourMotionSpec, task_poses
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
@@ -37,7 +35,9 @@ from cosim.trajectory.deviation import path_deviation
 from cosim.trajectory.driver_names import JointPrefix, driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits, scene_limits
+from cosim.trajectory.pour_motion import Pivot, PourMotionSpec, task_poses
 from cosim.trajectory.recorder import DEFAULT_SAMPLE_RATE_HZ, TrajectoryRecorder
 
 # IK tolerances (m, rad) of the scripted targets. With the scene's default vessel-target tolerance (1e-5) the joint
@@ -142,7 +142,7 @@ def generate_scripted(
 
 
 def pour_poses(scene: RobotScene, spec: PourMotionSpec, target_period: float = 0.01) -> dict[ArmRole, list[PlanarPose]]:
-    """The scripted pour of :mod:`cosim.robots.pour_motion` as targets every ``target_period`` s from 0 to its end."""
+    """The scripted pour of :mod:`cosim.trajectory.pour_motion` as targets every ``target_period`` s from 0 to its end."""
     count = int(round(spec.duration / target_period)) + 1
     samples = [task_poses(scene, spec, k * target_period) for k in range(count)]
     return {role: [s[role] for s in samples] for role in ArmRole}

@@ -12,7 +12,7 @@ those samples (zero at both ends, where the path is at rest). The result is chec
 limits and :data:`MAX_ACCELERATION` / :data:`MAX_JERK` (jerk by differencing the accelerations); a motion that
 exceeds them is refused with an ``InputError`` naming the joint, so every trajectory written is jerk-limited.
 
-``python -m cosim.robots.pour_motion --out pour.csv`` writes it; ``cosim replay pour.csv`` measures how the servos
+``python -m cosim.trajectory.pour_motion --out pour.csv`` writes it; ``cosim replay pour.csv`` measures how the servos
 track it.
 """
 
@@ -28,11 +28,12 @@ import numpy as np
 
 from cosim.checks import check_choice, check_positive, check_range
 from cosim.errors import InputError
-from cosim.io.trajectory_csv import JointTrajectory, write_trajectory_csv
 from cosim.robots.ik import IKSettings
 from cosim.robots.planar import PlanarPose, tilt_about_pivot
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.csv_file import write_trajectory_csv
+from cosim.trajectory.joint_trajectory import JointTrajectory
 
 # Joint acceleration and jerk limits for generated motions, rad/s^2 and rad/s^3. UR publishes no per-joint
 # acceleration limit for the UR10e; PolyScope's default joint acceleration is 80 deg/s^2 (1.4 rad/s^2) and its
