@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from controllers.figures import main
+from cosim.tools.controller_figures import main
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

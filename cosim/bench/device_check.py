@@ -12,7 +12,7 @@ report, DIR/device_check.md, is printed at the end:
    to in this flow: the yardstick for the device's difference); the device run
    with its substeps replayed as captured graphs against launched one by one (and why capture failed, if it did).
 2. validation: the hydrostatic tank (0.5 s) and the slosh case (:data:`SLOSH_PERIODS` periods) on both: every metric side by side.
-3. throughput: ``cosim.fluid.benchmark`` on the device (issue 7's sizes: 2-D 10k, 3-D 100k and 1M particles,
+3. throughput: ``cosim.bench.fluid_throughput`` on the device (issue 7's sizes: 2-D 10k, 3-D 100k and 1M particles,
    both solvers, warp's ``example_sph`` beside the 3-D rows; DFSPH again with the Jacobi density iteration), and
    the 2-D rows again without graph replay.
 4. pour: the coupled pour (robots, controllers, trajectory generation, no recording) on the device: the default
@@ -166,16 +166,16 @@ def _validation_table(rows: list[dict]) -> list[str]:
 
 # ---- throughput -------------------------------------------------------------------------------------------
 def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
-    from cosim.fluid import benchmark
+    from cosim.bench import fluid_throughput
 
     counts2d, counts3d = (["500"], ["2000"]) if quick else (["10000"], ["100000", "1000000"])
     table = out / "throughput.md"
     table.unlink(missing_ok=True)  # the benchmark appends: start this run's table afresh
     where = ["--device", device, "--out", str(table)]
     both = ["--solvers", "wcsph", "dfsph"]
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *both, *where])
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, "--solvers", "dfsph", "--density-iteration", "jacobi", *where])
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", "--no-graphs", *both, *where])
+    fluid_throughput.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *both, *where])
+    fluid_throughput.main(["--counts2d", *counts2d, "--counts3d", *counts3d, "--solvers", "dfsph", "--density-iteration", "jacobi", *where])
+    fluid_throughput.main(["--counts2d", *counts2d, "--counts3d", "--no-graphs", *both, *where])
     return [{"table": table.read_text()}]
 
 

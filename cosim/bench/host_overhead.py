@@ -27,7 +27,7 @@ import sys
 from cosim.coupling.loop import CoupledPour
 from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
-from cosim.fluid.benchmark import machine_description
+from cosim.bench.fluid_throughput import machine_description
 from cosim.fluid.config import PressureSolver
 from cosim.pour_run import prepare
 from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene, load_scene

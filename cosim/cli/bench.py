@@ -44,7 +44,7 @@ def register(subparsers, summary: str) -> None:
 
 def _machine_line() -> str:
     """'Machine: ...; CUDA .... Versions: ...' for a report's header."""
-    from cosim.fluid.benchmark import machine_description
+    from cosim.bench.fluid_throughput import machine_description
     from cosim.fluid.runtime import cuda_available
     from cosim.pour_run import package_versions
 

@@ -1,6 +1,6 @@
 """Benchmark inverse kinematics over the pour workspace: accuracy and time per solve.
 
-``python -m cosim.robots.benchmark_ik [--json] [--model SCENE]``
+``python -m cosim.bench.ik [--json] [--model SCENE]``
 
 Workspace (targets relative to the vessels' home poses, :mod:`cosim.robots.planar`): the pourer tilted
 0..120 deg (every :data:`TILT_STEP_DEG`) about its bottom middle and about its lip; the catcher translated
@@ -109,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         summary = run_benchmark(RobotScene.load(args.model))
     except InputError as exc:
-        print(f"benchmark_ik: error: {exc}", file=sys.stderr)
+        print(f"ik: error: {exc}", file=sys.stderr)
         return 2
     if args.json:
         print(json.dumps(summary, indent=2))
