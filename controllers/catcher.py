@@ -1,7 +1,8 @@
-"""The catcher: where the outflow lands (seed Eqs. 6-7) and vessel B following it without large steps.
+"""The catcher: where the outflow lands (Camporredondo et al. 2019, Eqs. 6-7) and vessel B following it without
+large steps.
 
 The jet leaves the pour lip (world x0, z0) with the mean outflow velocity (v_x, v_z) and falls freely:
-z = z0 + v_z t - g t^2 / 2 (Eq. 6, the seed takes v_z = 0), x = x0 + v_x t (Eq. 7). It enters vessel B at the
+z = z0 + v_z t - g t^2 / 2 (Eq. 6, the paper takes v_z = 0), x = x0 + v_x t (Eq. 7). It enters vessel B at the
 height of B's rim; vessel B moves (along world x only) to put its centre under that point.
 """
 

@@ -1,4 +1,4 @@
-"""Issue 7's speed targets (cosim.bench.targets, ``cosim bench --plan targets``): the verdicts, every measurement's
+"""The speed targets (cosim.bench.targets, ``cosim bench --plan targets``): the verdicts, every measurement's
 path at small sizes on the CPU (numbers meaningless there), and the report the command writes."""
 
 import json

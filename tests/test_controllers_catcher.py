@@ -1,5 +1,5 @@
-"""The catcher: landing point from the free-fall parabola (paper Eqs. 6-7) and rate-limited following; the motion
-helpers it shares with the controller."""
+"""The catcher: landing point from the free-fall parabola (Camporredondo et al. 2019, Eqs. 6-7) and
+rate-limited following; the motion helpers it shares with the controller."""
 
 import math
 
@@ -35,7 +35,7 @@ def test_landing_point_is_on_the_parabola(vx: float, vz: float) -> None:
     assert lip_z + vz * t - 0.5 * GRAVITY * t * t == pytest.approx(rim, abs=EXACT)  # Eq. 6 at the rim
     assert x == pytest.approx(_integrate_fall(lip_x, lip_z, vx, vz, rim), abs=BALLISTIC_TOL)
     if vz == 0.0:
-        assert t == pytest.approx(math.sqrt(2 * (lip_z - rim) / GRAVITY), abs=EXACT)  # the seed's form
+        assert t == pytest.approx(math.sqrt(2 * (lip_z - rim) / GRAVITY), abs=EXACT)  # the paper's form
 
 
 def test_jet_path_runs_from_the_lip_down_the_parabola_to_the_landing_point() -> None:

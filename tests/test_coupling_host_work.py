@@ -1,4 +1,4 @@
-"""Issue 7, Build 3: the co-simulation loop does no per-step host work that grows with the particle count.
+"""The co-simulation loop does no per-step host work that grows with the particle count.
 
 The host exchanges only a few hundred numbers with the liquid's arrays per control period, whatever the liquid's
 size: the controller's probe reduces the particles on the fluid's device (cosim/coupling/measure.py) and the

@@ -16,7 +16,7 @@ from cosim.validation import hydrostatic, moving_vessel, slosh
 from cosim.validation.common import whole_spacings
 from cosim.vessel import VesselSpec
 
-B = 0.191  # m, the seed's vessel width
+B = 0.191  # m, the width of the pouring vessel of Camporredondo et al. (2019)
 
 
 def _tank_solver(dim=2, across=12, fill=0.1, kernel=KernelType.WENDLAND_C2, device="cpu", **overrides):
@@ -37,8 +37,8 @@ def test_hydrostatic_coarse_2d_meets_the_acceptance_tolerances():
     assert r.passed
 
 
-# The hydrostatic law p = rho0 g (H - z) puts the free surface at H = liquid volume / floor area (issue "Fluid
-# core"); the pressure profile's zero must sit there to a tenth of a spacing. In a 3-D tank whose depth is not a
+# The hydrostatic law p = rho0 g (H - z) puts the free surface at H = liquid volume / floor area; the
+# pressure profile's zero must sit there to a tenth of a spacing. In a 3-D tank whose depth is not a
 # whole number of spacings it sat 0.2 spacings higher (the seeded lattice covered only part of the floor).
 SURFACE_HEIGHT_TOLERANCE = 0.1  # particle spacings
 

@@ -17,7 +17,7 @@ from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.pour_motion import Pivot, PourMotionSpec, plan_pour_trajectory
 from cosim.trajectory.replay import Feedforward, replay
 
-# Issue 3 acceptance: RMS lip error of a smooth pour under the position servos with the full-vessel payload.
+# Acceptance: RMS lip error of a smooth pour under the position servos with the full-vessel payload.
 MAX_LIP_RMS_ERROR_M = 2e-3
 # Holding home with gravity compensation of a known payload: no error beyond round-off (rad, m).
 HOLD_TOLERANCE = 1e-9

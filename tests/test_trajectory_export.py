@@ -31,7 +31,7 @@ from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
 from cosim.trajectory.scripted import generate_scripted, pour_poses
 
 POUR = PourMotionSpec(duration=10.0, max_tilt=math.radians(100.0), pivot=Pivot.LIP, catcher_dx=0.15)
-# Acceptance (issue 5): `cosim replay trajectory.csv` tracks the vessel path within 2 mm.
+# Acceptance: `cosim replay trajectory.csv` tracks the vessel path within 2 mm.
 MAX_REPLAY_ERROR_M = 2e-3
 # Relative slack on the limits for round-off (the files hold ruckig's output exactly).
 LIMIT_RTOL = 1e-9

@@ -10,7 +10,7 @@ streaming targets calls it). The error of every solution is re-measured independ
 (``mj_kinematics`` on a separate MjData): position of the vessel frame origin (m) and rotation angle (deg) to the
 target. Times are wall-clock per ``solve_vessel_target`` call (``time.perf_counter``), single thread.
 
-Acceptance (issue 3): every target within :data:`MAX_POSITION_ERROR_M` and :data:`MAX_ROTATION_ERROR_DEG`, median
+Acceptance: every target within :data:`MAX_POSITION_ERROR_M` and :data:`MAX_ROTATION_ERROR_DEG`, median
 time per solve <= :data:`MAX_MEDIAN_SOLVE_S`.
 """
 
@@ -36,7 +36,7 @@ TILT_STEP_DEG = 2.0
 MAX_TILT_DEG = 120.0
 CATCHER_RANGE_M = 0.15
 CATCHER_STEP_M = 0.01
-# Issue 3 acceptance thresholds.
+# Acceptance thresholds: m, deg, s.
 MAX_POSITION_ERROR_M = 1e-3
 MAX_ROTATION_ERROR_DEG = 0.1
 MAX_MEDIAN_SOLVE_S = 2e-3

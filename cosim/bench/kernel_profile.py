@@ -32,7 +32,7 @@ from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.device_layout import layout_for
 from cosim.fluid.runtime import resolve_device
 
-# issue 7's sizes (3-D 1M, 2-D 10k), each solver, DFSPH with either density iteration
+# the speed targets' sizes (3-D 1M, 2-D 10k), each solver, DFSPH with either density iteration
 DEFAULT_CASES = [f"{size}:{solver}" for size in ("3:1000000", "2:10000") for solver in ("wcsph", "dfsph:jacobi", "dfsph:gauss_seidel")]
 PAIR_LAYOUTS = {"rows": False, "columns": True}  # --pair-layouts: name -> DeviceLayout.pairs_by_column
 

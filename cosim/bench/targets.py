@@ -1,6 +1,6 @@
-"""Issue 7's speed targets, measured on this machine: ``cosim bench --plan targets``.
+"""The speed targets, measured on this machine: ``cosim bench --plan targets``.
 
-Each :class:`Target` names a measurement, the threshold the issue sets and the device it is set on:
+Each :class:`Target` names a measurement, its threshold and the device it is set on:
 
 - 3-D WCSPH at 1M particles on a CUDA device: >= 1.0 G particle-steps/s, warp's ``example_sph`` re-sized to the same
   count measured in the same run beside it (:func:`cosim.bench.fluid_throughput.solver_throughput`, the full substep);
@@ -11,12 +11,12 @@ Each :class:`Target` names a measurement, the threshold the issue sets and the d
   :func:`cosim.bench.host_overhead.pour_rate`, after a warm-up that compiles and captures);
 - the default pour, ``cosim pour --no-log`` as a user runs it (a new process: start-up, scene build, the whole pour,
   the outputs), with the compiled kernels cached by a short run first: <= 60 s wall, the median of
-  :attr:`TargetSizes.default_pour_repeats` runs. The issue sets it on the 2-core CPU; it runs on this machine's CPU,
+  :attr:`TargetSizes.default_pour_repeats` runs. The target is set for a 2-core CPU; it runs on this machine's CPU,
   whichever it is (the header names it).
 
 On a machine without a CUDA device the CUDA targets are listed as not measured; the CPU target is always measured.
 Timings are measured afresh on every run (nothing is cached: a cached time says nothing about this machine now). A
-measurement that fails is a row with its one-line error, and the exit status is 1. The fifth target of the issue,
+measurement that fails is a row with its one-line error, and the exit status is 1. The fifth target,
 DFSPH faster than WCSPH at equal error on the default pour, is the full plan's pour table (``cosim bench``).
 """
 

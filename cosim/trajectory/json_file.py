@@ -1,4 +1,4 @@
-"""Joint trajectory JSON: write and read (DESIGN.md: "the JSON mirrors ROS trajectory_msgs/JointTrajectory per arm").
+"""Joint trajectory JSON: write and read; per arm it mirrors ROS ``trajectory_msgs/JointTrajectory``.
 
 Layout (one object; numbers in SI units, listed in ``units``)::
 
