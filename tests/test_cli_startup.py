@@ -1,5 +1,5 @@
 """`cosim --help`, every subcommand's `--help` and refused input answer without loading the heavy libraries (each
-costs a second or more to import), and importing cosim changes nothing outside it."""
+costs a second or more to import), and importing any module of cosim or controllers changes nothing outside them."""
 
 from __future__ import annotations
 
