@@ -30,6 +30,7 @@ def measured():
     return {m.target: m for m in targets.measure_all(SMALL, cuda="cpu")}
 
 
+@pytest.mark.slow
 def test_every_measurement_runs_and_reports_its_figure(measured):
     assert list(measured) == list(targets.TARGETS)
     assert all(not m.failed and m.value > 0.0 and m.took_s > 0.0 for m in measured.values()), [m.detail for m in measured.values()]

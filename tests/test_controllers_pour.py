@@ -108,6 +108,7 @@ def test_sim_timeline_on_the_linear_plant() -> None:
     assert t[-1] < 60.0
 
 
+@pytest.mark.slow
 def test_partial_pour_reaches_its_target_and_holds_h_q() -> None:
     for fill, mode in ((0.1591, SimMode.AUTO), (0.1591, SimMode.NEVER), (0.10, SimMode.AUTO)):
         base = _config(fill_depth=fill)

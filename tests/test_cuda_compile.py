@@ -30,6 +30,7 @@ def test_the_kernel_modules_are_found():
 
 
 @pytest.mark.parametrize("name", kernel_modules())
+@pytest.mark.slow
 def test_kernel_module_compiles_for_the_gpu(name, tmp_path):
     init_warp()
     if GPU_ARCH not in wp.get_cuda_supported_archs():
