@@ -1,11 +1,11 @@
 """``cosim replay TRAJECTORY.csv [--json] [--tolerance-mm MM] [--model SCENE] [--payload full|empty] [--feedforward ...]``.
 
 Plays a joint trajectory (a CSV file, :mod:`cosim.trajectory.csv_file`) through the arms' position servos in
-MuJoCo without liquid (the liquid as a rigid payload, full by default) and reports per-joint tracking error and the vessel lips' path errors
-(:mod:`cosim.trajectory.replay`), then a verdict: PASS when every vessel lip stays within ``--tolerance-mm`` (default
-2 mm) of its commanded path and nothing collides, else FAIL with the reasons. The exit status says it, so that a
-script or CI job can gate on it: 0 pass, 1 fail, 2 bad input (a bad trajectory file, scene or option: one line).
-``--json`` prints a JSON object with ``verdict`` ("pass" or "fail"), ``tolerance_m``, ``failures`` (the reasons),
+MuJoCo without liquid (the liquid as a rigid payload, full by default) and reports per-joint tracking error and
+the vessel lips' path errors (:mod:`cosim.trajectory.replay`), then a verdict: PASS when every vessel lip stays
+within ``--tolerance-mm`` (default 2 mm) of its commanded path and nothing collides, else FAIL with the reasons. The
+exit status says it, so that a script or CI job can gate on it: 0 pass, 1 fail, 2 bad input (a bad trajectory file,
+scene or option: one line). ``--json`` prints a JSON object with ``verdict`` ("pass" or "fail"), ``tolerance_m``, ``failures`` (the reasons),
 ``max_error_m`` (largest pour-lip position error, m), ``joint_max_error_rad`` (per-joint maxima) and the rest.
 """
 
