@@ -1,6 +1,7 @@
 """Pouring controllers: pure numpy + python-control (no warp, no MuJoCo, no cosim).
 
-The slosh pendulum model and plant Gp (seed Eqs. 10-14, 17), the filtered-derivative PID compensator, the slosh
+After Camporredondo et al. (2019), "A Kinematic Controller for Liquid Pouring between Vessels Modelled with
+SPH": the slosh pendulum model and plant Gp (Eqs. 10-14, 17), the filtered-derivative PID compensator, the slosh
 induction method (SIM) timeline, the constant-flow stage (CFS), the catcher's landing-point prediction
 (Eqs. 6-7) and the pour state machine. Outputs are vessel targets (planar poses relative to home); the robot
 side turns them into joint targets.

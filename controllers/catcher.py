@@ -1,13 +1,16 @@
-"""The catcher: where the outflow lands (seed Eqs. 6-7) and vessel B following it without large steps.
+"""The catcher: where the outflow lands (Camporredondo et al. 2019, Eqs. 6-7) and vessel B following it without
+large steps.
 
 The jet leaves the pour lip (world x0, z0) with the mean outflow velocity (v_x, v_z) and falls freely:
-z = z0 + v_z t - g t^2 / 2 (Eq. 6, the seed takes v_z = 0), x = x0 + v_x t (Eq. 7). It enters vessel B at the
+z = z0 + v_z t - g t^2 / 2 (Eq. 6, the paper takes v_z = 0), x = x0 + v_x t (Eq. 7). It enters vessel B at the
 height of B's rim; vessel B moves (along world x only) to put its centre under that point.
 """
 
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 from controllers.motion import RateLimitedTracker
 from controllers.slosh import GRAVITY
@@ -26,6 +29,15 @@ def fall_time(drop: float, v_z: float = 0.0, gravity: float = GRAVITY) -> float:
 def landing_x(lip_x: float, lip_z: float, rim_z: float, v_x: float, v_z: float = 0.0, gravity: float = GRAVITY) -> float:
     """World x (m) where the jet launched at the lip (lip_x, lip_z) crosses the catcher's rim height ``rim_z``."""
     return lip_x + v_x * fall_time(lip_z - rim_z, v_z, gravity)
+
+
+def jet_path(
+    x0: float, z0: float, v_x: float, v_z: float, drop: float, samples: int = 50, gravity: float = GRAVITY
+) -> tuple[np.ndarray, np.ndarray]:
+    """World (x, z) m of the jet launched at (x0, z0) with velocity (v_x, v_z) m/s at ``samples`` equal time steps
+    until it has fallen ``drop`` m (Eqs. 6-7: z = z0 + v_z t - g t^2 / 2, x = x0 + v_x t)."""
+    t = np.linspace(0.0, fall_time(drop, v_z, gravity), samples)
+    return x0 + v_x * t, z0 + v_z * t - 0.5 * gravity * t**2
 
 
 def weir_velocity(h_q: float, discharge_coefficient: float, gravity: float = GRAVITY) -> float:

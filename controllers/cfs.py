@@ -1,7 +1,8 @@
-"""Constant-flow stage (seed Sec. 3.2, Fig. 9, Eq. 16): hold the liquid height over the crest at h_ref.
+"""Constant-flow stage: hold the liquid height over the crest at h_ref (Camporredondo et al. 2019, Sec. 3.2,
+Fig. 9, Eq. 16).
 
-Each control step the crest has to come down, relative to the liquid, by a height dh; the seed's vector step
-(:func:`controllers.geometry.vector_step`) turns dh into a tilt increment. The seed's b is "how far the level
+Each control step the crest has to come down, relative to the liquid, by a height dh; the paper's vector step
+(:func:`controllers.geometry.vector_step`) turns dh into a tilt increment. The paper's b is "how far the level
 over the lip dropped this step"; here dh has two parts, which make it a feedback law that a sloshing liquid
 tolerates:
 
@@ -9,7 +10,7 @@ tolerates:
   (feed-forward: the draining vessel needs a steadily growing tilt; without it the integral law below lags
   a ramp with a constant error);
 * a correction of the fraction dt / time_constant of the error h_ref - h_q (time_constant = dt would be the
-  seed's one-step correction). Linearised, this is the integral law theta' = (theta1_ref - theta1) /
+  paper's one-step correction). Linearised, this is the integral law theta' = (theta1_ref - theta1) /
   time_constant on the slosh plant, because at the crest h_q depends, to first order, only on the free
   surface's angle theta1 in the vessel frame.
 

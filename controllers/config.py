@@ -37,7 +37,7 @@ class SimMode(Enum):
 
     AUTO = "auto"  # when the fill condition holds (controllers.slosh_induction.sim_needed)
     ALWAYS = "always"
-    NEVER = "never"  # plain approach tilt, then CFS (the comparison case of issue 4)
+    NEVER = "never"  # plain approach tilt, then CFS (the comparison case without slosh induction)
 
 
 def _check_type(name: str, value: object, kind: type) -> None:
@@ -47,15 +47,15 @@ def _check_type(name: str, value: object, kind: type) -> None:
 
 @dataclass(frozen=True)
 class SimConfig:
-    """Slosh induction (seed Fig. 7).
+    """Slosh induction (Camporredondo et al. 2019, Fig. 7).
 
     mode: :class:`SimMode`.
-    trigger_angle: rad, the fill condition's tilt (seed: 20 deg). (0, 1.0]
+    trigger_angle: rad, the fill condition's tilt (the paper's: 20 deg). (0, 1.0]
     amplitude_fraction: phi as a fraction of the tilt at which the resting liquid reaches the crest. (0, 1]
       The default 0.9 leaves the static level just under the crest, so that the induced wave, not the tilt,
       starts the outflow (the point of SIM).
-    frequency_ratio: alpha / omega1 of the excitation theta = phi sin(alpha t). (0, 0.5]; the seed keeps alpha
-      well below the slosh resonance (its Fig. 6, left); 0.25 puts the seed's vessel at alpha = 3.2 rad/s.
+    frequency_ratio: alpha / omega1 of the excitation theta = phi sin(alpha t). (0, 0.5]; the paper keeps alpha
+      well below the slosh resonance (its Fig. 6, left); 0.25 puts the paper's vessel at alpha = 3.2 rad/s.
     hold_timeout_periods: longest t1 hold, in slosh periods. [0.5, 10]
     damp_timeout_periods: longest t2 damping, in slosh periods. [1, 50]
     settle_tolerance: rad, |sigma| below which the slosh counts as damped. (0, 0.2]
@@ -125,7 +125,7 @@ CFS_MAX_HEAD = 0.05  # m, the largest liquid height over the crest CFS accepts a
 
 @dataclass(frozen=True)
 class CfsConfig:
-    """Constant-flow stage (seed Sec. 3.2).
+    """Constant-flow stage (Camporredondo et al. 2019, Sec. 3.2).
 
     h_q_ref: m, liquid height over the crest to hold (seed: 5 mm, about one SPH smoothing radius). [0.001, 0.05]
     time_constant: s, the error h_ref - h_q is corrected at the rate dt / time_constant per step. [0.01, 10]
@@ -221,7 +221,7 @@ class PourConfig:
     fill_depth: m, A, the initial liquid depth in the upright pourer. (0, vessel.inner_height)
     target_volume: m^3 to pour (partial pour), or None to pour until empty. (0, initial volume]
     control_rate: Hz, rate of :meth:`PourController.step`. [20, 500]. Default 100 Hz: five 2 ms MuJoCo steps,
-      50 samples per slosh period (0.50 s for the seed's vessel), the derivative filter Tf = 27 ms spans 2.7
+      50 samples per slosh period (0.50 s for the paper's vessel), the derivative filter Tf = 27 ms spans 2.7
       samples, and the sampled SIM loop (theta1 measured one period before it acts) keeps a 52 deg phase
       margin, 13.8 dB gain margin and Ms = 1.47 (50 Hz: 43 deg, 11.6 dB, Ms = 1.70).
     start_time: s, the controller idles (vessel at home, catcher pre-positioned) until this time. [0, 60]

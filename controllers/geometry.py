@@ -60,7 +60,7 @@ class PlanarPose:
 
 @dataclass(frozen=True)
 class VesselGeometry:
-    """The pouring vessel, an open box (the seed's vessel 1). Lengths in m.
+    """The pouring vessel, an open box (vessel 1 of Camporredondo et al. 2019). Lengths in m.
 
     inner_width: B, along the pour direction (vessel x). (0, 2]
     inner_height: L, floor to rim (vessel z). (0, 2]
@@ -149,7 +149,7 @@ def static_tilt_for_h_q(geom: VesselGeometry, h_q: float, area: float) -> float:
     """Tilt (rad) at which a liquid at rest of ``area`` (m^2) stands ``h_q`` (m) over the crest.
 
     static_h_q grows monotonically with the tilt on [0, 90 deg); solved by bisection. Returns 0 if the liquid
-    already stands that high upright. Generalises the seed's Eq. 16, theta = atan(2 (h_q + h_e) / B), which is
+    already stands that high upright. Generalises the paper's Eq. 16, theta = atan(2 (h_q + h_e) / B), which is
     the wall-to-wall case with t = 0 and h_q measured along the vessel axis (see :func:`eq16_tilt`).
     """
     lo, hi = 0.0, MAX_STATIC_TILT
@@ -165,18 +165,18 @@ def static_tilt_for_h_q(geom: VesselGeometry, h_q: float, area: float) -> float:
 
 
 def eq16_tilt(width: float, empty_height: float, h_q: float) -> float:
-    """Seed Eq. 16: theta_V = atan((2/B) (h_q + h_e)) (rad); B, h_e = L - A, h_q in m."""
+    """Camporredondo et al. (2019), Eq. 16: theta_V = atan((2/B) (h_q + h_e)) (rad); B, h_e = L - A, h_q in m."""
     return math.atan(2.0 / width * (h_q + empty_height))
 
 
 def vector_step(a: tuple[float, float], dh: float) -> float:
-    """Tilt increment (rad) of the seed's CFS vector step (Fig. 9) that lowers the tip of ``a`` by ``dh``.
+    """Tilt increment (rad) lowering the tip of ``a`` by ``dh``: the CFS vector step (Camporredondo et al., Fig. 9).
 
     ``a`` (m, world x-z) goes from the centre of rotation to the point at the lip; b = (0, dh) is the vertical
     step at that point and c = a - b. Turning by the angle between a and c, as Fig. 9 reads literally, lowers
     the tip by only cos^2(beta) dh to first order (beta = elevation of a; the tip stays at length |a|, not |c|).
     This returns the rotation (in the tilt sense) that brings the tip of a exactly to the height of c, i.e. down
-    by dh, as the seed's text asks. dh < 0 raises the point. A dh beyond the reach of the circle is clipped.
+    by dh, as the paper's text asks. dh < 0 raises the point. A dh beyond the reach of the circle is clipped.
     """
     ax, az = a
     r = math.hypot(ax, az)

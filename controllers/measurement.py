@@ -43,9 +43,10 @@ class LiquidMeasurement:
     poured_volume: m^3, liquid that has left the pourer since the start (initial minus in-pourer volume).
     lip_x, lip_z: m, world position of the pour lip (outer top edge of the +x wall).
     catcher_rim_z: m, world z of vessel B's rim, the height at which the jet enters it.
-    v_q_z: m/s, mean world-z velocity (up positive) of the same particles as v_q; 0 reproduces the seed's Eq. 6.
+    v_q_z: m/s, mean world-z velocity (up positive) of the same particles as v_q; 0 reproduces the paper's
+      Eq. 6 (Camporredondo et al. 2019).
     jet_dx, jet_dz: m, mean world position of the same particles relative to the lip: where the measured launch
-      state (v_q, v_q_z) applies; 0 launches at the lip (the seed's Eqs. 6-7).
+      state (v_q, v_q_z) applies; 0 launches at the lip (the paper's Eqs. 6-7).
     """
 
     t: float

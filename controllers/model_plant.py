@@ -3,7 +3,8 @@
 The liquid is the first-mode slosh pendulum (:meth:`controllers.slosh.SloshModel.state_space`, driven by the
 world motion of its hinge; model (M) for small tilts) plus the box geometry: the free surface is the vessel-frame line of slope tan(theta1) that
 bounds the liquid's area (:mod:`controllers.geometry`); h_q is that line's height over the crest; the outflow
-is the sharp-crested weir per unit depth q = (2/3) C_d sqrt(2 g) h_q^(3/2) with v_q = q / h_q (seed Sec. 2.2).
+is the sharp-crested weir per unit depth q = (2/3) C_d sqrt(2 g) h_q^(3/2) with v_q = q / h_q
+(Camporredondo et al. 2019, Sec. 2.2).
 Limits: linear slosh with the pendulum of the initial fill, no damping, no vertical-acceleration effect, no
 spill over the back wall, tilts below 90 deg. The arm is ideal: the pose moves linearly from one command to
 the next over one control period (a one-period lag), or carries out each command ``arm_delay_steps`` periods

@@ -52,7 +52,7 @@ ARRIVAL_TOLERANCE = 1e-4
 # The vessel's lag behind its commanded tilt, for the after-flow prediction: fitted as a pure delay
 # (controllers.motion.fitted_delay) over the last LAG_WINDOW s of commanded and measured tilt, between 0 and
 # MAX_FOLLOWER_LAG s in steps of half a control period. The coupled pour's task-space filter and arm fit 0.08-0.1 s.
-LAG_WINDOW = 0.5  # s, about one slosh period of the seed's vessel
+LAG_WINDOW = 0.5  # s, about one slosh period of the vessel of Camporredondo et al. (2019)
 MAX_FOLLOWER_LAG = 0.3  # s
 
 Transition = tuple[Phase, str] | None

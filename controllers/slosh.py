@@ -52,7 +52,7 @@ Where this departs from the paper: its Eqs. 10-11 as printed put the hinge at l1
 tanh(pi A/B), 64 mm above the floor for its own vessel (B = 0.191 m, A = 0.1591 m), where potential flow puts it
 at H = 115.5 mm (b2 = -54 mm instead of -2.7 mm; the RHP zero at 13.5 rad/s instead of 61). The tilts of the
 project's SPH liquid about several pivots agree with H (``cosim validate slosh-plant``). The printed model is kept
-as :func:`printed_paper_model`, only to reproduce the paper's figures (:mod:`controllers.figures`).
+as :func:`printed_paper_model`, only to reproduce the paper's figures (:mod:`cosim.tools.controller_figures`).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Slosh induction method, SIM (seed Sec. 3.1, Figs. 4 and 7): when to use it and its excitation.
+"""Slosh induction method, SIM (Camporredondo et al. 2019, Sec. 3.1, Figs. 4 and 7): when to use it and its excitation.
 
 Timeline (Fig. 7), run by :class:`controllers.pour.PourController` about the centre of the inner floor:
   t0  excitation theta = phi sin(alpha t) until theta = phi (a quarter period, pi / (2 alpha));
@@ -12,10 +12,10 @@ Timeline (Fig. 7), run by :class:`controllers.pour.PourController` about the cen
       not be damping the plant it was designed on. Here the slosh is damped below the crest first, and CFS starts
       the outflow from a calm liquid.
 
-Fill condition. The seed runs SIM when "h_e <= h_q at theta = 20 deg". Read literally (h_q = 5 mm) it would
-exclude the seed's own vessel. Implemented reading (reference README): SIM is needed when the liquid would reach
+Fill condition. The paper runs SIM when "h_e <= h_q at theta = 20 deg". Read literally (h_q = 5 mm) it would
+exclude the paper's own vessel. Implemented reading: SIM is needed when the liquid would reach
 the lip before the vessel has tilted by the trigger angle (20 deg), i.e. for a box whose level surface rises
-by (B/2) tan(theta) at the front wall, when h_e = L - A <= (B/2) tan(20 deg). Seed vessel: h_e = 31.9 mm <=
+by (B/2) tan(theta) at the front wall, when h_e = L - A <= (B/2) tan(20 deg). The paper's vessel: h_e = 31.9 mm <=
 34.8 mm, so SIM runs.
 """
 

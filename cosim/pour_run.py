@@ -3,7 +3,7 @@
 Outputs, in a new run folder (``recordings/<UTC time>-<scene name>/``, never an earlier run's) or ``--out DIR``:
 ``pour.rrd`` (Rerun recording, unless logging is off), ``trajectory.csv``, ``trajectory.json`` and ``trajectory.mcap``
 (the arms' checked jerk-limited joint trajectories, the MCAP as ROS 2 ``JointTrajectory`` messages,
-:mod:`cosim.io.trajectory_mcap`; the torques their inverse dynamics needs with the liquid's measured wrench are
+:mod:`cosim.trajectory.mcap_file`; the torques their inverse dynamics needs with the liquid's measured wrench are
 checked against the joints' rated torques too), ``series.csv`` (per-control-step signals,
 :mod:`cosim.io.pour_series`), ``summary.json`` (volumes, the volume left in the pourer and a partial pour's error
 first, phases, timings, the arms' load: vessel deviation caused by the liquid, peak servo and required torques against

@@ -214,6 +214,7 @@ def test_code_version_is_per_case_sources():
     assert code_version(BenchCase.HYDROSTATIC) != code_version(BenchCase.POUR) != code_version(BenchCase.COUPLING_STATIC)
 
 
+@pytest.mark.slow
 def test_cli_smoke_writes_csv_markdown_plots_and_the_doc_block(tmp_path, capsys):
     doc = tmp_path / "docs" / "benchmarks.md"
     out = tmp_path / "out"

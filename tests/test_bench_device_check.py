@@ -1,9 +1,12 @@
 """The prepared device check (cosim.bench.device_check): its machinery, run on the CPU at its quick sizes."""
 
+import pytest
+
 from cosim.bench import device_check, host_overhead
 from cosim.pour_scene import FluidSettings
 
 
+@pytest.mark.slow
 def test_quick_agreement_on_the_cpu_reports_identical_runs(tmp_path):
     # The CPU against itself: the solver is deterministic and its captured substeps replay the same launches, so
     # every difference the check reports must be exactly 0 (on a CUDA device the same table shows the CPU/CUDA

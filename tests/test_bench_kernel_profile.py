@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from cosim.bench.kernel_profile import OperationTimer, parse_case, profile_case
-from cosim.fluid.benchmark import resting_block
+from cosim.bench.fluid_throughput import resting_block
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 
 

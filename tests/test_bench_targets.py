@@ -1,4 +1,4 @@
-"""Issue 7's speed targets (cosim.bench.targets, ``cosim bench --plan targets``): the verdicts, every measurement's
+"""The speed targets (cosim.bench.targets, ``cosim bench --plan targets``): the verdicts, every measurement's
 path at small sizes on the CPU (numbers meaningless there), and the report the command writes."""
 
 import json
@@ -30,6 +30,7 @@ def measured():
     return {m.target: m for m in targets.measure_all(SMALL, cuda="cpu")}
 
 
+@pytest.mark.slow
 def test_every_measurement_runs_and_reports_its_figure(measured):
     assert list(measured) == list(targets.TARGETS)
     assert all(not m.failed and m.value > 0.0 and m.took_s > 0.0 for m in measured.values()), [m.detail for m in measured.values()]

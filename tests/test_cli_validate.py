@@ -44,6 +44,7 @@ def test_density_tolerance_reaches_the_solver(capsys):
     assert tight["max_density_error"] < default["max_density_error"]
 
 
+@pytest.mark.slow
 def test_a_tank_rounded_to_whole_spacings_says_so(capsys):
     assert main(["validate", "dam-break", "--dim", "3", "--width", "0.05", "--spacing", "0.006", "--json", "--no-plot"]) == 0
     captured = capsys.readouterr()

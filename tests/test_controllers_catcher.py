@@ -1,5 +1,5 @@
-"""The catcher: landing point from the free-fall parabola (paper Eqs. 6-7) and rate-limited following; the motion
-helpers it shares with the controller."""
+"""The catcher: landing point from the free-fall parabola (Camporredondo et al. 2019, Eqs. 6-7) and
+rate-limited following; the motion helpers it shares with the controller."""
 
 import math
 
@@ -7,7 +7,7 @@ import control as ct
 import numpy as np
 import pytest
 
-from controllers.catcher import CatcherFollower, fall_time, landing_x, weir_velocity
+from controllers.catcher import CatcherFollower, fall_time, jet_path, landing_x, weir_velocity
 from controllers.motion import CriticallyDampedSmoother, RateLimitedTracker, fitted_delay, stop_time
 from controllers.slosh import GRAVITY
 
@@ -35,7 +35,18 @@ def test_landing_point_is_on_the_parabola(vx: float, vz: float) -> None:
     assert lip_z + vz * t - 0.5 * GRAVITY * t * t == pytest.approx(rim, abs=EXACT)  # Eq. 6 at the rim
     assert x == pytest.approx(_integrate_fall(lip_x, lip_z, vx, vz, rim), abs=BALLISTIC_TOL)
     if vz == 0.0:
-        assert t == pytest.approx(math.sqrt(2 * (lip_z - rim) / GRAVITY), abs=EXACT)  # the seed's form
+        assert t == pytest.approx(math.sqrt(2 * (lip_z - rim) / GRAVITY), abs=EXACT)  # the paper's form
+
+
+def test_jet_path_runs_from_the_lip_down_the_parabola_to_the_landing_point() -> None:
+    lip_x, lip_z, rim, vx, vz = 0.16, 0.45, 0.20, 0.2, 0.1
+    x, z = jet_path(lip_x, lip_z, vx, vz, lip_z - rim, samples=20)
+    assert x.shape == z.shape == (20,)
+    assert (x[0], z[0]) == (lip_x, lip_z)
+    assert x[-1] == pytest.approx(landing_x(lip_x, lip_z, rim, vx, vz), abs=EXACT)
+    assert z[-1] == pytest.approx(rim, abs=EXACT)
+    t = (x - lip_x) / vx
+    np.testing.assert_allclose(z, lip_z + vz * t - 0.5 * GRAVITY * t * t, atol=EXACT)  # Eq. 6 at every point
 
 
 def test_weir_velocity_and_degenerate_cases() -> None:

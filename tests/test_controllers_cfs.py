@@ -1,4 +1,5 @@
-"""Constant-flow stage: loop stability by pivot, the pivot rule, level drop and after-flow (seed Sec. 3.2)."""
+"""Constant-flow stage: loop stability by pivot, the pivot rule, level drop and after-flow
+(Camporredondo et al. 2019, Sec. 3.2)."""
 
 import math
 

@@ -4,12 +4,13 @@ from pathlib import Path
 
 import pytest
 
-from controllers.figures import main
+from cosim.tools.controller_figures import main
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
 @pytest.mark.parametrize("plant", ["potential-flow", "printed-paper"])
+@pytest.mark.slow
 def test_figures_are_written(tmp_path: Path, capsys: pytest.CaptureFixture[str], plant: str) -> None:
     assert main(["--out", str(tmp_path), "--plant", plant]) == 0
     names = sorted(p.name for p in tmp_path.iterdir())

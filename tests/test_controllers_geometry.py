@@ -1,4 +1,5 @@
-"""Planar poses, the static liquid in a tilted box (seed Eq. 16) and the CFS vector step (seed Fig. 9)."""
+"""Planar poses, the static liquid in a tilted box (Camporredondo et al. 2019, Eq. 16) and the CFS
+vector step (its Fig. 9)."""
 
 import math
 
@@ -19,7 +20,7 @@ from controllers.geometry import (
     vector_step,
 )
 
-SEED = VesselGeometry()  # B = L = 0.191 m, t = 5 mm (seed Sec. 4)
+SEED = VesselGeometry()  # B = L = 0.191 m, t = 5 mm (the paper's vessel, its Sec. 4)
 EXACT = 1e-12  # m or rad: identities that hold to float64 round-off on O(0.1) quantities
 # m^2: trapezoid rule with 200001 samples on a piecewise-linear integrand; the only error is at the kink where
 # the line meets the floor, (step^2 / 4) * slope ~ 1e-11 m^2 for slope 6.
@@ -70,7 +71,7 @@ def test_static_h_q_matches_eq16_for_a_thin_wall() -> None:
 
 
 def test_static_h_q_grows_with_tilt_and_handles_the_floor() -> None:
-    area = SEED.inner_width * 0.054  # seed's lowest fill: the surface reaches the floor before the crest
+    area = SEED.inner_width * 0.054  # the paper's lowest fill: the surface reaches the floor before the crest
     thetas = np.linspace(0.0, 1.4, 300)
     h = np.array([static_h_q(SEED, th, area) for th in thetas])
     assert np.all(np.diff(h) > 0)
@@ -93,8 +94,8 @@ def test_vector_step_lowers_the_point_by_dh_exactly() -> None:
 
 def test_the_seeds_literal_angle_lowers_the_point_by_only_cos2_elevation_dh() -> None:
     """Turning by the angle between a and c = a - b (Fig. 9 read literally) lowers the tip by cos^2(beta) dh to
-    first order (beta = elevation of a): for the seed's crest seen from the floor centre only 22 % of dh. Hence
-    vector_step solves for the exact drop, which is what the seed's text asks for."""
+    first order (beta = elevation of a): for the paper's crest seen from the floor centre only 22 % of dh. Hence
+    vector_step solves for the exact drop, which is what the paper's text asks for."""
     dh = 1e-5
     for a in [(0.1005, 0.191), (0.0955, 0.032), (0.2, 0.0)]:
         literal = math.atan2(a[1], a[0]) - math.atan2(a[1] - dh, a[0])

@@ -125,8 +125,9 @@ def test_filtered_pid_has_zero_steady_state_error() -> None:
     assert first_settled == pytest.approx(design.settling_time, abs=t[1] - t[0] + 1e-3)
 
 
+@pytest.mark.slow
 def test_designs_across_sim_fills_are_stable() -> None:
-    """SIM runs for h_e <= (B/2) tan 20 deg, i.e. A >= 156 mm in the seed's vessel; also lower fills."""
+    """SIM runs for h_e <= (B/2) tan 20 deg, i.e. A >= 156 mm in the paper's vessel; also lower fills."""
     for fill in (0.12, 0.156, 0.1591, 0.175, 0.189):
         design = design_filtered_pid(potential_flow_model(0.191, fill), dt=DT)
         assert np.max(design.closed_loop_poles.real) < 0

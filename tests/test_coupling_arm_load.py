@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from cosim.coupling.settings import Compensation, Coupling
-from cosim.io.trajectory_csv import JointTrajectory
 from cosim.pour_run import prepare
 from cosim.pour_scene import load_scene
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import UnsafeTrajectoryError, check_torques
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import JointLimitOverride, arm_limits, scene_limits
 from cosim.trajectory.torques import required_torques
 

@@ -1,4 +1,4 @@
-"""Issue 7, Build 3: the co-simulation loop does no per-step host work that grows with the particle count.
+"""The co-simulation loop does no per-step host work that grows with the particle count.
 
 The host exchanges only a few hundred numbers with the liquid's arrays per control period, whatever the liquid's
 size: the controller's probe reduces the particles on the fluid's device (cosim/coupling/measure.py) and the
@@ -8,6 +8,7 @@ and upload (``wp.array.assign``, ``wp.copy``) in the same stretch of the default
 
 from collections import Counter
 
+import pytest
 import warp as wp
 
 from cosim.bench.host_overhead import POUR_WARM_UP, time_steps, warm_pour
@@ -51,6 +52,7 @@ def _transfers(across: int, monkeypatch) -> tuple[int, Counter]:
     return pour.fluid.n_particles, _spied(monkeypatch, pour)
 
 
+@pytest.mark.slow
 def test_what_the_host_moves_does_not_grow_with_the_particle_count(monkeypatch):
     coarse_n, coarse = _transfers(COARSE, monkeypatch)
     fine_n, fine = _transfers(FINE, monkeypatch)

@@ -33,7 +33,8 @@ def measure(t, geo, pose, catcher, x, v, active, volume):
 
 
 def _level_liquid(tilt: float, area: float) -> tuple[Pose, np.ndarray]:
-    """A resting liquid of cross-section ``area`` (m^2) in the seed vessel tilted by ``tilt`` about the lip."""
+    """A resting liquid of cross-section ``area`` (m^2) in the pouring vessel of Camporredondo et al. (2019)
+    tilted by ``tilt`` about the lip."""
     lip = SPEC.lip_local
     rot = rotation_y(tilt)
     pose = Pose(lip - rot @ lip, rot)
@@ -124,7 +125,7 @@ PROBE_TOLERANCE = dict(theta1=1e-5, h_q=1e-6, v_q=1e-5, v_q_z=1e-5, jet_dx=1e-6,
 # within the 0.5 s (the crossing does not depend on the dimension; 2-D checks it)
 @pytest.mark.parametrize("dim, across, crossings", [(2, 16, 5), (3, 8, 0)])
 def test_probe_equals_the_numpy_contract_on_a_pouring_sph_liquid(dim, across, crossings):
-    # the half-full seed vessel tilted about its lip at 4 rad/s to 80 deg: a slosh over the crest, then a stream
+    # that vessel, half full, tilted about its lip at 4 rad/s to 80 deg: a slosh over the crest, then a stream
     spec = seed_pouring_vessel()
     dx = spec.inner_width / across
     cfg = FluidConfig(dim=dim, spacing=dx, max_expected_speed=1.6, domain_min=domain_around(spec, 0.0)[0],

@@ -3,12 +3,11 @@
 import numpy as np
 import pytest
 
-from cosim.coupling.exchange import ROLES, vessel_poses
-from cosim.coupling.loop import coupled_step, pour_fluid_config
+from cosim.coupling.exchange import ROLES
+from cosim.coupling.liquid import scene_liquid
+from cosim.coupling.loop import coupled_step
 from cosim.coupling.settings import Coupling, CouplingSettings
 from cosim.fluid.config import FluidConfig
-from cosim.fluid.seeding import fill_vessel
-from cosim.fluid.solver import FluidSolver
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.validation import coupling_static
@@ -25,9 +24,8 @@ def test_two_way_static_coupling_meets_the_acceptance_tolerances():
 def test_one_way_coupling_keeps_the_liquid_off_the_arm():
     scene = RobotScene.load()
     pourer = scene.arms[ArmRole.POUR].vessel
-    cfg = pour_fluid_config(scene, FluidConfig(dim=2, spacing=pourer.inner_width / 12), 0.15)
-    poses = vessel_poses(scene)
-    fluid = FluidSolver(cfg, [scene.arms[r].vessel for r in ROLES], poses, fill_vessel(pourer, 0.15, cfg, poses[0]))
+    fluid = scene_liquid(scene, FluidConfig(dim=2, spacing=pourer.inner_width / 12), 0.15)
+    cfg = fluid.config
     settings = CouplingSettings(coupling=Coupling.ONE_WAY)
     targets = {r: (scene.arms[r].home_q, None) for r in ROLES}
     wrench = np.zeros((2, 6))

@@ -19,7 +19,7 @@ from cosim.pour_scene import FluidSettings
 from cosim.validation import hydrostatic
 from cosim.vessel import VesselSpec
 
-B = 0.191  # m, the seed's vessel width
+B = 0.191  # m, the width of the pouring vessel of Camporredondo et al. (2019)
 FILL = 0.1  # m
 # A resting column must stay at rest: after REST_SETTLE of simulated time its fastest particle moves slower than this
 # fraction of the shallow-water wave speed sqrt(g H) (the scale of any sloshing the start-up could excite). DFSPH

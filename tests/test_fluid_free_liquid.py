@@ -86,6 +86,7 @@ def test_liquid_in_the_air_is_free_and_the_seeded_liquid_is_not():
     assert not resting.free_mask().any()
 
 
+@pytest.mark.slow
 def test_caught_rain_packs_like_the_liquid_it_joins():
     """Rain (lone particles two spacings apart) falling into a half-full tank: once settled, the tank holds all of
     it at the height its volume fills. A density that kept each drop's loose arrival (a lone particle's kernel
@@ -109,6 +110,7 @@ def test_caught_rain_packs_like_the_liquid_it_joins():
     assert not solver.free_mask()[z < height - 2 * dx].any()  # below the surface layers all is bound again
 
 
+@pytest.mark.slow
 def test_outflow_falls_on_its_parabola_as_free_liquid():
     r = free_fall.run(free_fall.Params(particles_across=16))
     assert r.raw["failure"] == "" and len(r.raw["landing_error"]) >= free_fall.MIN_FOLLOWED
@@ -116,6 +118,7 @@ def test_outflow_falls_on_its_parabola_as_free_liquid():
     assert r.passed
 
 
+@pytest.mark.slow
 def test_outflow_under_the_continuity_density_lands_short():
     # the validation can fail: the continuity density's tension decelerates the falling stream (README)
     r = free_fall.run(free_fall.Params(particles_across=16, numerics=(("free_liquid", False),)))

@@ -141,6 +141,7 @@ def _in_walls(points, shape, dim, tol=0.0):
 
 
 @pytest.mark.parametrize("shape, dim", [(SHAPE_BOX, 2), (SHAPE_BOX, 3), (SHAPE_CYLINDER, 3)])
+@pytest.mark.slow
 def test_guard_against_sampled_paths_near_the_walls(shape, dim):
     # Random short paths (shorter than the wall is thick, as the CFL step keeps them) from outside the walls, on or
     # near every face: each coordinate (for the cylinder: the radius, on the x axis where it is exact in float32, and
@@ -224,6 +225,7 @@ def _periodic_jacobi_gain(kernel: KernelType, smoothing_ratio: float, n: int = 4
 
 @pytest.mark.parametrize("kernel", list(KernelType))
 @pytest.mark.parametrize("smoothing_ratio", [1.5, 2.0])
+@pytest.mark.slow
 def test_jacobi_gain_matches_the_assembled_lattice_system(kernel, smoothing_ratio):
     exact = _periodic_jacobi_gain(kernel, smoothing_ratio)
     gain = lattice_jacobi_gain(kernel, smoothing_ratio, 2)

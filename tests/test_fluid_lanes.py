@@ -40,6 +40,7 @@ def _assert_same_run(fluid: FluidSolver, reference: FluidSolver) -> None:
 
 
 @pytest.mark.parametrize(("solver", "iteration"), SOLVER_VARIANTS)
+@pytest.mark.slow
 def test_lanes_give_the_single_thread_run_to_the_bit(solver, iteration):
     one = tank(solver, ACROSS, threads=1, iteration=iteration)
     shake(one, **SHAKE)

@@ -10,7 +10,7 @@ import warp as wp
 import cosim.fluid.memory
 from cosim.cli.main import main
 from cosim.errors import InputError
-from cosim.fluid.benchmark import resting_block
+from cosim.bench.fluid_throughput import resting_block
 from cosim.fluid.config import PressureSolver
 from cosim.fluid.memory import allocation_failure_refused, liquid_bytes
 

@@ -7,7 +7,7 @@ from cosim.fluid.config import FluidConfig
 from cosim.fluid.seeding import MIN_FILL_LAYERS, fill_layers, fill_vessel
 from cosim.vessel import VesselSpec
 
-SEED = VesselSpec()  # the seed's vessel: 0.191 x 0.1 x 0.191 m
+SEED = VesselSpec()  # the pouring vessel of Camporredondo et al. (2019): 0.191 x 0.1 x 0.191 m
 
 
 def test_too_few_layers_is_refused_with_the_spacing_that_would_do() -> None:

@@ -16,7 +16,7 @@ from cosim.validation import hydrostatic, moving_vessel, slosh
 from cosim.validation.common import whole_spacings
 from cosim.vessel import VesselSpec
 
-B = 0.191  # m, the seed's vessel width
+B = 0.191  # m, the width of the pouring vessel of Camporredondo et al. (2019)
 
 
 def _tank_solver(dim=2, across=12, fill=0.1, kernel=KernelType.WENDLAND_C2, device="cpu", **overrides):
@@ -37,12 +37,13 @@ def test_hydrostatic_coarse_2d_meets_the_acceptance_tolerances():
     assert r.passed
 
 
-# The hydrostatic law p = rho0 g (H - z) puts the free surface at H = liquid volume / floor area (issue "Fluid
-# core"); the pressure profile's zero must sit there to a tenth of a spacing. In a 3-D tank whose depth is not a
+# The hydrostatic law p = rho0 g (H - z) puts the free surface at H = liquid volume / floor area; the
+# pressure profile's zero must sit there to a tenth of a spacing. In a 3-D tank whose depth is not a
 # whole number of spacings it sat 0.2 spacings higher (the seeded lattice covered only part of the floor).
 SURFACE_HEIGHT_TOLERANCE = 0.1  # particle spacings
 
 
+@pytest.mark.slow
 def test_static_3d_tank_weighs_its_liquid_and_stands_at_its_volume_over_the_floor():
     dx = B / 10
     r = hydrostatic.run(hydrostatic.Params(spacing=dx, duration=0.5, dim=3))
@@ -63,12 +64,14 @@ def test_validation_tanks_are_whole_spacings_wide_and_deep():
     assert whole_spacings(B, 0.006) == pytest.approx(32 * 0.006)  # 31.8 spacings
 
 
+@pytest.mark.slow
 def test_hydrostatic_at_a_spacing_that_does_not_divide_the_tank():
     r = hydrostatic.run(hydrostatic.Params(spacing=0.006, duration=1.0))  # B = 31.8 spacings: built 32 wide
     assert r.parameters["width"] == pytest.approx(32 * 0.006)
     assert abs({m.name: m for m in r.metrics}["pressure (worst probe)"].error) <= hydrostatic.PRESSURE_TOLERANCE
 
 
+@pytest.mark.slow
 def test_slosh_coarse_frequency_matches_eq17():
     r = slosh.run(slosh.Params(spacing=B / 16, fill=0.108, periods=3))
     assert r.raw["periods_used"] >= 1
@@ -85,6 +88,7 @@ def test_slosh_coarse_frequency_matches_eq17():
         ("shake", 2, 16, 60.0, "dfsph"),
     ],
 )
+@pytest.mark.slow
 def test_moving_vessel_never_leaks(case, dim, across, rate, solver):
     p = moving_vessel.Params(dim=dim, particles_across=across, rate=rate, periods=2.0, solver=solver)
     r = (moving_vessel.run_tilt if case == "tilt" else moving_vessel.run_shake)(p)

@@ -99,6 +99,7 @@ def test_two_pours_that_pick_the_same_default_folder_both_keep_their_outputs(tmp
     assert f"wrote {ours}:" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_a_terminated_pour_leaves_nothing_behind_and_exits_143(tmp_path):
     # a batch scheduler stops a job with SIGTERM: the pour unwinds as on Ctrl-C, removing its partial run folder
     out = tmp_path / "run"

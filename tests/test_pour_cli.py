@@ -14,11 +14,11 @@ from cosim.cli.main import main
 from cosim.frames import tilt_about_y
 from cosim.io.pour_series import read_series_csv
 from cosim.io.rerun_read import blueprint_camera, entity_paths, read_scalar_series, recording_properties, series_names
-from cosim.io.trajectory_csv import read_trajectory_csv
-from cosim.io.trajectory_json import read_trajectory_json
 from cosim.pour_scene import PourScene, load_scene
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.csv_file import read_trajectory_csv
+from cosim.trajectory.json_file import read_trajectory_json
 
 COARSE = """
 name = "test-pour"
@@ -38,7 +38,7 @@ TINY = "[fluid]\nparticles_across = 8\n[logging]\nenabled = false\n"
 SAMPLE_SPACING = 1.0 / 500.0
 ROUND_OFF = 1e-6
 LIMIT_TOLERANCE = 1e-6  # relative slack on the limits (float round-off of the checks)
-REPLAY_TOLERANCE_M = 0.002  # issue "The main job": replay tracks the vessel path within 2 mm
+REPLAY_TOLERANCE_M = 0.002  # replay tracks the vessel path within 2 mm
 
 
 def _pour(tmp_path, name, duration=0.6, extra=()):
@@ -251,7 +251,7 @@ def test_a_section_changes_only_its_own_keys_of_the_scene_default(tmp_path, toml
 @pytest.mark.parametrize(
     "toml, dim, across, head_in_spacings",
     [
-        ("", 2, 32, 2.5),  # the default scene: 2.5 dx = 14.9 mm, over the seed's 5 mm
+        ("", 2, 32, 2.5),  # the default scene: 2.5 dx = 14.9 mm, over the 5 mm of Camporredondo et al. (2019)
         ("[fluid]\ndim = 3\nparticles_across = 16\n", 3, 16, 1.0),  # 3-D: one spacing, 11.9 mm
         ("[fluid]\ndim = 3\nparticles_across = 16\n[controller]\nstream_particles = 2.5\n", 3, 16, 2.5),
         ("[controller]\nstream_particles = 1.5\n", 2, 32, 1.5),
@@ -266,7 +266,7 @@ def test_cfs_head_floor_is_stream_particles_spacings_by_dimension_unless_set(tmp
     spacing = 0.191 / across  # the default pourer's inner width over the particles across
     assert scene.fluid.dim == dim
     assert cfs_head_reference(scene, spacing) == pytest.approx(head_in_spacings * spacing, rel=1e-12)
-    fine = 0.191 / 100  # a fine 3-D liquid: the seed's own h_q_ref (5 mm) is the larger
+    fine = 0.191 / 100  # a fine 3-D liquid: the paper's h_q_ref (5 mm) is the larger
     assert cfs_head_reference(scene, fine) == scene.controller.cfs.h_q_ref == 0.005
 
 

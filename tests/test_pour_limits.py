@@ -8,7 +8,7 @@ import re
 import numpy as np
 
 from cosim.cli.main import main
-from cosim.io.trajectory_csv import read_trajectory_csv
+from cosim.trajectory.csv_file import read_trajectory_csv
 
 COARSE = """
 name = "limits"

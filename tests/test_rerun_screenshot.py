@@ -1,4 +1,4 @@
-"""``python -m cosim.io.screenshot``: bad input is one line and exit 2 with nothing written; the viewer URL opens
+"""``python -m cosim.tools.screenshot``: bad input is one line and exit 2 with nothing written; the viewer URL opens
 the recording the script serves."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import urllib.parse
 
 import pytest
 
-from cosim.io import screenshot
+from cosim.tools import screenshot
 
 
 @pytest.mark.parametrize(

@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 from cosim.cli.main import main
-from cosim.io.trajectory_csv import JointTrajectory, write_trajectory_csv
 from cosim.robots.scene import RobotScene
+from cosim.trajectory.csv_file import write_trajectory_csv
+from cosim.trajectory.joint_trajectory import JointTrajectory
 
 
 def _two_samples(path, lift: float):

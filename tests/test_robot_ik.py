@@ -15,7 +15,7 @@ from cosim.robots.planar import PlanarPose, planar_to_world, tilt_about_pivot
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 
-# Issue 3 acceptance: vessel targets reached within 1 mm and 0.1 deg.
+# Acceptance: vessel targets reached within 1 mm and 0.1 deg.
 MAX_POSITION_ERROR_M = 1e-3
 MAX_ROTATION_ERROR_RAD = math.radians(0.1)
 

@@ -57,6 +57,22 @@ def test_scene_arms_fk_matches_dh_model_in_their_base_frames(role):
         np.testing.assert_allclose(rel_rot, expected[:3, :3], atol=FK_TOLERANCE)
 
 
+def test_posed_places_the_named_arm_by_forward_kinematics_and_leaves_the_rest_at_home():
+    scene = RobotScene.load()
+    live = scene.data.qpos.copy()
+    q = _random_configurations(1)[0]
+    data = scene.posed({ArmRole.POUR: q})
+    pour, catch = scene.arms[ArmRole.POUR], scene.arms[ArmRole.CATCH]
+    np.testing.assert_array_equal(data.qpos[pour.qpos_adr], q)
+    np.testing.assert_array_equal(data.qpos[catch.qpos_adr], catch.home_q)
+    base = scene.model.body("pour_arm/base").id
+    flange = scene.model.site("pour_arm/flange").id
+    r_base = data.xmat[base].reshape(3, 3)
+    expected = dh_forward_kinematics(q)
+    np.testing.assert_allclose(r_base.T @ (data.site_xpos[flange] - data.xpos[base]), expected[:3, 3], atol=FK_TOLERANCE)
+    np.testing.assert_array_equal(scene.data.qpos, live)
+
+
 def test_arm_weight_matches_data_sheet():
     model = mujoco.MjModel.from_xml_path(str(assets.model_path(assets.UR10E_ARM)))
     assert abs(model.body_mass.sum() - UR10E_WEIGHT_KG) < WEIGHT_TOLERANCE_KG

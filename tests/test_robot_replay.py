@@ -8,16 +8,16 @@ import numpy as np
 import pytest
 
 from cosim.errors import InputError
-from cosim.io.trajectory_csv import JointTrajectory
 from cosim.robots.payload import PayloadMode
 from cosim.robots.planar import PlanarPose
-from cosim.robots.pour_motion import Pivot, PourMotionSpec, plan_pour_trajectory
-from cosim.robots.replay import Feedforward, replay
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.robots.ur10e import UR10E_PAYLOAD_KG
+from cosim.trajectory.joint_trajectory import JointTrajectory
+from cosim.trajectory.pour_motion import Pivot, PourMotionSpec, plan_pour_trajectory
+from cosim.trajectory.replay import Feedforward, replay
 
-# Issue 3 acceptance: RMS lip error of a smooth pour under the position servos with the full-vessel payload.
+# Acceptance: RMS lip error of a smooth pour under the position servos with the full-vessel payload.
 MAX_LIP_RMS_ERROR_M = 2e-3
 # Holding home with gravity compensation of a known payload: no error beyond round-off (rad, m).
 HOLD_TOLERANCE = 1e-9

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from cosim.errors import InputError
-from cosim.io.trajectory_csv import JointTrajectory, header, read_trajectory_csv, write_trajectory_csv
+from cosim.trajectory.csv_file import header, read_trajectory_csv, write_trajectory_csv
+from cosim.trajectory.joint_trajectory import JointTrajectory
 
 JOINTS = ("pour_arm/shoulder_pan", "pour_arm/elbow")
 

@@ -70,7 +70,7 @@ JOINTS = ("j1", "j2", "j3", "j4", "j5", "j6")
 TEST_ARM7_XML = TEST_ARM_XML.replace(
     '<joint name="j4" axis="0 1 0"/>', '<joint name="j4" axis="0 1 0"/> <joint name="j7" axis="0 1 0"/>'
 ).replace('<general name="a6" joint="j6"/>', '<general name="a6" joint="j6"/> <general name="a7" joint="j7"/>')
-# Reaching a vessel target: the acceptance tolerances of issue 3 (m, rad).
+# Reaching a vessel target: the acceptance tolerances of the project's IK (m, rad).
 MAX_POSITION_ERROR_M = 1e-3
 MAX_ROTATION_ERROR_RAD = math.radians(0.1)
 

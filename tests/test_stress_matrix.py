@@ -42,7 +42,7 @@ def test_config_id_is_stable_and_fluid_config_follows_the_axes():
 def test_shake_runs_at_the_first_sloshing_mode():
     c = StressConfig(Motion.SHAKE, 0.02, 0.5, 12, 1.0, 2, "wcsph")
     b, a = 0.191, 0.5 * 0.191
-    omega = math.sqrt(9.81 * math.pi / b * math.tanh(math.pi * a / b))  # seed Eq. 17
+    omega = math.sqrt(9.81 * math.pi / b * math.tanh(math.pi * a / b))  # Eq. 17, the linear first sloshing mode
     assert c.shake_omega == pytest.approx(omega)
     assert c.pose_script()(math.pi / (2 * omega)).position[0] == pytest.approx(0.02)
 

@@ -23,6 +23,7 @@ from cosim.sweep.plan import PlannedPour
 from cosim.sweep.runner import CodeVersionMismatch, failure_record, pour_task
 from cosim.sweep.spec import load_sweep
 
+pytestmark = pytest.mark.slow  # starts a local Ray cluster and runs several pours
 FILLS = (0.08, 0.10, 0.12, 0.5)  # m; the pourer is 0.191 m deep inside: 0.5 is refused when its pour is checked
 BASE = """
 [scene]

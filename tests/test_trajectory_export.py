@@ -17,20 +17,21 @@ from mcap_ros2.decoder import DecoderFactory
 
 from cosim.cli.main import main
 from cosim.errors import InputError
-from cosim.io.trajectory_csv import JointTrajectory, read_trajectory_csv
-from cosim.io.trajectory_json import FORMAT, UNITS, read_trajectory_json
 from cosim.robots.assets import DEFAULT_SCENE, models_dir
-from cosim.robots.pour_motion import Pivot, PourMotionSpec
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import UnsafeTrajectoryError
+from cosim.trajectory.csv_file import read_trajectory_csv
 from cosim.trajectory.driver_names import JointPrefix, driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
+from cosim.trajectory.joint_trajectory import JointTrajectory
+from cosim.trajectory.json_file import FORMAT, UNITS, read_trajectory_json
 from cosim.trajectory.limits import JointLimitOverride, arm_limits
+from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
 from cosim.trajectory.scripted import generate_scripted, pour_poses
 
 POUR = PourMotionSpec(duration=10.0, max_tilt=math.radians(100.0), pivot=Pivot.LIP, catcher_dx=0.15)
-# Acceptance (issue 5): `cosim replay trajectory.csv` tracks the vessel path within 2 mm.
+# Acceptance: `cosim replay trajectory.csv` tracks the vessel path within 2 mm.
 MAX_REPLAY_ERROR_M = 2e-3
 # Relative slack on the limits for round-off (the files hold ruckig's output exactly).
 LIMIT_RTOL = 1e-9

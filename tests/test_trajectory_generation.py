@@ -9,15 +9,15 @@ import pytest
 import ruckig
 
 from cosim.errors import InputError
-from cosim.io.trajectory_csv import JointTrajectory
 from cosim.robots.planar import PlanarPose, tilt_about_pivot
-from cosim.robots.pour_motion import Pivot, PourMotionSpec
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
 from cosim.trajectory.deviation import path_deviation
 from cosim.trajectory.generator import TrajectoryGenerator
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits, JointLimitOverride, JointLimits, arm_limits
+from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
 from cosim.trajectory.recorder import TrajectoryRecorder
 from cosim.trajectory.scripted import generate_scripted, pour_path, pour_poses
 
@@ -117,8 +117,8 @@ def test_arm_catches_up_with_a_path_that_starts_abruptly(scene):
     assert generator.late_targets > 0 and generator.max_target_error > 100 * ON_PATH_TOLERANCE  # and it is reported
 
 
-# The seed's SIM excitation, tilt 0.3 sin(3.2 t) about the vessel bottom for a quarter period, then held: it starts
-# with a velocity step no jerk-limited arm can follow.
+# The SIM excitation of Camporredondo et al. (2019), tilt 0.3 sin(3.2 t) about the vessel bottom for a quarter
+# period, then held: it starts with a velocity step no jerk-limited arm can follow.
 SIM_AMPLITUDE, SIM_FREQUENCY, SIM_TARGETS = 0.3, 3.2, 200
 # Jerk-limited filter of the tilt angle (rad/s, rad/s^2, rad/s^3) that keeps the joints within their limits.
 TILT_FILTER = (1.5, 2.5, 40.0)

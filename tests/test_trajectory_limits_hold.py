@@ -14,12 +14,12 @@ import re
 import numpy as np
 import pytest
 
-from cosim.robots.pour_motion import Pivot, PourMotionSpec
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
 from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator, UntrackablePathError
 from cosim.trajectory.limits import ArmLimits, JointLimitOverride, JointLimits, arm_limits
+from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
 from cosim.trajectory.recorder import TrajectoryRecorder
 from cosim.trajectory.scripted import generate_scripted, pour_poses
 

@@ -57,6 +57,7 @@ def test_fewer_than_three_pivots_are_refused():
         plant_fit.identify_plant([0.0, 0.1], t, sigmas)
 
 
+@pytest.mark.slow
 def test_sph_plant_of_the_papers_vessel_is_potential_flow_not_the_printed_pendulum(capsys):
     """Coarse (16 across B, 2-D, DFSPH): the hinge the liquid shows is the potential-flow one, some 50 mm above
     the hinge of the paper's printed Eqs. 10-11."""

@@ -19,7 +19,7 @@ class BenchCase(Enum):
     """What a configuration runs."""
 
     HYDROSTATIC = "hydrostatic"  # cosim.validation.hydrostatic: pressure against rho0 g (H - z)
-    SLOSH = "slosh"  # cosim.validation.slosh: first-mode frequency against the seed's Eq. 17
+    SLOSH = "slosh"  # cosim.validation.slosh: first-mode frequency against Eq. 17 of Camporredondo et al. (2019)
     DAM_BREAK = "dam-break"  # cosim.validation.dam_break: surge front against Martin & Moyce (1952)
     FREE_FALL = "free-fall"  # cosim.validation.free_fall: outflow particles against their free-fall parabolas
     COUPLING_STATIC = "coupling-static"  # cosim.validation.coupling_static: reaction against the liquid's weight

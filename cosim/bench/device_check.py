@@ -1,4 +1,4 @@
-"""The checks that need a CUDA device, as one short prepared run for a session that has one (issue 7).
+"""The checks that need a CUDA device, as one short prepared run on a machine that has one.
 
     python -m cosim.bench.device_check [--device cuda] [--out DIR] [--quick]
 
@@ -12,8 +12,8 @@ report, DIR/device_check.md, is printed at the end:
    to in this flow: the yardstick for the device's difference); the device run
    with its substeps replayed as captured graphs against launched one by one (and why capture failed, if it did).
 2. validation: the hydrostatic tank (0.5 s) and the slosh case (:data:`SLOSH_PERIODS` periods) on both: every metric side by side.
-3. throughput: ``cosim.fluid.benchmark`` on the device (issue 7's sizes: 2-D 10k, 3-D 100k and 1M particles,
-   both solvers, warp's ``example_sph`` beside the 3-D rows; DFSPH again with the Jacobi density iteration), and
+3. throughput: ``cosim.bench.fluid_throughput`` on the device (the speed targets' sizes: 2-D 10k, 3-D 100k and 1M
+   particles, both solvers, warp's ``example_sph`` beside the 3-D rows; DFSPH again with the Jacobi density iteration), and
    the 2-D rows again without graph replay.
 4. pour: the coupled pour (robots, controllers, trajectory generation, no recording) on the device: the default
    2-D scene (its own solver, DFSPH with Gauss-Seidel density sweeps), and the 3-D one at 64 across (~112k
@@ -23,17 +23,14 @@ report, DIR/device_check.md, is printed at the end:
    MuJoCo step split into the substeps and the rest (``cosim.bench.host_overhead``: the rest bounds the real-time
    factor), and the particle-substeps per second real time would take (particles x substeps per simulated
    second: what the device must sustain, besides the host's share); and where the 2-D pour's host time goes
-   (cProfile, OUT/pour_host_profile.txt: the rest of the loop took 2.0 to 2.5 ms per 2 ms step on the H200's
-   machine, 0.9 to 1.6 on the 2-core CPU).
+   (cProfile, OUT/pour_host_profile.txt).
 5. profile: ``cosim.bench.kernel_profile``, each kernel's device time in a substep of the benchmark's block (its
    default cases: 3-D at 1M and 2-D at 10k particles, WCSPH and DFSPH with either density iteration).
 
-Sized to finish within one 600 s call of the device tool (:data:`TIME_LIMITS`; on the H200 on 2026-12-04 the first
-four took 53, 35, 8 and 91 s); the warp install the GPU machine needs first is in ``../shared/gpu/README.md``.
+Sized to finish within 600 s (:data:`TIME_LIMITS`, one per check); docs/performance.md has the timings measured.
 
 ``--quick`` runs every check at small sizes (on the CPU too): a dry run of the machinery, numbers meaningless.
-Needs warp, mujoco, ruckig and control; not rerun-sdk or tqdm (the GPU machine's staged packages,
-``../shared/gpu/README.md``).
+Needs warp, mujoco, ruckig and control; not rerun-sdk or tqdm.
 """
 
 from __future__ import annotations
@@ -166,16 +163,16 @@ def _validation_table(rows: list[dict]) -> list[str]:
 
 # ---- throughput -------------------------------------------------------------------------------------------
 def check_throughput(device: str, quick: bool, out: Path) -> list[dict]:
-    from cosim.fluid import benchmark
+    from cosim.bench import fluid_throughput
 
     counts2d, counts3d = (["500"], ["2000"]) if quick else (["10000"], ["100000", "1000000"])
     table = out / "throughput.md"
     table.unlink(missing_ok=True)  # the benchmark appends: start this run's table afresh
     where = ["--device", device, "--out", str(table)]
     both = ["--solvers", "wcsph", "dfsph"]
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *both, *where])
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", *counts3d, "--solvers", "dfsph", "--density-iteration", "jacobi", *where])
-    benchmark.main(["--counts2d", *counts2d, "--counts3d", "--no-graphs", *both, *where])
+    fluid_throughput.main(["--counts2d", *counts2d, "--counts3d", *counts3d, *both, *where])
+    fluid_throughput.main(["--counts2d", *counts2d, "--counts3d", *counts3d, "--solvers", "dfsph", "--density-iteration", "jacobi", *where])
+    fluid_throughput.main(["--counts2d", *counts2d, "--counts3d", "--no-graphs", *both, *where])
     return [{"table": table.read_text()}]
 
 

@@ -5,7 +5,7 @@ pour controller and its IK and trajectory generators (every control period), ``m
 exchange, the upload of the walls' motion and the diagnostics read back after the substeps. The host's share does
 not shrink with a faster device, so it bounds the real-time factor of every pour: at 2 ms per step and H ms of host
 work per step a pour cannot run faster than 2 / H times real time, however fast its liquid is. It must not grow
-with the particle count either (issue "Faster at equal error", Build 3); a run at two resolutions shows that.
+with the particle count either; a run at two resolutions shows that.
 
 The split is exact: ``CoupledPour.wall_time`` times every step and ``FluidSolver.substep_wall_time`` the substep
 loops inside them (on CUDA up to the device's completion), so host = wall - substeps, both from one run.
@@ -27,7 +27,7 @@ import sys
 from cosim.coupling.loop import CoupledPour
 from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
-from cosim.fluid.benchmark import machine_description
+from cosim.bench.fluid_throughput import machine_description
 from cosim.fluid.config import PressureSolver
 from cosim.pour_run import prepare
 from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene, load_scene

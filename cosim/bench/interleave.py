@@ -29,7 +29,7 @@ from cosim.bench.report import update_document
 from cosim.bench.run import warm_up
 from cosim.bench.runners import run_config
 from cosim.errors import InputError
-from cosim.fluid.benchmark import machine_description
+from cosim.bench.fluid_throughput import machine_description
 
 BEGIN = "<!-- cosim.bench.interleave: generated, begin -->"
 END = "<!-- cosim.bench.interleave: generated, end -->"

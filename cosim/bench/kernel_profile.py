@@ -5,7 +5,7 @@ timed by warp's CUDA activity timing (a profile, not a benchmark: launches run o
                                          [--top 12] [--pair-layouts rows columns] [--out DIR]
 
 For each case (dim:particles:solver, for DFSPH optionally :gauss_seidel or :jacobi, its density iteration) the
-block of ``cosim.fluid.benchmark`` settles for one interval of ``steps`` WCSPH substeps, then one more is timed: the wall time, the sum of the device activities (their
+block of ``cosim.bench.fluid_throughput`` settles for one interval of ``steps`` WCSPH substeps, then one more is timed: the wall time, the sum of the device activities (their
 difference is the host's launch and synchronisation cost), and the ``top`` activities by total time, with their
 count and milliseconds per substep. On the CPU, where warp times nothing per kernel, each operation of the substeps is
 timed on the host's clock instead (:class:`OperationTimer`, the solver's ``operation_hook``; a CPU launch returns
@@ -27,12 +27,12 @@ from pathlib import Path
 import warp as wp
 
 from cosim.atomic_files import write_text_atomic
-from cosim.fluid.benchmark import resting_block
+from cosim.bench.fluid_throughput import resting_block
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.device_layout import layout_for
 from cosim.fluid.runtime import resolve_device
 
-# issue 7's sizes (3-D 1M, 2-D 10k), each solver, DFSPH with either density iteration
+# the speed targets' sizes (3-D 1M, 2-D 10k), each solver, DFSPH with either density iteration
 DEFAULT_CASES = [f"{size}:{solver}" for size in ("3:1000000", "2:10000") for solver in ("wcsph", "dfsph:jacobi", "dfsph:gauss_seidel")]
 PAIR_LAYOUTS = {"rows": False, "columns": True}  # --pair-layouts: name -> DeviceLayout.pairs_by_column
 

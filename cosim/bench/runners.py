@@ -24,8 +24,8 @@ from cosim.bench.config import BenchCase, BenchConfig
 from cosim.config_mapping import from_mapping
 from cosim.errors import SimulationError
 from cosim.io.pour_series import read_series_csv
-from cosim.io.trajectory_csv import read_trajectory_csv
 from cosim.pour_scene import PourScene
+from cosim.trajectory.csv_file import read_trajectory_csv
 from cosim.validation import CASES
 from cosim.validation.common import CaseResult
 

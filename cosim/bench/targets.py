@@ -1,9 +1,9 @@
-"""Issue 7's speed targets, measured on this machine: ``cosim bench --plan targets``.
+"""The speed targets, measured on this machine: ``cosim bench --plan targets``.
 
-Each :class:`Target` names a measurement, the threshold the issue sets and the device it is set on:
+Each :class:`Target` names a measurement, its threshold and the device it is set on:
 
 - 3-D WCSPH at 1M particles on a CUDA device: >= 1.0 G particle-steps/s, warp's ``example_sph`` re-sized to the same
-  count measured in the same run beside it (:func:`cosim.fluid.benchmark.solver_throughput`, the full substep);
+  count measured in the same run beside it (:func:`cosim.bench.fluid_throughput.solver_throughput`, the full substep);
 - 2-D at 10k particles on a CUDA device: >= 20,000 steps/s (WCSPH and DFSPH with either density iteration measured;
   the figure is the one with the most steps per second, the others in the detail column);
 - the 3-D two-arm pour at ~100k particles (64 across the pourer: 111,936) on a CUDA device: at least real time,
@@ -11,12 +11,12 @@ Each :class:`Target` names a measurement, the threshold the issue sets and the d
   :func:`cosim.bench.host_overhead.pour_rate`, after a warm-up that compiles and captures);
 - the default pour, ``cosim pour --no-log`` as a user runs it (a new process: start-up, scene build, the whole pour,
   the outputs), with the compiled kernels cached by a short run first: <= 60 s wall, the median of
-  :attr:`TargetSizes.default_pour_repeats` runs. The issue sets it on the 2-core CPU; it runs on this machine's CPU,
+  :attr:`TargetSizes.default_pour_repeats` runs. The target is set for a 2-core CPU; it runs on this machine's CPU,
   whichever it is (the header names it).
 
 On a machine without a CUDA device the CUDA targets are listed as not measured; the CPU target is always measured.
 Timings are measured afresh on every run (nothing is cached: a cached time says nothing about this machine now). A
-measurement that fails is a row with its one-line error, and the exit status is 1. The fifth target of the issue,
+measurement that fails is a row with its one-line error, and the exit status is 1. The fifth target,
 DFSPH faster than WCSPH at equal error on the default pour, is the full plan's pour table (``cosim bench``).
 """
 
@@ -42,7 +42,7 @@ GIGA = 1e9
 class TargetSizes:
     """What the measurements run: the issue's sizes by default (tests use small ones, whose numbers mean nothing).
 
-    throughput_3d / throughput_2d: particles of the resting block (:func:`cosim.fluid.benchmark.resting_block`).
+    throughput_3d / throughput_2d: particles of the resting block (:func:`cosim.bench.fluid_throughput.resting_block`).
     steps: WCSPH substeps per timed interval; repeats: timed intervals (medians). pour_3d_across: particles across
     the pourer of the 3-D pour; pour_3d_seconds: its simulated seconds timed after the warm-up.
     default_pour_repeats: timed runs of ``cosim pour --no-log``; default_pour_duration: their simulated s (None: the
@@ -111,7 +111,7 @@ TARGETS = (THROUGHPUT_3D, STEPS_2D, POUR_3D, DEFAULT_POUR)
 
 def measure_throughput_3d(device: str, sizes: TargetSizes) -> tuple[float, str]:
     """G particle-steps/s of the 3-D WCSPH full substep, and example_sph's beside it."""
-    from cosim.fluid.benchmark import example_sph_throughput, solver_throughput
+    from cosim.bench.fluid_throughput import example_sph_throughput, solver_throughput
     from cosim.fluid.config import FluidConfig, PressureSolver
 
     rate, _, particles, _, _ = solver_throughput(sizes.throughput_3d, 3, device, sizes.steps, sizes.repeats, PressureSolver.WCSPH,
@@ -123,7 +123,7 @@ def measure_throughput_3d(device: str, sizes: TargetSizes) -> tuple[float, str]:
 def measure_steps_2d(device: str, sizes: TargetSizes) -> tuple[float, str]:
     """Substeps per second of the 2-D block, the best of WCSPH and DFSPH with either density iteration (the others
     in the detail, with the simulated seconds per wall second that compare solvers of different time steps)."""
-    from cosim.fluid.benchmark import solver_throughput
+    from cosim.bench.fluid_throughput import solver_throughput
     from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 
     variants = {"wcsph": (PressureSolver.WCSPH, FluidConfig.density_iteration)}

@@ -10,7 +10,7 @@ Markdown file and puts the plots beside it. Results are cached per configuration
 configuration and the simulation code's version), so a rerun, or a run after an interruption, only computes what
 is missing.
 
-``--plan targets`` measures issue 7's speed targets instead (:mod:`cosim.bench.targets`: the 3-D throughput at 1M
+``--plan targets`` measures the speed targets instead (:mod:`cosim.bench.targets`: the 3-D throughput at 1M
 particles beside warp's example_sph, the 2-D steps per second at 10k, the 3-D pour's real-time factor, all on a CUDA
 device when one is present; the default pour's wall time on the CPU), afresh each time, into ``targets.md`` and
 ``targets.json``; with ``--docs`` it rewrites that file's block for this machine's kind (cpu or cuda).
@@ -32,7 +32,7 @@ PLANS = ("full", "smoke", "targets")
 
 def register(subparsers, summary: str) -> None:
     p = subparsers.add_parser("bench", help=summary, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--plan", default="full", help="which configurations: full (default), smoke (seconds, for checks) or targets (issue 7's speed targets on "
+    p.add_argument("--plan", default="full", help="which configurations: full (default), smoke (seconds, for checks) or targets (the speed targets on "
                    "this machine's devices, measured afresh: no cache)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for bench.csv, bench.md and the plots (default {DEFAULT_OUT})")
     p.add_argument("--cache", type=Path, help="result cache folder (default OUT/cache)")
@@ -44,7 +44,7 @@ def register(subparsers, summary: str) -> None:
 
 def _machine_line() -> str:
     """'Machine: ...; CUDA .... Versions: ...' for a report's header."""
-    from cosim.fluid.benchmark import machine_description
+    from cosim.bench.fluid_throughput import machine_description
     from cosim.fluid.runtime import cuda_available
     from cosim.pour_run import package_versions
 
@@ -60,7 +60,7 @@ def _header(command: str, code_versions: dict) -> str:
 
 
 def _run_targets(args) -> int:
-    """``--plan targets``: issue 7's speed targets measured on this machine (:mod:`cosim.bench.targets`)."""
+    """``--plan targets``: the speed targets measured on this machine (:mod:`cosim.bench.targets`)."""
     from cosim.bench.report import update_document
     from cosim.bench.targets import measure_all, write_report
     from cosim.fluid.runtime import cuda_available

@@ -2,7 +2,8 @@
 
 Without a scene file the embedded default scene runs (``cosim scene --dump`` prints it). Outputs go to a new run
 folder under ``recordings/`` named after the scene file (``cosim pour my_cell.toml``: recordings/<UTC time>-my_cell,
-unless the scene sets ``name``; the default scene: <UTC time>-seed-pour) or to ``--out DIR``: pour.rrd (Rerun;
+unless the scene sets ``name``; the default scene, the setup of Camporredondo et al. (2019) it starts
+from: <UTC time>-seed-pour) or to ``--out DIR``: pour.rrd (Rerun;
 ``cosim view RUN`` opens it), trajectory.csv, trajectory.json and trajectory.mcap (jerk-limited joint trajectories for
 the real arms; the MCAP for ROS 2, docs/ros2.md), summary.json.
 """

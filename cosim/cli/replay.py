@@ -1,11 +1,11 @@
 """``cosim replay TRAJECTORY.csv [--json] [--tolerance-mm MM] [--model SCENE] [--payload full|empty] [--feedforward ...]``.
 
-Plays a joint trajectory (DESIGN.md CSV format) through the arms' position servos in MuJoCo without liquid (the
-liquid as a rigid payload, full by default) and reports per-joint tracking error and the vessel lips' path errors
-(:mod:`cosim.robots.replay`), then a verdict: PASS when every vessel lip stays within ``--tolerance-mm`` (default
-2 mm) of its commanded path and nothing collides, else FAIL with the reasons. The exit status says it, so that a
-script or CI job can gate on it: 0 pass, 1 fail, 2 bad input (a bad trajectory file, scene or option: one line).
-``--json`` prints a JSON object with ``verdict`` ("pass" or "fail"), ``tolerance_m``, ``failures`` (the reasons),
+Plays a joint trajectory (a CSV file, :mod:`cosim.trajectory.csv_file`) through the arms' position servos in
+MuJoCo without liquid (the liquid as a rigid payload, full by default) and reports per-joint tracking error and
+the vessel lips' path errors (:mod:`cosim.trajectory.replay`), then a verdict: PASS when every vessel lip stays
+within ``--tolerance-mm`` (default 2 mm) of its commanded path and nothing collides, else FAIL with the reasons. The
+exit status says it, so that a script or CI job can gate on it: 0 pass, 1 fail, 2 bad input (a bad trajectory file,
+scene or option: one line). ``--json`` prints a JSON object with ``verdict`` ("pass" or "fail"), ``tolerance_m``, ``failures`` (the reasons),
 ``max_error_m`` (largest pour-lip position error, m), ``joint_max_error_rad`` (per-joint maxima) and the rest.
 """
 
@@ -18,11 +18,11 @@ import math
 from typing import TYPE_CHECKING
 
 from cosim.checks import check_positive
-from cosim.robots.feedforward import DEFAULT_TOLERANCE_M, Feedforward
 from cosim.robots.payload import PayloadMode
+from cosim.trajectory.feedforward import DEFAULT_TOLERANCE_M, Feedforward
 
 if TYPE_CHECKING:
-    from cosim.robots.replay import ReplayReport
+    from cosim.trajectory.replay import ReplayReport
 
 MAX_TOLERANCE_MM = 1000.0
 
@@ -72,9 +72,9 @@ def _print_table(report: ReplayReport) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from cosim.io.trajectory_csv import read_trajectory_csv
-    from cosim.robots.replay import replay
     from cosim.robots.scene import RobotScene
+    from cosim.trajectory.csv_file import read_trajectory_csv
+    from cosim.trajectory.replay import replay
 
     tolerance = check_positive("--tolerance-mm", args.tolerance_mm, "mm", MAX_TOLERANCE_MM) / 1000.0
     scene = RobotScene.load(args.model, PayloadMode(args.payload))

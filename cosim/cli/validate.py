@@ -38,7 +38,7 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--width", type=float, help="tank width B (hydrostatic, slosh, slosh-plant; slosh-plant's cylinder: inner "
                    "diameter) or column width a (dam-break), m")
     p.add_argument("--fill", type=float, help="fill depth A (hydrostatic, slosh, slosh-plant) or column height (dam-break), m; "
-                   "slosh without --fill runs the seed's fills 0.054, 0.108, 0.162 m")
+                   "slosh without --fill runs the fills 0.054, 0.108, 0.162 m of Camporredondo et al. (2019)")
     p.add_argument("--shape", choices=("box", "cylinder"), help="slosh-plant's vessel: box or cylinder (3-D only) (default box)")
     p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
     p.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2-D (pour plane) or 3-D (default 2)")
@@ -70,7 +70,7 @@ def _case_params(name: str, args) -> list:
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
     if name in ("tilt", "shake", "free-fall", "coupling-static"):
-        geometry.pop("width", None)  # the scene's (seed's) vessel
+        geometry.pop("width", None)  # the scene's pouring vessel
     if name == "slosh-plant" and args.shape is not None:
         geometry["shape"] = args.shape
     if name == "slosh" and args.fill is None:

@@ -1,2 +1,2 @@
 """Input/output that observes a run and never changes it: the Rerun recording (``recording``), its geometry,
-blueprint and read-back helpers (``rerun_*``), trajectory files (``trajectory_csv``) and summaries."""
+blueprint and read-back helpers (``rerun_*``) and the pour's time series (``pour_series``)."""

@@ -1,4 +1,4 @@
-"""MuJoCo robot side: scene loading, vessel bodies, inverse kinematics, actuation, collision checks, replay.
+"""MuJoCo robot side: scene loading, vessel bodies, inverse kinematics, actuation, collision checks.
 
 Conventions (shared by the whole project; every module here states the ones it relies on):
 

@@ -18,7 +18,7 @@ from cosim.vessel import VesselSpec
 if TYPE_CHECKING:  # only the annotations name MuJoCo: `cosim replay --help` lists PayloadMode without loading it
     import mujoco
 
-# Density of the liquid, kg/m^3 (water; DESIGN.md rho0 = 1000).
+# Density of the liquid, kg/m^3 (water, the fluid's rest density rho0).
 LIQUID_DENSITY = 1000.0
 
 

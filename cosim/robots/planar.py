@@ -7,8 +7,8 @@ the +x lip (pours).
 A controller's vessel target is a :class:`PlanarPose` relative to the vessel's HOME pose ``(p_home, R_home)``:
 world position ``p_home + (dx, 0, dz)``, world orientation ``R_y(theta) @ R_home``. :func:`tilt_about_pivot` builds
 such a target from "tilt by an angle about the line through a point p of the vessel (given in the vessel frame),
-parallel to world y, plus a translation"; the seed tilts about the bottom middle ``(0, 0, 0)`` during SIM and about
-the lip (``VesselSpec.lip_local``) during CFS.
+parallel to world y, plus a translation"; Camporredondo et al. (2019) tilt about the bottom middle ``(0, 0, 0)``
+during SIM and about the lip (``VesselSpec.lip_local``) during CFS.
 """
 
 from __future__ import annotations

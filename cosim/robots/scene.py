@@ -20,6 +20,7 @@ feedforward torque (e.g. ``-J^T w`` for a known external wrench).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -251,6 +252,17 @@ class RobotScene:
         """Put the live data at the home keyframe (positions, zero velocities, servo targets) and run forward."""
         mujoco.mj_resetDataKeyframe(self.model, self.data, self.home_key)
         mujoco.mj_forward(self.model, self.data)
+
+    def posed(self, configuration: Mapping[ArmRole, np.ndarray]) -> mujoco.MjData:
+        """A new MjData at the home keyframe with the arms at ``configuration`` (role -> q (n,) rad; arms not named
+        stay at home), bodies, geoms and sites placed by forward kinematics (``mj_kinematics``); the live data is
+        untouched."""
+        data = mujoco.MjData(self.model)
+        mujoco.mj_resetDataKeyframe(self.model, data, self.home_key)
+        for role, q in configuration.items():
+            data.qpos[self.arms[role].qpos_adr] = q
+        mujoco.mj_kinematics(self.model, data)
+        return data
 
     def joint_positions(self, role: ArmRole) -> np.ndarray:
         """(n,) rad, the arm's current joint angles."""

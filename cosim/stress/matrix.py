@@ -37,7 +37,7 @@ class Motion(Enum):
     speed (m/s)."""
 
     TILT = "tilt"  # rotation about the pour lip at a constant rate up to TILT_ANGLE, then held
-    SHAKE = "shake"  # x = level sin(omega1 t) at the first sloshing mode (seed Eq. 17)
+    SHAKE = "shake"  # x = level sin(omega1 t) at the first sloshing mode (linear theory, see shake_omega)
     CARRY = "carry"  # x = D/2 (1 - cos(pi t / CARRY_TIME)), peak speed = level, then held
 
 
@@ -119,7 +119,7 @@ class StressConfig:
 
     @property
     def shake_omega(self) -> float:
-        """rad/s, first sloshing mode (seed Eq. 17) of this fill."""
+        """rad/s, first sloshing mode of this fill (:func:`cosim.validation.slosh.eq17_frequency`)."""
         return 2.0 * math.pi * eq17_frequency(self.spec().inner_width, self.fill_depth)
 
     @property

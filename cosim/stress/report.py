@@ -42,9 +42,10 @@ def markdown(rows: list[dict], commands: list[str]) -> str:
     lines = [
         "# Numerical stability matrix",
         "",
-        f"{len(rows)} configurations of the SPH liquid in the seed's vessel (0.191 x 0.1 x 0.191 m), each "
+        f"{len(rows)} configurations of the SPH liquid in the pouring vessel of Camporredondo et al. (2019) "
+        "(0.191 x 0.1 x 0.191 m), each "
         f"simulated for {DURATION:g} s under a scripted motion: `tilt` about the pour lip at a constant rate (rad/s) "
-        "up to 90 deg, `shake` sideways at the first sloshing mode (seed Eq. 17) with an amplitude (m), `carry` "
+        "up to 90 deg, `shake` sideways at the first sloshing mode (the paper's Eq. 17) with an amplitude (m), `carry` "
         f"sideways with a cosine speed profile reaching a peak speed (m/s) and stopping after {CARRY_TIME:g} s. "
         "Axes: fill (fraction of the inner height), particles across the inner width (dx = 0.191 m / across), "
         f"CFL factor (x the default Courant number {DEFAULT_CFL:g}), dimension and pressure solver. See `cosim stress --help` "

@@ -23,7 +23,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from cosim.errors import SimulationError
-from cosim.io.trajectory_csv import JointTrajectory
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import LIMIT_FIELDS, ArmLimits
 
 # s: slack of the uniform-spacing check; sample times n / rate carry round-off of ~1e-16 t.

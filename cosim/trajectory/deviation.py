@@ -15,11 +15,11 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
-from cosim.io.trajectory_csv import JointTrajectory
 from cosim.frames import quat_wxyz_to_matrix
 from cosim.robots.planar import PlanarPose
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.joint_trajectory import JointTrajectory
 
 
 def path_deviation(

@@ -2,8 +2,8 @@
 
 :func:`write_trajectory_files` runs :func:`cosim.trajectory.checks.check_trajectory` and builds the JSON text and the
 MCAP bytes first: an unsafe trajectory raises :class:`cosim.trajectory.checks.UnsafeTrajectoryError` and nothing is
-written. Then it writes the CSV (:mod:`cosim.io.trajectory_csv`), the JSON (:mod:`cosim.io.trajectory_json`) and the
-MCAP (:mod:`cosim.io.trajectory_mcap`), each atomically.
+written. Then it writes the CSV (:mod:`cosim.trajectory.csv_file`), the JSON (:mod:`cosim.trajectory.json_file`) and the
+MCAP (:mod:`cosim.trajectory.mcap_file`), each atomically.
 """
 
 from __future__ import annotations
@@ -11,11 +11,12 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-from cosim.io.trajectory_csv import JointTrajectory, write_trajectory_csv
-from cosim.io.trajectory_json import trajectory_json_text, write_json_text
-from cosim.io.trajectory_mcap import trajectory_mcap_bytes, write_mcap_bytes
 from cosim.trajectory.checks import TIME_TOLERANCE, check_trajectory
+from cosim.trajectory.csv_file import write_trajectory_csv
+from cosim.trajectory.joint_trajectory import JointTrajectory
+from cosim.trajectory.json_file import trajectory_json_text, write_json_text
 from cosim.trajectory.limits import ArmLimits
+from cosim.trajectory.mcap_file import trajectory_mcap_bytes, write_mcap_bytes
 
 
 def write_trajectory_files(

@@ -13,8 +13,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from cosim.checks import check_positive
-from cosim.io.trajectory_csv import JointTrajectory
 from cosim.trajectory.generator import TIME_EPSILON, TrajectoryGenerator
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits
 
 DEFAULT_SAMPLE_RATE_HZ = 500.0

@@ -9,35 +9,27 @@ both arms to rest on the last target, samples at ``sample_rate_hz`` and checks t
 Target ``k`` is sent at ``k * target_period`` as the path's state at that time, like a live target; the generator
 extrapolates it one period ahead, so the trajectory follows the script without lag.
 
-``python -m cosim.trajectory.scripted --out DIR`` writes ``DIR/trajectory.csv``, ``.json`` and ``.mcap`` of a
-smooth 10 s pour (:mod:`cosim.robots.pour_motion`: tilt about the lip and back, the catcher moving along x) and prints
-the lips' deviation from the scripted path; ``cosim replay DIR/trajectory.csv`` then measures how the servos track it.
+``python -m cosim.tools.scripted_pour --out DIR`` writes the files of such a trajectory.
 """
 
 from __future__ import annotations
 
-import argparse
 import math
-import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from cosim.errors import InputError, SimulationError
-from cosim.io.trajectory_csv import JointTrajectory
 from cosim.robots.ik import IKSettings
 from cosim.robots.planar import PlanarPose
-from cosim.robots.pour_motion import Pivot, PourMotionSpec, task_poses
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
-from cosim.trajectory.deviation import path_deviation
-from cosim.trajectory.driver_names import JointPrefix, driver_joint_names
-from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits, scene_limits
+from cosim.trajectory.pour_motion import PourMotionSpec, task_poses
 from cosim.trajectory.recorder import DEFAULT_SAMPLE_RATE_HZ, TrajectoryRecorder
 
 # IK tolerances (m, rad) of the scripted targets. With the scene's default vessel-target tolerance (1e-5) the joint
@@ -142,7 +134,7 @@ def generate_scripted(
 
 
 def pour_poses(scene: RobotScene, spec: PourMotionSpec, target_period: float = 0.01) -> dict[ArmRole, list[PlanarPose]]:
-    """The scripted pour of :mod:`cosim.robots.pour_motion` as targets every ``target_period`` s from 0 to its end."""
+    """The scripted pour of :mod:`cosim.trajectory.pour_motion` as targets every ``target_period`` s from 0 to its end."""
     count = int(round(spec.duration / target_period)) + 1
     samples = [task_poses(scene, spec, k * target_period) for k in range(count)]
     return {role: [s[role] for s in samples] for role in ArmRole}
@@ -151,44 +143,3 @@ def pour_poses(scene: RobotScene, spec: PourMotionSpec, target_period: float = 0
 def pour_path(scene: RobotScene, spec: PourMotionSpec) -> dict[ArmRole, Callable[[float], PlanarPose]]:
     """Per arm, the pour's vessel path ``t -> PlanarPose`` (at rest before 0 and after the end)."""
     return {role: (lambda t, role=role: task_poses(scene, spec, min(max(t, 0.0), spec.duration))[role]) for role in ArmRole}
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description="Write the checked trajectory CSV, JSON and MCAP of a scripted pour.")
-    parser.add_argument("--out", required=True, help="folder for trajectory.csv, trajectory.json and trajectory.mcap")
-    parser.add_argument("--duration", type=float, default=10.0, help="s (default 10)")
-    parser.add_argument("--tilt-deg", type=float, default=100.0, help="peak tilt about the lip, deg (default 100)")
-    parser.add_argument("--catcher-dx", type=float, default=0.15, help="catcher travel at peak, m (default 0.15)")
-    parser.add_argument("--sample-rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help="Hz (default 500)")
-    args = parser.parse_args(argv)
-    try:
-        scene = RobotScene.load()
-        spec = PourMotionSpec(args.duration, math.radians(args.tilt_deg), Pivot.LIP, args.catcher_dx)
-        run = generate_scripted(scene, pour_poses(scene, spec), sample_rate_hz=args.sample_rate)
-        out = Path(args.out)
-        write_trajectory_files(
-            run.trajectory, run.limits, run.sample_rate_hz, driver_joint_names(scene, JointPrefix()),
-            out / "trajectory.csv", out / "trajectory.json", out / "trajectory.mcap",
-        )
-    except (InputError, SimulationError) as exc:
-        print(f"scripted: error: {exc}", file=sys.stderr)
-        return 2
-    print(f"wrote {out}/trajectory.csv, .json and .mcap: {run.trajectory.time.size} samples, {run.trajectory.duration:.3f} s")
-    paths = pour_path(scene, spec)
-    for role in ArmRole:
-        deviation = path_deviation(scene, role, run.trajectory, paths[role])
-        print(
-            f"{role.value}: lip deviation from the scripted path: max {deviation.max() * 1e3:.4f} mm, "
-            f"RMS {np.sqrt(np.mean(deviation**2)) * 1e3:.4f} mm"
-        )
-    for role in ArmRole:
-        print(
-            f"{role.value}: targets missed by the arm: {run.late_targets[role]}, largest joint distance to a target on "
-            f"arrival: {run.max_target_error[role]:.2e} rad"
-        )
-    print(f"targets clamped to the joint range: {sum(run.clamped_targets.values())}")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -18,9 +18,9 @@ from collections.abc import Mapping
 import mujoco
 import numpy as np
 
-from cosim.io.trajectory_csv import JointTrajectory
 from cosim.robots.scene import RobotScene, shift_wrench
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.joint_trajectory import JointTrajectory
 
 
 def required_torques(scene: RobotScene, trajectory: JointTrajectory, wrenches: Mapping[ArmRole, np.ndarray]) -> np.ndarray:

@@ -41,7 +41,7 @@ class Case:
 
 CASES: dict[str, Case] = {
     "hydrostatic": Case("hydrostatic", "run", "resting tank: p = rho0 g (H - z)"),
-    "slosh": Case("slosh", "run", "first sloshing mode vs seed Eq. 17"),
+    "slosh": Case("slosh", "run", "first sloshing mode vs linear theory (Eq. 17)"),
     "dam-break": Case("dam_break", "run", "surge front vs Martin & Moyce (1952)"),
     "tilt": Case("moving_vessel", "run_tilt", "full vessel tilted about its lip"),
     "coupling-static": Case("coupling_static", "run", "held full vessel: reaction and joint torques"),

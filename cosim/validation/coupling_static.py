@@ -18,20 +18,19 @@ import mujoco
 import numpy as np
 
 from cosim.checks import check_positive
-from cosim.coupling.exchange import ROLES, vessel_poses
-from cosim.coupling.loop import coupled_step, pour_fluid_config
+from cosim.coupling.exchange import ROLES
+from cosim.coupling.liquid import scene_liquid
+from cosim.coupling.loop import coupled_step
 from cosim.coupling.settings import Compensation, CouplingSettings
 from cosim.fluid.config import GRAVITY, FluidConfig
-from cosim.fluid.seeding import fill_vessel
-from cosim.fluid.solver import FluidSolver
 from cosim.robots.payload import add_liquid_payload
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_builder import build_scene_spec
 from cosim.robots.scene_config import ArmRole
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, new_figure
 
-# Acceptance (issue "Coupled pour"): reaction = liquid weight within 1 %; joint torques match the rigid-payload
-# model within 2 %.
+# Acceptance: the reaction equals the liquid's weight within 1 %; the joint torques match the rigid-payload model
+# within 2 %.
 WEIGHT_TOLERANCE = 0.01
 TORQUE_TOLERANCE = 0.02
 AVERAGE_WINDOW = 0.1  # s at the end of the run over which forces and torques are averaged
@@ -86,9 +85,8 @@ def run(p: Params) -> CaseResult:
     scene = RobotScene.load()
     pourer = scene.arms[ArmRole.POUR].vessel
     spacing = p.spacing if p.spacing is not None else pourer.inner_width / PARTICLES_ACROSS
-    cfg = pour_fluid_config(scene, FluidConfig(dim=p.dim, spacing=spacing, pressure_solver=p.solver, **dict(p.numerics)), p.fill)
-    poses = vessel_poses(scene)
-    fluid = FluidSolver(cfg, [scene.arms[r].vessel for r in ROLES], poses, fill_vessel(pourer, p.fill, cfg, poses[0]), device=p.device)
+    fluid = scene_liquid(scene, FluidConfig(dim=p.dim, spacing=spacing, pressure_solver=p.solver, **dict(p.numerics)), p.fill, p.device)
+    cfg = fluid.config
     settings = CouplingSettings(compensation=Compensation.IDEAL_FORCE_TORQUE)
     dt = float(scene.model.opt.timestep)
     steps = int(round(p.duration / dt))

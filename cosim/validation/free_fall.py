@@ -1,6 +1,7 @@
-"""Free fall of the outflow: particles leaving over the pour lip must follow the parabola of seed Eqs. 6-7.
+"""Free fall of the outflow: particles leaving over the pour lip must follow the free-fall parabola
+(Camporredondo et al. 2019, Eqs. 6-7).
 
-The seed's vessel, filled to A, is tilted about its pour lip at ``rate`` up to ``angle`` and held, as in the
+The paper's vessel, filled to A, is tilted about its pour lip at ``rate`` up to ``angle`` and held, as in the
 ``tilt`` case; the liquid pours over the lip and falls. Every particle is followed (numpy, from positions and
 velocities at every 2 ms sample): its launch state is taken at the first sample where it is more than
 ``launch_spacings`` particle spacings beyond the lip (the outer top edge of the wall the liquid sees), outside the
@@ -28,7 +29,7 @@ from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fl
 from cosim.validation.scripted import FALL_HEIGHT, domain_around, run_scripted, tilt_about_lip
 from cosim.vessel import VesselSpec, seed_pouring_vessel
 
-# Acceptance: the median landing error of the followed particles within 10 mm, the landing accuracy issue 4 asks
+# Acceptance: the median landing error of the followed particles within 10 mm, the landing accuracy asked
 # of the pour (there measured against the controller's prediction, which adds the measurement of the jet).
 LANDING_TOLERANCE = 0.010  # m
 MIN_FOLLOWED = 20  # particles that must land for the median to mean something

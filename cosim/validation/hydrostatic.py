@@ -1,4 +1,4 @@
-"""Hydrostatic tank: a resting column must carry p(z) = rho0 g (H - z) (shared/reference/README.md).
+"""Hydrostatic tank: a resting column must carry p(z) = rho0 g (H - z).
 
 A box tank of inner width ``width`` is filled to ``fill`` and left alone for ``duration``; then the SPH pressure
 is interpolated (Shepard, the solver's kernel) at probes more than 2h from walls, floor and surface and compared
@@ -22,8 +22,8 @@ from cosim.frames import Pose
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
 from cosim.vessel import VesselSpec
 
-# Acceptance (issue "Fluid core"): pressure within 2 % of rho0 g (H - z) away from walls and surface, density
-# error <= 1 % (weakly compressible bound (v_max / c0)^2 with c0 >= 10 v_max, shared/reference/README.md),
+# Acceptance: pressure within 2 % of rho0 g (H - z) away from walls and surface, density error <= 1 % (the weakly
+# compressible bound (v_max / c0)^2 with c0 >= 10 v_max: Monaghan 1994, "Simulating free surface flows with SPH"),
 # vertical reaction = liquid weight within 1 %, no leak, volume conserved.
 PRESSURE_TOLERANCE = 0.02
 DENSITY_ERROR_LIMIT = 0.01

@@ -1,8 +1,9 @@
-"""Moving-vessel robustness: the seed's full vessel tilted about its lip, or shaken sideways at resonance.
+"""Moving-vessel robustness: the full pouring vessel of Camporredondo et al. (2019) tilted about its lip, or
+shaken sideways at resonance.
 
 ``tilt``: the vessel filled to A is rotated about its pour lip at ``rate`` (default 60 deg/s) to ``angle``
 (default 90 deg) and held; the liquid pours out and falls out of the domain. ``shake``: the vessel moves
-x(t) = amplitude sin(2 pi f t) at the first sloshing frequency f (seed Eq. 17), default 1 cm for 4 periods.
+x(t) = amplitude sin(2 pi f t) at the first sloshing frequency f (the paper's Eq. 17), default 1 cm for 4 periods.
 
 Checked independently of the solver's own guard (``cosim.validation.scripted``), from positions and poses at
 every 2 ms sample (numpy): no particle inside the wall solid (the wall region the liquid sees), and no particle

@@ -1,6 +1,6 @@
-"""First sloshing mode of a rectangular tank against the seed's Eq. 17.
+"""First sloshing mode of a rectangular tank against linear potential-flow theory.
 
-omega^2 = (g pi / B) tanh(pi A / B), f = omega / (2 pi)  (shared/reference/README.md; Camporredondo et al. 2019).
+omega^2 = (g pi / B) tanh(pi A / B), f = omega / (2 pi)  (Camporredondo et al. 2019, Eq. 17).
 
 The tank (inner width B, fill A) starts at rest; a smooth lateral displacement pulse of a few millimetres (half a
 cosine over a quarter of the expected period) excites the first mode, then the tank stands still. The horizontal
@@ -34,16 +34,16 @@ from cosim.validation.common import (
 )
 from cosim.vessel import VesselSpec
 
-# Acceptance (issue "Fluid core"): first-mode frequency within 3 % of the seed's Eq. 17.
+# Acceptance: first-mode frequency within 3 % of Eq. 17.
 FREQUENCY_TOLERANCE = 0.03
-SEED_FILLS = (0.054, 0.108, 0.162)  # m, the fills the issue names (seed Sec. 4 tests 54..162 mm)
+SEED_FILLS = (0.054, 0.108, 0.162)  # m, fills within the paper's tests (its Sec. 4: 54..162 mm)
 MIN_PARTICLES_ACROSS = 40
 PULSE_AMPLITUDE = 0.004  # m, lateral displacement of the excitation pulse (small: linear regime)
 SAMPLE_INTERVAL = 0.002  # s, sampling of the centre-of-mass signal (and the pose update interval)
 
 
 def eq17_frequency(width: float, fill: float, g: float = GRAVITY) -> float:
-    """Seed Eq. 17: first-mode sloshing frequency (Hz) of a rectangular tank of inner width B, fill depth A."""
+    """Eq. 17: first-mode sloshing frequency (Hz) of a rectangular tank of inner width B, fill depth A."""
     return math.sqrt(g * math.pi / width * math.tanh(math.pi * fill / width)) / (2.0 * math.pi)
 
 

@@ -13,7 +13,7 @@ from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose, rotation_y
 from cosim.vessel import VesselSpec
 
-B = 0.191  # m, the seed's vessel width
+B = 0.191  # m, the width of the pouring vessel of Camporredondo et al. (2019)
 FILL = 0.1  # m
 # The solver variants the execution variants are compared under: (pressure solver, DFSPH's density iteration)
 SOLVER_VARIANTS = [

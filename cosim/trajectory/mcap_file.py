@@ -10,7 +10,7 @@ each after a line of 80 ``=`` and ``MSG: <package>/<type>``, as rosbag2 records 
   ``frame_id`` empty;
 * ``joint_names``: the arm's joints as its ROS 2 driver names them, with the scene's prefix
   (:mod:`cosim.trajectory.driver_names`), the same as trajectory.json's;
-* ``points``: one ``JointTrajectoryPoint`` per sample (:mod:`cosim.io.joint_trajectory_msg`): positions (rad),
+* ``points``: one ``JointTrajectoryPoint`` per sample (:mod:`cosim.trajectory.ros_points`): positions (rad),
   velocities (rad/s), accelerations (rad/s^2) as float64, equal to the CSV's; ``effort`` empty; ``time_from_start``
   the sample time rounded to the nanosecond.
 
@@ -28,9 +28,9 @@ from pathlib import Path
 from mcap_ros2.writer import Writer
 
 from cosim.atomic_files import atomic_path
-from cosim.io.joint_trajectory_msg import arm_columns, check_driver_names, points
-from cosim.io.trajectory_csv import JointTrajectory
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits
+from cosim.trajectory.ros_points import arm_columns, check_driver_names, points
 
 JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
 _SEPARATOR = "=" * 80

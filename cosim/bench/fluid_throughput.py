@@ -1,7 +1,7 @@
 """Fluid throughput benchmark: particle-steps per second of the SPH step, side by side with warp's bundled
 ``example_sph`` at the same particle count (a benchmark, not a test).
 
-    python -m cosim.fluid.benchmark [--device cpu|cuda] [--counts2d 1000 4000 16000] [--counts3d 4000 16000 62500]
+    python -m cosim.bench.fluid_throughput [--device cpu|cuda] [--counts2d 1000 4000 16000] [--counts3d 4000 16000 62500]
                                     [--solvers wcsph dfsph] [--threads 0 1] [--repeats 3] [--no-graphs]
                                     [--out docs/benchmarks.md]
 
@@ -173,7 +173,7 @@ def main(argv: list[str] | None = None) -> int:
     header = (
         f"\n## Fluid step throughput, {device} ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
         f"Machine: {machine_description()}. Versions: Python {platform.python_version()}, warp {wp.__version__}, numpy {np.__version__}.\n"
-        f"Command: `python -m cosim.fluid.benchmark --device {args.device} --counts2d {' '.join(map(str, args.counts2d))} "
+        f"Command: `python -m cosim.bench.fluid_throughput --device {args.device} --counts2d {' '.join(map(str, args.counts2d))} "
         f"--counts3d {' '.join(map(str, args.counts3d))} --solvers {' '.join(args.solvers)} --threads {' '.join(map(str, args.threads))} "
         f"--steps {args.steps} --repeats {args.repeats} --density-iteration {args.density_iteration}"
         f"{' --no-graphs' if args.no_graphs else ''}`. "

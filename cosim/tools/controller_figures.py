@@ -1,7 +1,7 @@
 """Model versions of the controller figures of Camporredondo et al. (2019) (the SPH versions come from the coupled
 simulation).
 
-    python -m controllers.figures --out DIR [--plant potential-flow|printed-paper]
+    python -m cosim.tools.controller_figures --out DIR [--plant potential-flow|printed-paper]
 
 writes, for the paper's vessel (B = L = 0.191 m, A = 0.1591 m) and the default configuration, on the physical
 slosh model (potential flow, the default) or, to reproduce the paper's own figures, on its Eqs. 10-11 as printed
@@ -10,7 +10,7 @@ slosh model (potential flow, the default) or, to reproduce the paper's own figur
   fig14_root_locus.png      root loci of Gp and of C Gp with the design's closed-loop poles (Fig. 14)
   fig15_step_response.png   step responses of Gp and C Gp in unity feedback (Fig. 15)
   fig16_sim_timeline.png    the SIM timeline theta, theta1 and the slosh angle on the model plant (Fig. 16)
-and prints the design's numbers. matplotlib is imported here only.
+and prints the design's numbers. Figures are drawn off-screen (matplotlib's Agg backend, chosen by :func:`main`).
 """
 
 from __future__ import annotations
@@ -21,17 +21,15 @@ from pathlib import Path
 
 import control as ct
 import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from controllers.config import CatcherConfig, PourConfig  # noqa: E402
-from controllers.measurement import Phase  # noqa: E402
-from controllers.model_plant import ModelPlant, ModelPlantConfig, Trace, run_closed_loop  # noqa: E402
-from controllers.pid import PidDesign, PidDesignSpec, actuator, delayed_loop, design_filtered_pid  # noqa: E402
-from controllers.pour import PourController  # noqa: E402
-from controllers.slosh import potential_flow_model, printed_paper_model  # noqa: E402
+from controllers.config import CatcherConfig, PourConfig
+from controllers.measurement import Phase
+from controllers.model_plant import ModelPlant, ModelPlantConfig, Trace, run_closed_loop
+from controllers.pid import PidDesign, PidDesignSpec, actuator, delayed_loop, design_filtered_pid
+from controllers.pour import PourController
+from controllers.slosh import potential_flow_model, printed_paper_model
 
 PAPER_FILLS_MM = (54, 81, 108, 135, 162)  # the paper's Sec. 4 tests fills from 54 to 162 mm
 PLANTS = {"potential-flow": potential_flow_model, "printed-paper": printed_paper_model}
@@ -154,11 +152,12 @@ def figure_sim_timeline(path: Path, config: PourConfig) -> PourController:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m controllers.figures", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m cosim.tools.controller_figures", description=__doc__.split("\n")[0])
     parser.add_argument("--out", type=Path, required=True, help="directory for the PNG files")
     parser.add_argument("--plant", choices=sorted(PLANTS), default="potential-flow",
                         help="slosh model: potential flow (physical, the default) or the paper's Eqs. 10-11 as printed")
     args = parser.parse_args(argv)
+    matplotlib.use("Agg")
     args.out.mkdir(parents=True, exist_ok=True)
     config = paper_config(args.plant)
     model = config.slosh_model()

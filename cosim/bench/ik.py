@@ -1,6 +1,6 @@
 """Benchmark inverse kinematics over the pour workspace: accuracy and time per solve.
 
-``python -m cosim.robots.benchmark_ik [--json] [--model SCENE]``
+``python -m cosim.bench.ik [--json] [--model SCENE]``
 
 Workspace (targets relative to the vessels' home poses, :mod:`cosim.robots.planar`): the pourer tilted
 0..120 deg (every :data:`TILT_STEP_DEG`) about its bottom middle and about its lip; the catcher translated
@@ -10,7 +10,7 @@ streaming targets calls it). The error of every solution is re-measured independ
 (``mj_kinematics`` on a separate MjData): position of the vessel frame origin (m) and rotation angle (deg) to the
 target. Times are wall-clock per ``solve_vessel_target`` call (``time.perf_counter``), single thread.
 
-Acceptance (issue 3): every target within :data:`MAX_POSITION_ERROR_M` and :data:`MAX_ROTATION_ERROR_DEG`, median
+Acceptance: every target within :data:`MAX_POSITION_ERROR_M` and :data:`MAX_ROTATION_ERROR_DEG`, median
 time per solve <= :data:`MAX_MEDIAN_SOLVE_S`.
 """
 
@@ -36,7 +36,7 @@ TILT_STEP_DEG = 2.0
 MAX_TILT_DEG = 120.0
 CATCHER_RANGE_M = 0.15
 CATCHER_STEP_M = 0.01
-# Issue 3 acceptance thresholds.
+# Acceptance thresholds: m, deg, s.
 MAX_POSITION_ERROR_M = 1e-3
 MAX_ROTATION_ERROR_DEG = 0.1
 MAX_MEDIAN_SOLVE_S = 2e-3
@@ -109,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         summary = run_benchmark(RobotScene.load(args.model))
     except InputError as exc:
-        print(f"benchmark_ik: error: {exc}", file=sys.stderr)
+        print(f"ik: error: {exc}", file=sys.stderr)
         return 2
     if args.json:
         print(json.dumps(summary, indent=2))

@@ -4,7 +4,7 @@ The scene is loaded with the liquid as a rigid payload (:mod:`cosim.robots.paylo
 rim, the catcher holding that volume). The arms start exactly on the trajectory's first sample; arms without
 columns in the trajectory hold their home posture. Each 2 ms step commands the servos with the trajectory's
 position and velocity at the current time (quintic Hermite interpolation of the samples, see
-:mod:`cosim.robots.interpolation`), then steps the simulation.
+:mod:`cosim.trajectory.interpolation`), then steps the simulation.
 
 Errors, sampled at every step (world frame, SI units):
 * joint tracking error ``q_cmd(t) - q(t)`` per joint, rad: maximum of the absolute value and RMS;
@@ -31,11 +31,11 @@ import mujoco
 import numpy as np
 
 from cosim.errors import InputError, SimulationError
-from cosim.io.trajectory_csv import JointTrajectory
-from cosim.robots.feedforward import DEFAULT_TOLERANCE_M, Feedforward
-from cosim.robots.interpolation import QuinticInterpolator
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.feedforward import DEFAULT_TOLERANCE_M, Feedforward
+from cosim.trajectory.interpolation import QuinticInterpolator
+from cosim.trajectory.joint_trajectory import JointTrajectory
 
 
 @dataclass(frozen=True)

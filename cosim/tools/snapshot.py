@@ -1,14 +1,16 @@
 """Side-view pictures of a finished pour, from its run folder (a tool for docs and debugging; it only reads).
 
-    python -m cosim.io.snapshot RUN [--times 2.0 5.0 8.0] [--stream] [--out RUN/snapshot.png]
+    python -m cosim.tools.snapshot RUN [--times 2.0 5.0 8.0] [--stream] [--out RUN/snapshot.png]
 
-Each panel is the pour plane (world x-z): the liquid particles logged in ``pour.rrd`` at the nearest logged time
-(coloured by speed, viridis), and the vessels and arm links of the scene posed by forward kinematics of the joint
-trajectory in ``trajectory.csv`` at that time (every box geom as its outline in the plane, capsules and cylinders as
-their axis). Without ``--times``, four times spread over the controller's pouring phases are taken from
+Each panel is the pour plane (world x-z): the liquid particles logged in ``pour.rrd`` at the nearest logged time,
+and the vessels and arm links of the scene posed by forward kinematics of the joint trajectory in ``trajectory.csv``
+at that time (:meth:`cosim.robots.scene.RobotScene.posed`; every box geom as its outline in the plane, capsules and
+cylinders as their axis). Without ``--times``, four times spread over the controller's pouring phases are taken from
 ``summary.json``. ``--stream`` draws, where liquid flows over the lip, the free-fall parabola the catcher aims
-with (seed Eqs. 6-7, launched at the lip with the measured v_q, from where it is measured, ``series.csv``) over the SPH stream: the seed's
-Fig. 10 comparison, and the landing point predicted at the catcher's rim height.
+with (:func:`controllers.catcher.jet_path`, Eqs. 6-7 of Camporredondo et al. (2019), "A Kinematic Controller for
+Liquid Pouring between Vessels Modelled with SPH", launched with the measured v_q from where it is measured,
+``series.csv``) over the SPH stream, as in the paper's Fig. 10, and the landing point predicted at the catcher's rim
+height.
 """
 
 from __future__ import annotations
@@ -20,15 +22,14 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from controllers.catcher import fall_time
+from controllers.catcher import jet_path
 from cosim.atomic_files import atomic_path
 from cosim.io.pour_series import read_series_csv
-from cosim.io.rerun_read import read_component
 from cosim.io.rerun_paths import LIQUID
-from cosim.io.trajectory_csv import read_trajectory_csv
+from cosim.io.rerun_read import read_component
 from cosim.robots.scene import RobotScene
+from cosim.trajectory.csv_file import read_trajectory_csv
 
-GRAVITY = 9.81  # m/s^2, the scenes' gravity (the controller's model uses the same)
 BOX_CORNERS = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1], [-1, -1]], dtype=float)
 
 
@@ -61,8 +62,8 @@ def _draw_parabola(ax, series: dict[str, np.ndarray], t: float) -> None:
         return
     x0, z0 = series["lip_x"][k] + series["jet_dx"][k], series["lip_z"][k] + series["jet_dz"][k]
     rim = series["catcher_rim_z"][k]
-    s = np.linspace(0.0, fall_time(z0 - rim, v_z, GRAVITY), 50)
-    ax.plot(x0 + v_x * s, z0 + v_z * s - 0.5 * GRAVITY * s**2, "r--", lw=1.2, zorder=4, label="Eqs. 6-7 parabola")
+    x, z = jet_path(x0, z0, v_x, v_z, z0 - rim)
+    ax.plot(x, z, "r--", lw=1.2, zorder=4, label="Eqs. 6-7 parabola")
     ax.plot([series["landing_x"][k]], [rim], "rx", ms=8, zorder=5, label="predicted landing")
     ax.legend(loc="upper right", fontsize=7)
 
@@ -78,17 +79,12 @@ def render(run: Path, times: list[float] | None, out: Path, stream: bool = False
     liquid = read_component(run / "pour.rrd", LIQUID, "Points3D:positions")
     traj = read_trajectory_csv(run / "trajectory.csv")
     scene = RobotScene.load(summary.get("scene", {}).get("robots", {}).get("scene") or None)
-    model, data = scene.model, mujoco.MjData(scene.model)
-    mujoco.mj_resetDataKeyframe(model, data, scene.home_key)
-    columns = {name: k for k, name in enumerate(traj.joint_names)}
     series = {k: np.asarray(v) for k, v in read_series_csv(run / "series.csv").items()} if stream else None
     fig, axes = plt.subplots(1, len(times), figsize=(4.2 * len(times), 4.6), dpi=110, squeeze=False)
     for ax, t in zip(axes[0], times):
         k = int(np.argmin(np.abs(traj.time - t)))
-        for arm in scene.arms.values():
-            data.qpos[arm.qpos_adr] = [traj.positions[k, columns[j]] for j in arm.joints]
-        mujoco.mj_kinematics(model, data)
-        _draw_scene(ax, model, data)
+        data = scene.posed({role: traj.positions[k, traj.columns(arm.joints)] for role, arm in scene.arms.items()})
+        _draw_scene(ax, scene.model, data)
         i = int(np.argmin(np.abs(liquid.sim_time - t)))
         points = liquid.values[i]
         ax.scatter(points[:, 0], points[:, 2], s=4, c="tab:blue", zorder=3)

@@ -1,5 +1,5 @@
-"""The servo feedforward choices and the default path tolerance of a replay (:mod:`cosim.robots.replay`), in a module
-of their own so that ``cosim replay --help`` can show them without loading MuJoCo."""
+"""The servo feedforward choices and the default path tolerance of a replay (:mod:`cosim.trajectory.replay`), in a
+module of their own so that ``cosim replay --help`` can show them without loading MuJoCo."""
 
 from __future__ import annotations
 

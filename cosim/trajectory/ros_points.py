@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 
-from cosim.io.trajectory_csv import JointTrajectory
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits
 
 NANOSECONDS = 1_000_000_000

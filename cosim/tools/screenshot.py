@@ -1,6 +1,6 @@
 """Screenshot of a recording as a user first sees it: Rerun's own web viewer in a headless Chromium.
 
-    python -m cosim.io.screenshot RUN/pour.rrd --out docs/recording.png [--size 1600x1000]
+    python -m cosim.tools.screenshot RUN/pour.rrd --out docs/recording.png [--size 1600x1000]
 
 Serves the recording with ``rerun --web-viewer`` (on free local ports), opens the viewer in Chromium without a
 display (software WebGL: SwiftShader), and drives it over the Chrome DevTools protocol: it captures the page every
@@ -106,7 +106,7 @@ def screenshot(recording: Path, out: Path, size: tuple[int, int], poll: float, s
     rerun = shutil.which("rerun", path=os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")]))
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")
     if rerun is None or chromium is None:
-        raise SystemExit(f"cosim.io.screenshot: error: needs 'rerun' and 'chromium' on the PATH (found {rerun}, {chromium})")
+        raise SystemExit(f"cosim.tools.screenshot: error: needs 'rerun' and 'chromium' on the PATH (found {rerun}, {chromium})")
     web_port, grpc_port, devtools_port = _free_port(), _free_port(), _free_port()
     started: list[subprocess.Popen] = []
     with tempfile.TemporaryDirectory(prefix="cosim-screenshot-") as profile:
@@ -146,7 +146,7 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m cosim.io.screenshot", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m cosim.tools.screenshot", description=__doc__.split("\n\n")[0])
     parser.add_argument("recording", type=Path, help="a pour.rrd (or a run folder holding one)")
     parser.add_argument("--out", type=Path, required=True, help="PNG to write")
     parser.add_argument("--size", type=_size, default=(1600, 1000), help="window WIDTHxHEIGHT in pixels (default 1600x1000)")

@@ -12,15 +12,13 @@ those samples (zero at both ends, where the path is at rest). The result is chec
 limits and :data:`MAX_ACCELERATION` / :data:`MAX_JERK` (jerk by differencing the accelerations); a motion that
 exceeds them is refused with an ``InputError`` naming the joint, so every trajectory written is jerk-limited.
 
-``python -m cosim.robots.pour_motion --out pour.csv`` writes it; ``cosim replay pour.csv`` measures how the servos
+``python -m cosim.tools.pour_motion --out pour.csv`` writes it; ``cosim replay pour.csv`` measures how the servos
 track it.
 """
 
 from __future__ import annotations
 
-import argparse
 import math
-import sys
 from dataclasses import dataclass
 from enum import Enum
 
@@ -28,11 +26,11 @@ import numpy as np
 
 from cosim.checks import check_choice, check_positive, check_range
 from cosim.errors import InputError
-from cosim.io.trajectory_csv import JointTrajectory, write_trajectory_csv
 from cosim.robots.ik import IKSettings
 from cosim.robots.planar import PlanarPose, tilt_about_pivot
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.joint_trajectory import JointTrajectory
 
 # Joint acceleration and jerk limits for generated motions, rad/s^2 and rad/s^3. UR publishes no per-joint
 # acceleration limit for the UR10e; PolyScope's default joint acceleration is 80 deg/s^2 (1.4 rad/s^2) and its
@@ -46,8 +44,8 @@ PLANNING_TOLERANCE = 1e-10
 class Pivot(Enum):
     """Closed choice of the pourer's tilt pivot (a line parallel to world y through this vessel point)."""
 
-    BOTTOM = "bottom"  # the bottom middle, vessel frame origin (the seed's SIM)
-    LIP = "lip"  # the pour lip (the seed's CFS)
+    BOTTOM = "bottom"  # bottom middle, vessel frame origin (slosh induction's pivot in Camporredondo et al. 2019)
+    LIP = "lip"  # the pour lip (their pivot in the constant-flow stage)
 
 
 @dataclass(frozen=True)
@@ -127,27 +125,3 @@ def plan_pour_trajectory(scene: RobotScene, spec: PourMotionSpec = PourMotionSpe
     trajectory = JointTrajectory(times, joints, q, qd, qdd)
     _check_limits(trajectory, np.concatenate([scene.arms[r].max_joint_speed for r in roles]), h)
     return trajectory
-
-
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description="Write a smooth two-arm pour motion as a trajectory CSV.")
-    parser.add_argument("--out", required=True, help="CSV file to write")
-    parser.add_argument("--duration", type=float, default=10.0, help="s (default 10)")
-    parser.add_argument("--tilt-deg", type=float, default=120.0, help="peak tilt, deg (default 120)")
-    parser.add_argument("--pivot", choices=[p.value for p in Pivot], default=Pivot.LIP.value)
-    parser.add_argument("--catcher-dx", type=float, default=0.15, help="catcher travel at peak, m (default 0.15)")
-    parser.add_argument("--model", default=None, help="scene MJCF (default: the project's scene)")
-    args = parser.parse_args(argv)
-    try:
-        spec = PourMotionSpec(args.duration, math.radians(args.tilt_deg), Pivot(args.pivot), args.catcher_dx)
-        trajectory = plan_pour_trajectory(RobotScene.load(args.model), spec)
-        write_trajectory_csv(args.out, trajectory)
-    except InputError as exc:
-        print(f"pour_motion: error: {exc}", file=sys.stderr)
-        return 2
-    print(f"wrote {args.out}: {trajectory.time.size} samples, {trajectory.duration:.2f} s, {len(trajectory.joint_names)} joints")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

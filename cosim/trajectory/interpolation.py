@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cosim.io.trajectory_csv import JointTrajectory
+from cosim.trajectory.joint_trajectory import JointTrajectory
 
 
 class QuinticInterpolator:

@@ -1,4 +1,4 @@
-"""Joint trajectory JSON: write and read (DESIGN.md: "the JSON mirrors ROS trajectory_msgs/JointTrajectory per arm").
+"""Joint trajectory JSON: write and read; per arm it mirrors ROS ``trajectory_msgs/JointTrajectory``.
 
 Layout (one object; numbers in SI units, listed in ``units``)::
 
@@ -15,12 +15,12 @@ Layout (one object; numbers in SI units, listed in ``units``)::
               "catch_arm": {...}}}
 
 Per arm this is a ROS ``trajectory_msgs/JointTrajectory`` (``joint_names``, ``points`` of
-``JointTrajectoryPoint``, :mod:`cosim.io.joint_trajectory_msg`) plus the arm model, the scene's names of the same
+``JointTrajectoryPoint``, :mod:`cosim.trajectory.ros_points`) plus the arm model, the scene's names of the same
 joints (the CSV's column stems) and the limits the trajectory was generated under, per joint in ``joint_names``
 order. ``joint_names`` are the names the arm's ROS 2 driver uses, with the scene's prefix
 (:mod:`cosim.trajectory.driver_names`). Every arm has the same points' times. Numbers are written with Python's
 shortest round-trip repr: positions, velocities and accelerations read back exactly, equal to the CSV of the same run
-(:mod:`cosim.io.trajectory_csv`).
+(:mod:`cosim.trajectory.csv_file`).
 
 Writing is atomic (:mod:`cosim.atomic_files`). Reading validates everything and raises :class:`InputError` with one
 line naming the file, the field (e.g. ``arms.pour_arm.points[3].positions``) and the problem.
@@ -38,9 +38,9 @@ import numpy as np
 
 from cosim.atomic_files import atomic_path
 from cosim.errors import InputError
-from cosim.io.joint_trajectory_msg import NANOSECONDS, POINT_FIELDS, arm_columns, check_driver_names, points
-from cosim.io.trajectory_csv import JointTrajectory
+from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import LIMIT_FIELDS, ArmLimits, JointLimits
+from cosim.trajectory.ros_points import NANOSECONDS, POINT_FIELDS, arm_columns, check_driver_names, points
 
 FORMAT = "cosim.joint_trajectory.v2"
 UNITS = {"time": "s", "position": "rad", "velocity": "rad/s", "acceleration": "rad/s^2", "jerk": "rad/s^3"}
