@@ -2,7 +2,7 @@
 
 ``cosim scene --dump`` prints the embedded default (:class:`PourScene` with its defaults) as TOML, every field
 commented with its unit and range; a user's file only needs the keys it changes. Sections: ``liquid`` (fill and how
-much to pour), ``fluid`` (SPH resolution and numerics), ``controller`` (the seed's SIM, PID, CFS and catcher, from
+much to pour), ``fluid`` (SPH resolution and numerics), ``controller`` (the paper's SIM, PID, CFS and catcher, from
 ``controllers.config``), ``coupling``, ``trajectory`` (sampling and joint-limit overrides), ``logging`` (Rerun),
 ``vessels`` (the pourer's and the catcher's shape, size and walls), ``placement`` (the table, the pourer's height,
 where vessel B waits, the pour height), ``robots`` (a MuJoCo scene file instead of the project's cell).
@@ -32,7 +32,7 @@ from cosim.vessel import VesselShape, VesselSpec, default_catching_vessel, seed_
 
 @dataclass(frozen=True)
 class LiquidSettings:
-    """fill_depth: m, liquid depth in the upright pourer; the seed's A = 0.1591 m. (0, pourer inner height)
+    """fill_depth: m, liquid depth in the upright pourer; the paper's A = 0.1591 m. (0, pourer inner height)
     pour_fraction: fraction of the liquid to pour; 1 pours until the pourer is empty. (0, 1]
     """
 
@@ -48,7 +48,7 @@ class LiquidSettings:
 class FluidSettings:
     """dim: 2 (liquid in the pour plane, times the pourer's depth) or 3. [2, 3]
     particles_across: particles across the pourer's inner width; sets the spacing dx = B / n. [8, 400]
-    kernel: 'wendland_c2' or 'cubic_spline' (the seed's).
+    kernel: 'wendland_c2' or 'cubic_spline' (the paper's).
     pressure_solver: 'dfsph' (divergence-free SPH, time step set by the flow speed; the default: it passes the
       validations WCSPH passes and pours the default scene about 3.5 x faster) or 'wcsph' (weakly compressible, time
       step set by an artificial sound speed).
@@ -160,12 +160,12 @@ STREAM_PARTICLES = {2: 2.5, 3: 1.0}
 class ControllerSettings:
     """control_rate: Hz, rate of the pour controller. [20, 500]
     stream_particles: the CFS liquid height over the crest is at least this many particle spacings, so that the
-      stream is resolved (the seed holds it near the smoothing length), up to 0.05 m (cfs.h_q_ref's limit); a
+      stream is resolved (the paper holds it near the smoothing length), up to 0.05 m (cfs.h_q_ref's limit); a
       partial pour's final stage holds cfs.final_head_fraction of it; not set: 2.5 in 2-D, 1.0 in 3-D (a 3-D sheet
       spreads sideways off the lip under its head, README Pour results). [0, 10]
-    sim: slosh induction (seed Fig. 7).
+    sim: slosh induction (Camporredondo et al. 2019, Fig. 7).
     approach: tilt toward the crest without SIM.
-    cfs: constant-flow stage (seed Sec. 3.2).
+    cfs: constant-flow stage (Camporredondo et al. 2019, Sec. 3.2).
     returning: back upright after the pour.
     catcher: vessel B's motion.
     pose_filter: task-space limits of the vessel targets before inverse kinematics.

@@ -3,10 +3,10 @@
 Both the SPH solver (``cosim.fluid``) and the robot scene (``cosim.robots``, ``models/``) build their vessel from
 a :class:`VesselSpec`, so the liquid's walls and the rigid body the arm holds are the same shape.
 
-Vessel frame (the "local frame" everywhere in this project): origin at the centre of the inner floor (the seed's
+Vessel frame (the "local frame" everywhere in this project): origin at the centre of the inner floor (the paper's
 "bottom middle" pivot of SIM), +x toward the pour lip (the pour direction), +z up the vessel's axis, +y completing
 a right-handed frame (perpendicular to the pour plane). The pour lip is the outer top edge of the +x wall, where
-the liquid leaves the vessel (the seed's pivot during CFS).
+the liquid leaves the vessel (the paper's pivot during CFS).
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ def _left_to_right_sum(values) -> float:
 class VesselShape(Enum):
     """Closed choice of vessel shapes."""
 
-    BOX = "box"  # open rectangular box (the seed's vessel)
+    BOX = "box"  # open rectangular box (the paper's vessel)
     CYLINDER = "cylinder"  # open cylindrical cup
 
 
@@ -58,7 +58,7 @@ class VesselSpec:
       shape: :class:`VesselShape` (box or cylinder).
       inner_width: m, inner size along the pour direction (local x); a cylinder's inner diameter. (0, 2]
       inner_depth: m, inner size perpendicular to the pour plane (local y); ignored for a cylinder. (0, 2]
-      inner_height: m, inner floor to rim (local z); the seed's L. (0, 2]
+      inner_height: m, inner floor to rim (local z); the paper's L. (0, 2]
       wall_thickness: m, thickness of floor and walls. (0, 0.05]
       wall_density: kg/m^3, wall material density (sets the empty vessel's mass). (0, 25000]
     """
@@ -177,7 +177,7 @@ class VesselSpec:
 
 
 def seed_pouring_vessel() -> VesselSpec:
-    """The seed's pouring vessel: B = L = 0.191 m in the pour plane, 0.10 m deep (Camporredondo et al. 2019)."""
+    """The paper's pouring vessel: B = L = 0.191 m in the pour plane, 0.10 m deep (Camporredondo et al. 2019)."""
     return VesselSpec(name="pourer")
 
 

@@ -30,7 +30,7 @@ from cosim.robots.scene_config import ArmPlacement, MountSide, SceneConfig, defa
 from cosim.robots.vessel_mjcf import add_vessel_body, frame_site
 from cosim.vessel import VesselSpec
 
-# Simulation options of every scene (DESIGN.md: implicitfast with stiff position servos; 2 ms step).
+# Simulation options of every scene (implicitfast with stiff position servos; 2 ms step).
 TIMESTEP = 0.002
 # Name of the home keyframe.
 HOME_KEY = "home"

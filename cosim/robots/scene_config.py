@@ -250,5 +250,5 @@ def pour_cell_config(
 
 
 def default_scene_config() -> SceneConfig:
-    """The project's scene: UR10e-class arms, the seed's pouring vessel and the default catching vessel."""
+    """The project's scene: UR10e-class arms, the paper's pouring vessel and the default catching vessel."""
     return pour_cell_config(seed_pouring_vessel(), default_catching_vessel())
