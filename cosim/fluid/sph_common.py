@@ -105,10 +105,10 @@ def viscous_pair(
     prm: SPHParams, alpha: float, mass_j: float, r: wp.vec3, r2: float, gw: wp.vec3, v_rel: wp.vec3, v_rel_laminar: wp.vec3, rho_i: float,
     rho_j: float,
 ) -> wp.vec3:
-    """Acceleration (m/s^2) of particle i from neighbour j of mass ``mass_j`` (kg, or kg/m in 2-D): Monaghan (1992) artificial viscosity
-    with coefficient ``alpha`` on the approaching relative velocity ``v_rel`` = v_i - v_j (scaled by the configured
-    c0) plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the neighbour's, or a wall's
-    no-slip, velocity)."""
+    """Acceleration (m/s^2) of particle i from neighbour j of mass ``mass_j`` (kg, or kg/m in 2-D): Monaghan (1992)
+    artificial viscosity with coefficient ``alpha`` on the approaching relative velocity ``v_rel`` = v_i - v_j
+    (scaled by the configured c0) plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the
+    neighbour's, or a wall's no-slip, velocity)."""
     # min(vr, 0) instead of a branch on the approach: about half the pairs approach, so the branch is mispredicted
     # about half the time (measured on the default pour's 2-D non-pressure stage: 165 against 219 us per launch of
     # this term alone); a receding pair adds exactly zero, as the branch skipped it
@@ -177,9 +177,9 @@ def finish_particle(
     A particle that enters a vessel (outside its inner volume at the substep's start, inside at its end) takes the
     vessel's in-plane mass (``VesselGeometry.liquid_mass``, 2-D: its own 3-D mass spread over the vessel's depth)
     where that differs from its own, and becomes free liquid: its density is then re-measured by summation with the
-    new mass until it is packed inside the vessel (:func:`next_free_state`), under both solvers,
-    instead of carrying a continuity density or a seeded offset that describe its old packing. One switch at the
-    inlet: the stream between the vessels keeps the depth of the vessel it left."""
+    new mass until it is packed inside the vessel (:func:`next_free_state`), under both solvers, instead of carrying
+    a continuity density or a seeded offset that describe its old packing. One switch at the inlet: the stream
+    between the vessels keeps the depth of the vessel it left."""
     xi = x_new
     vi = v_new
     if prm.dim == 2:
