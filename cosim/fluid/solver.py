@@ -700,7 +700,8 @@ class FluidSolver:
 
     def vessel_wrenches(self) -> np.ndarray:
         """(V, 6): the liquid's force (N) and torque (N m) on each vessel about its centre of mass, world frame,
-        averaged over the last interval's substeps (2-D: per unit depth x ``depth_2d``)."""
+        averaged over the last interval's substeps (2-D: each particle's per-unit-depth force x its own depth,
+        ``cosim.fluid.model``)."""
         return self._wrench.copy()
 
     @property
