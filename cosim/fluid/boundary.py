@@ -34,7 +34,9 @@ class VesselGeometry:
 
     half_width: b = inner_width / 2 (a cylinder's inner radius); half_depth: inner_depth / 2 (box, 3-D);
     height: inner height H; thickness: wall thickness the liquid sees (the dummy layers', if thicker than the
-    vessel's own); com: centre of mass in the vessel frame (torque point).
+    vessel's own); com: centre of mass in the vessel frame (torque point); liquid_mass: the in-plane SPH mass
+    (kg/m) a particle takes when it enters the vessel (2-D: its 3-D mass spread over the vessel's depth,
+    :func:`cosim.fluid.model.caught_liquid_mass`), 0 where entering changes nothing (3-D).
     """
 
     shape: int
@@ -43,6 +45,7 @@ class VesselGeometry:
     height: float
     thickness: float
     com: wp.vec3
+    liquid_mass: float
 
 
 @wp.struct

@@ -129,8 +129,10 @@ class FluidConfig:
     cpu_threads: threads a CPU substep is split over (``cosim.fluid.lanes``; each takes every n-th chunk of 16 particles
         in cell order, and the results are the same to the bit for any number); 0: one per core this process may run
         on, at most one per 200 particles. Ignored on CUDA. [0, 256]
-    depth_2d: m, liquid thickness perpendicular to the pour plane in 2-D (the pouring vessel's depth): masses,
-        volumes and wrenches reported to the outside are per unit depth times this. (0, 2]
+    depth_2d: m, liquid thickness perpendicular to the pour plane in 2-D as seeded (the pouring vessel's depth): a
+        particle stands for the 3-D volume dx^2 depth_2d; in a vessel of another depth it enters, that volume
+        spreads over the vessel's depth (``cosim.fluid.model``). Volumes and wrenches reported to the outside are
+        3-D. (0, 2]
     boundary_spacing_ratio: wall sample spacing / dx. [0.3, 1.0]
     domain_min, domain_max: m, world box of the simulation; its bottom face is the floor. Particles that leave it
         are deactivated and counted as spilled.

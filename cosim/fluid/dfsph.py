@@ -7,12 +7,13 @@ A substep, after the neighbour search:
   compute_density_factor   the substep's pair list (liquid and wall neighbours with their kernel gradients, which
                            every later stage loops over instead of searching the cell grid again: one search per
                            substep);
-                           rho_i = (sum_j m W_ij + sum_b rho0 V_b W_ib) / s (summation density, wall particles
+                           rho_i = (sum_j m_j W_ij + sum_b rho0 V_b W_ib) / s (summation density, wall particles
                            included; s = the sum over a resting lattice / rho0, 1.005 for Wendland C2 at h = 1.5 dx
                            in 2-D, so the liquid as seeded is at rest instead of 0.5 % compressed), plus the bound
                            liquid's seeded surface offset (:func:`bound_or_free_density`), and the DFSPH
-                           factor alpha_i = rho_i / (|sum_j m grad W_ij + sum_b rho0 V_b grad W_ib|^2
-                           + sum_j |m grad W_ij|^2) (denominator bounded below); starts the divergence solve.
+                           factor alpha_i = rho_i / (|sum_j m_j grad W_ij + sum_b rho0 V_b grad W_ib|^2
+                           + sum_j m_i m_j |grad W_ij|^2) (denominator bounded below; m_j: each particle's
+                           own mass, ``cosim.fluid.model``); starts the divergence solve.
   compute_wall_density_factor  the same for the wall layer that faces the liquid (below).
   divergence solve         iterate [apply_stiffness, compute_solve_error, compute_wall_solve_error,
                            check_convergence] until the average
@@ -36,15 +37,15 @@ One Jacobi iteration, for stiffness increments k_i (m^2/s^2, a pressure over den
   k_i = omega max(e_i, 0) alpha_i / dt^2, with e_i = dt Drho_i/Dt (divergence) or rho_i - rho0 + dt Drho_i/Dt (density),
   omega = min(1, JACOBI_GAIN_LIMIT / gain) (``cosim.fluid.params``; the gain of the lattice's pressure system,
   ``cosim.fluid.sph_kernels.lattice_jacobi_gain``: 1 for the 2-D default, 0.56 in 3-D, where plain Jacobi diverges),
-  Drho_i/Dt = sum_j m (v_i - v_j) . grad W_ij + sum_b rho0 V_b (v_i - v_b) . grad W_ib   (wall velocity v_b: the
+  Drho_i/Dt = sum_j m_j (v_i - v_j) . grad W_ij + sum_b rho0 V_b (v_i - v_b) . grad W_ib   (wall velocity v_b: the
   moving vessel enters the divergence term),
-  v_i -= dt [sum_j m (k_i / rho_i + k_j / rho_j) grad W_ij + sum_b rho0 V_b (k_i / rho_i + k_b / rho_b) grad W_ib].
+  v_i -= dt [sum_j m_j (k_i / rho_i + k_j / rho_j) grad W_ij + sum_b rho0 V_b (k_i / rho_i + k_b / rho_b) grad W_ib].
 Only compression is corrected (e_i >= 0): a free surface's kernel deficiency is not a pressure.
 
 Pressure-carrying walls (Band et al. 2018 solve boundary pressures with the liquid's; this is that idea in DFSPH's
 constraint form): the layer of dummy wall particles that faces the liquid (``FluidModel.b_wetted``) is held to rest
 density like liquid that does not move, each wall particle b with its own stiffness k_b (its density rate
-sum_j m (v_b - v_j) . grad W_bj from the liquid moving against the wall, its factor from the density change its
+sum_j m_j (v_b - v_j) . grad W_bj from the liquid moving against the wall, its factor from the density change its
 push on the liquid causes, warm-started as the liquid's). The force on the liquid stays the transpose of the
 constraints' gradient, so the solve is stable; with the wall term carrying the particle's own stiffness only (the
 previous form, as SPlisHSPlasH's Akinci boundary) the constant part of the pressure pushed the rows next to a wall
@@ -210,6 +211,7 @@ def compute_density_factor(
     motions: wp.array(dtype=VesselMotion),
     x: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=float),
     cell_start: wp.array(dtype=wp.int32),
     cell_end: wp.array(dtype=wp.int32),
     bx: wp.array(dtype=wp.vec3),
@@ -235,9 +237,11 @@ def compute_density_factor(
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
 ):
-    """Summation density, DFSPH factor and the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall
+    """Summation density, DFSPH factor (for particles of different masses, alpha_i = rho_i / (|sum_j m_j grad W_ij|^2
+    + sum_j m_i m_j |grad W_ij|^2): neighbour j moves by m_i (k_i / rho_i) grad W_ij under i's stiffness) and the
+    substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall
     code :func:`wall_pair`; ``pair_grad[i, k]``: grad_i W, 1/m^(dim+1); ``pair_mass_grad[i, k]``: the same times the
-    pair's mass, m or rho0 V_b, as the solves use it), which the later stages loop over instead of the cell grid;
+    pair's mass, m_j or rho0 V_b, as the solves use it), which the later stages loop over instead of the cell grid;
     the divergence solve's warm start (increment = a fraction of the last substep's stiffness, applied by the first
     iteration; ``increment_per_rho`` = increment / rho, as the neighbours read it) and its counters. More than
     ``capacity`` neighbours (impossible below ~2x compression) count as an overflow, an instability."""
@@ -257,7 +261,8 @@ def compute_density_factor(
     wp.atomic_add(solve_stats, stat_slot(prm, i, STAT_COUNT), wp.int64(1))
     xi = x[i]
     support2 = prm.support * prm.support
-    density = prm.mass * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
+    mi = mass[i]
+    density = mi * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     grad_sum = wp.vec3(0.0)
     grad_sq = float(0.0)
     count = int(0)
@@ -271,11 +276,12 @@ def compute_density_factor(
                     r2 = wp.dot(r, r)
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
-                    density += prm.mass * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                    mj = mass[j]
+                    density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
                     gw = kernel_gradient(prm, r, r2)
-                    gm = prm.mass * gw
+                    gm = mj * gw
                     grad_sum += gm
-                    grad_sq += wp.dot(gm, gm)
+                    grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
                     if count < capacity:
                         pair_index[i, count] = j
                         pair_grad[i, count] = gw
@@ -326,7 +332,7 @@ def liquid_density_rate(
     pair_index: wp.array2d(dtype=wp.int32),
     pair_mass_grad: wp.array2d(dtype=wp.vec3),
 ) -> float:
-    """Drho_i/Dt = sum_j m (v_i - v_j) . grad W_ij + sum_b rho0 V_b (v_i - v_b) . grad W_ib over liquid particle i's
+    """Drho_i/Dt = sum_j m_j (v_i - v_j) . grad W_ij + sum_b rho0 V_b (v_i - v_b) . grad W_ib over liquid particle i's
     pair list, from the velocities as they are (kg/m^3/s)."""
     vi = v[i]
     rate = float(0.0)
@@ -350,7 +356,7 @@ def wall_density_rate(
     b_pair_index: wp.array2d(dtype=wp.int32),
     b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
 ) -> float:
-    """Drho_b/Dt = sum_j m (v_b - v_j) . grad W_bj over wall-layer particle b's liquid neighbours (kg/m^3/s)."""
+    """Drho_b/Dt = sum_j m_j (v_b - v_j) . grad W_bj over wall-layer particle b's liquid neighbours (kg/m^3/s)."""
     vb = bv[b]
     rate = float(0.0)
     for k in range(b_pair_count[b]):
@@ -374,7 +380,7 @@ def apply_stiffness(
     v: wp.array(dtype=wp.vec3),
     kappa: wp.array(dtype=float),
 ):
-    """v_i -= dt [sum_j m (k_i/rho_i + k_j/rho_j) grad W_ij + sum_b rho0 V_b (k_i/rho_i + k_b/rho_b) grad W_ib]
+    """v_i -= dt [sum_j m_j (k_i/rho_i + k_j/rho_j) grad W_ij + sum_b rho0 V_b (k_i/rho_i + k_b/rho_b) grad W_ib]
     (k_b: the wall layer's increment, zero for the deeper wall particles; k / rho read from ``increment_per_rho``,
     which the stage that set the increments wrote); kappa_i += k_i. The first iteration of a solve applies its warm
     start; once a solve has converged, the increments its last iteration measured are not applied (the loop ends
@@ -493,6 +499,7 @@ def compute_wall_density_factor(
     capacity: int,
     # State in
     x: wp.array(dtype=wp.vec3),
+    mass: wp.array(dtype=float),
     cell_start: wp.array(dtype=wp.int32),
     cell_end: wp.array(dtype=wp.int32),
     bx: wp.array(dtype=wp.vec3),
@@ -510,8 +517,8 @@ def compute_wall_density_factor(
     diag_i: wp.array2d(dtype=wp.int32),
 ):
     """The pressure-carrying wall layer (``b_wetted``): each of its particles b is held to rest density like a
-    liquid particle that does not move. Its summation density rho_b = (rho0 V_b W(0) + sum_j m W_bj + sum_b'
-    rho0 V_b' W_bb') / s, its factor alpha_b = rho_b / sum_j m rho0 V_b |grad W_bj|^2 (the density change its
+    liquid particle that does not move. Its summation density rho_b = (rho0 V_b W(0) + sum_j m_j W_bj + sum_b'
+    rho0 V_b' W_bb') / s, its factor alpha_b = rho_b / sum_j m_j rho0 V_b |grad W_bj|^2 (the density change its
     stiffness causes by pushing its liquid neighbours away; bounded below as the liquid's) and its list of liquid
     neighbours with m grad_b W. Other wall particles carry no stiffness (rho_b = rho0, no pairs)."""
     b = lane_item(wp.tid(), lane)
@@ -536,12 +543,13 @@ def compute_wall_density_factor(
                     r2 = wp.dot(r, r)
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
-                    density += prm.mass * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                    mj = mass[j]
+                    density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
                     gw = kernel_gradient(prm, r, r2)
-                    grad_sq += prm.mass * mb * wp.dot(gw, gw)
+                    grad_sq += mj * mb * wp.dot(gw, gw)
                     if count < capacity:
                         b_pair_index[b, count] = j
-                        b_pair_mass_grad[b, count] = prm.mass * gw
+                        b_pair_mass_grad[b, count] = mj * gw
                     count += 1
                 density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xb, density)
     if count == 0:
@@ -603,7 +611,7 @@ def compute_wall_solve_error(
 ):
     """The wall layer's side of one iteration: adds the increment the liquid just received from it to its
     stiffness, then its remaining error e_b (dt Drho_b/Dt, plus rho_b - rho0 in the density solve; compression
-    only), with Drho_b/Dt = sum_j m (v_b - v_j) . grad W_bj, and its next increment omega e_b alpha_b / dt^2."""
+    only), with Drho_b/Dt = sum_j m_j (v_b - v_j) . grad W_bj, and its next increment omega e_b alpha_b / dt^2."""
     b = lane_item(wp.tid(), lane)
     b_kappa[b] = b_kappa[b] + b_increment[b]
     n = b_pair_count[b]
@@ -646,27 +654,29 @@ def relax_liquid_density(
     pair_count: wp.array(dtype=wp.int32),
     pair_index: wp.array2d(dtype=wp.int32),
     pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    mass: wp.array(dtype=float),
     v: wp.array(dtype=wp.vec3),
     kappa: wp.array(dtype=float),
 ) -> float:
     """One Gauss-Seidel step of liquid particle i's density constraint: its predicted compression e_i = rho_i - rho0
-    + dt sum_j m (v_i - v_j) . grad W_ij from the velocities as they are now (compression only), the stiffness
+    + dt sum_j m_j (v_i - v_j) . grad W_ij from the velocities as they are now (compression only), the stiffness
     increment k_i = e_i alpha_i / dt^2 that removes it, added to kappa_i, and applied at once to i and to its liquid
-    neighbours (v_i -= dt (k_i / rho_i) sum_j m grad W_ij, v_j += dt (k_i / rho_i) m grad W_ij: the k_i part of the
-    Jacobi step's pair force, so the momentum exchanged is the same). Returns e_i / rho0."""
+    neighbours (v_i -= dt (k_i / rho_i) sum_j m_j grad W_ij, v_j += dt (k_i / rho_i) m_i grad W_ij: the k_i part of
+    the Jacobi step's pair force, so the momentum exchanged is the same). Returns e_i / rho0."""
     e = wp.max(h * liquid_density_rate(i, v, bv, pair_count, pair_index, pair_mass_grad) + rho[i] - prm.rest_density, 0.0)
     if e == 0.0:
         return 0.0
     k_i = e * alpha[i] / (h * h)
     kappa[i] = kappa[i] + k_i
     push = h * k_i / rho[i]
+    mi = mass[i]
     dv = wp.vec3(0.0)
     for k in range(pair_count[i]):
         j = pair_index[i, k]
         gm = pair_mass_grad[i, k]
         dv += gm
         if j >= 0:
-            v[j] = v[j] + push * gm
+            v[j] = v[j] + (push * (mi / mass[j])) * gm  # gm carries m_j
     v[i] = v[i] - push * dv
     return e / prm.rest_density
 
@@ -683,10 +693,11 @@ def relax_wall_density(
     b_pair_count: wp.array(dtype=wp.int32),
     b_pair_index: wp.array2d(dtype=wp.int32),
     b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    mass: wp.array(dtype=float),
     v: wp.array(dtype=wp.vec3),
     b_kappa: wp.array(dtype=float),
 ) -> float:
-    """The same step for wall-layer particle b (compression e_b = rho_b - rho0 + dt sum_j m (v_b - v_j) . grad W_bj),
+    """The same step for wall-layer particle b (compression e_b = rho_b - rho0 + dt sum_j m_j (v_b - v_j) . grad W_bj),
     pushing its liquid neighbours only (v_j += dt (k_b / rho_b) rho0 V_b grad_b W_bj, the wall term of the pair
     force). Not relaxed: the Jacobi step halves the wall's increment because the liquid's constraints correct the
     same approach in the same iteration (``WALL_RELAXATION``); here the wall measures what the liquid left. Returns
@@ -699,10 +710,10 @@ def relax_wall_density(
         return 0.0
     k_b = e * b_alpha[b] / (h * h)
     b_kappa[b] = b_kappa[b] + k_b
-    push = h * k_b / b_rho[b] * prm.rest_density * b_volume[b] / prm.mass  # b_pair_mass_grad carries the liquid's m
+    push = h * k_b / b_rho[b] * prm.rest_density * b_volume[b]
     for k in range(n):
         j = b_pair_index[b, k]
-        v[j] = v[j] + push * b_pair_mass_grad[b, k]
+        v[j] = v[j] + (push / mass[j]) * b_pair_mass_grad[b, k]  # b_pair_mass_grad carries the liquid's m_j
     return e / prm.rest_density
 
 
@@ -785,6 +796,7 @@ def gauss_seidel_density_sweep(
     b_pair_count: wp.array(dtype=wp.int32),
     b_pair_index: wp.array2d(dtype=wp.int32),
     b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    mass: wp.array(dtype=float),
     # State in/out
     v: wp.array(dtype=wp.vec3),
     kappa: wp.array(dtype=float),
@@ -806,11 +818,11 @@ def gauss_seidel_density_sweep(
             continue
         cell = sweep_cell[thread, k]
         for i in range(cell_start[cell], cell_end[cell]):
-            q = error_quanta(relax_liquid_density(prm, i, h, rho, alpha, bv, pair_count, pair_index, pair_mass_grad, v, kappa))
+            q = error_quanta(relax_liquid_density(prm, i, h, rho, alpha, bv, pair_count, pair_index, pair_mass_grad, mass, v, kappa))
             total += q
             worst = wp.max(worst, q)
         for kk in range(b_cell_start[cell], b_cell_end[cell]):
-            q = error_quanta(relax_wall_density(prm, b_order[kk], h, b_volume, bv, b_rho, b_alpha, b_pair_count, b_pair_index, b_pair_mass_grad, v, b_kappa))
+            q = error_quanta(relax_wall_density(prm, b_order[kk], h, b_volume, bv, b_rho, b_alpha, b_pair_count, b_pair_index, b_pair_mass_grad, mass, v, b_kappa))
             total += q
             worst = wp.max(worst, q)
     if total > wp.int64(0):
@@ -845,6 +857,7 @@ def compute_nonpressure(
     pair_grad: wp.array2d(dtype=wp.vec3),
     row: wp.array(dtype=wp.int32),
     free: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=float),
     # State in/out
     kappa_density: wp.array(dtype=float),
     # Out
@@ -879,7 +892,7 @@ def compute_nonpressure(
             r = xi - x[j]
             vij = vi - v[j]
             alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
-            a += viscous_pair(prm, alpha, prm.mass, r, wp.dot(r, r), pair_grad[i, k], vij, vij, rhoi, rho[j])
+            a += viscous_pair(prm, alpha, mass[j], r, wp.dot(r, r), pair_grad[i, k], vij, vij, rhoi, rho[j])
         else:
             b = pair_wall(j)
             r = xi - bx[b]
@@ -976,6 +989,8 @@ def integrate(
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=float),
+    free: wp.array(dtype=wp.int32),
     wall_force: wp.array2d(dtype=wp.vec3),
     wall_torque: wp.array2d(dtype=wp.vec3),
     # Out
@@ -990,5 +1005,5 @@ def integrate(
     vi = v_star[i]
     finish_particle(
         prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, diag_slot(prm, row[0], i), i, x_old, x_old + dt[0] * vi, vi, rho[i], dt[0],
-        x, v, active, wall_force, wall_torque, diag_f, diag_i,
+        x, v, active, mass, free, wall_force, wall_torque, diag_f, diag_i,
     )

@@ -1,7 +1,18 @@
-"""Model (static, built once) and State (per particle, two buffers swapped at each reorder) of the SPH liquid."""
+"""Model (static, built once) and State (per particle, two buffers swapped at each reorder) of the SPH liquid.
+
+In 2-D each particle stands for a slab of liquid across the pour plane, of a fixed 3-D volume V = dx^2 d0 (d0 =
+``depth_2d``, the depth the liquid was seeded for) and mass M = rho0 V. Inside a vessel of another depth d (a
+catcher deeper than the pourer) the same volume spreads over d, so its area in the plane is V / d: the particle's
+in-plane SPH mass (per unit depth) is m = M / d, and the liquid packs to the height V_total / (d w) by itself.
+A particle takes a vessel's depth when it enters it (:func:`cosim.fluid.sph_common.finish_particle`); the
+falling stream keeps the depth of the vessel it left (a pourer's stream is as wide as its lip). The 3-D mass M
+does not change, so volumes (count x V), wrenches (per-unit-depth force x the particle's depth = M a) and energies
+are the same sums as before.
+"""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,6 +42,8 @@ class FluidModel:
     b_reach: (V,) numpy, largest distance of a vessel's wall particles from its frame origin (m): wall speed bound.
     wall_thickness: (V,) numpy, wall thickness the liquid sees (m), >= the vessel's own.
     grid, b_grid: neighbour grids for liquid and wall particles (identical cell layout).
+    densest_smoothing_ratio: h over the spacing of the densest liquid the particles can pack to (2-D: of the
+    smallest in-plane mass, :func:`densest_smoothing_ratio`; the configured ratio otherwise).
     """
 
     config: FluidConfig
@@ -46,6 +59,7 @@ class FluidModel:
     wall_thickness: np.ndarray
     grid: CellGrid
     b_grid: CellGrid
+    densest_smoothing_ratio: float
 
     @property
     def n_vessels(self) -> int:
@@ -56,7 +70,30 @@ class FluidModel:
         return self.b_local.shape[0]
 
 
-def _geometry(spec: VesselSpec, wall_thickness: float) -> VesselGeometry:
+def caught_liquid_mass(cfg: FluidConfig, spec: VesselSpec) -> float:
+    """In-plane SPH mass (kg/m) of a particle inside ``spec`` in 2-D: m = M / d = rho0 dx^2 d0 / d, with d0 =
+    ``depth_2d`` and d the vessel's section depth (exactly ``particle_mass`` where d = d0). 0 (a particle keeps its
+    mass) in 3-D, where a particle is a 3-D volume, and without ``free_liquid``: the particle that changes its mass
+    is re-measured as free liquid until packed (:func:`cosim.fluid.sph_common.finish_particle`), which the
+    continuity density alone cannot do."""
+    if cfg.dim != 2 or not cfg.free_liquid:
+        return 0.0
+    if spec.section_depth == cfg.depth_2d:
+        return cfg.particle_mass
+    return cfg.particle_mass * cfg.depth_2d / spec.section_depth
+
+
+def densest_smoothing_ratio(cfg: FluidConfig, specs: tuple[VesselSpec, ...]) -> float:
+    """h / dx' for the densest lattice the liquid packs to: a resting 2-D liquid of in-plane mass m has the spacing
+    dx' = sqrt(m / rho0) = dx sqrt(m / m0), so the smallest mass any vessel gives (:func:`caught_liquid_mass`) sets
+    the largest ratio smoothing_ratio sqrt(m0 / m). The configured ratio where no vessel makes the liquid denser."""
+    masses = [m for m in (caught_liquid_mass(cfg, s) for s in specs) if 0.0 < m < cfg.particle_mass]
+    if not masses:
+        return cfg.smoothing_ratio
+    return cfg.smoothing_ratio * math.sqrt(cfg.particle_mass / min(masses))
+
+
+def _geometry(spec: VesselSpec, wall_thickness: float, liquid_mass: float) -> VesselGeometry:
     geo = VesselGeometry()
     geo.shape = SHAPE_BOX if spec.is_box else SHAPE_CYLINDER
     geo.half_width = 0.5 * spec.inner_width
@@ -64,6 +101,7 @@ def _geometry(spec: VesselSpec, wall_thickness: float) -> VesselGeometry:
     geo.height = spec.inner_height
     geo.thickness = wall_thickness
     geo.com = wp.vec3(*spec.com_local)
+    geo.liquid_mass = liquid_mass
     return geo
 
 
@@ -79,13 +117,14 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
     b_vessel = np.concatenate([np.full(len(s), k, dtype=np.int32) for k, s in enumerate(samples)]) if samples else np.zeros(0, np.int32)
     reach = np.array([np.linalg.norm(s, axis=1).max() for s in samples]) if samples else np.zeros(0)
     thickness = np.array([numerical_wall_thickness(s, cfg.spacing, cfg.support_radius) for s in specs])
+    densest = densest_smoothing_ratio(cfg, specs)
     make_grid = lambda capacity: CellGrid(cfg.domain_min, cfg.domain_max, cfg.support_radius, cfg.dim, capacity, device, cfg.grid_reset)  # noqa: E731
     return FluidModel(
         config=cfg,
         device=device,
-        params=make_params(cfg, len(specs), atomic_replicas),
+        params=make_params(cfg, len(specs), atomic_replicas, densest),
         vessel_specs=tuple(specs),
-        vessels=wp.array([_geometry(s, t) for s, t in zip(specs, thickness)], dtype=VesselGeometry, device=device),
+        vessels=wp.array([_geometry(s, t, caught_liquid_mass(cfg, s)) for s, t in zip(specs, thickness)], dtype=VesselGeometry, device=device),
         b_local=wp.array(b_local.astype(np.float32), dtype=wp.vec3, device=device),
         b_vessel=wp.array(b_vessel, dtype=wp.int32, device=device),
         b_volume=wp.array(b_volume.astype(np.float32), dtype=float, device=device),
@@ -94,6 +133,7 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
         wall_thickness=thickness,
         grid=make_grid(n_particles),
         b_grid=make_grid(len(b_local)),
+        densest_smoothing_ratio=densest,
     )
 
 
@@ -120,6 +160,7 @@ class FluidState:
     kappa_divergence: wp.array
     free: wp.array
     rest_offset: wp.array
+    mass: wp.array
 
     @staticmethod
     def allocate(n: int, device) -> "FluidState":
@@ -134,7 +175,8 @@ class FluidState:
             kappa_divergence=wp.zeros(n, dtype=float, device=device),
             free=wp.zeros(n, dtype=wp.int32, device=device),
             rest_offset=wp.zeros(n, dtype=float, device=device),
+            mass=wp.zeros(n, dtype=float, device=device),
         )
 
     def arrays(self) -> list[wp.array]:
-        return [self.x, self.v, self.rho, self.p, self.active, self.pid, self.kappa_density, self.kappa_divergence, self.free, self.rest_offset]
+        return [self.x, self.v, self.rho, self.p, self.active, self.pid, self.kappa_density, self.kappa_divergence, self.free, self.rest_offset, self.mass]

@@ -18,8 +18,9 @@ JACOBI_GAIN_LIMIT = 3.5
 
 @wp.struct
 class SPHParams:
-    """Static SPH parameters (SI). ``mass`` is the SPH particle mass (kg, or kg/m of depth in 2-D); ``mass_out``
-    the 3-D mass one particle stands for (kg); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``alpha_free`` the artificial
+    """Static SPH parameters (SI). ``mass`` is the SPH mass a particle is seeded with (kg, or kg/m of depth in 2-D;
+    each particle's own is ``FluidState.mass``); ``mass_out`` the 3-D mass one particle stands for (kg, the same for
+    every particle); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``alpha_free`` the artificial
     viscosity of pairs with free liquid (WCSPH); ``max_tension`` (Pa) the clamp of WCSPH's negative pressure,
     reached at ``tension_density`` (kg/m^3); ``eta2`` = 0.01 h^2 (m^2); then DFSPH's stopping rule (relative
     tolerances and the iteration cap of each solve) and ``lattice_density``, the summation density of a resting
@@ -59,7 +60,10 @@ class SPHParams:
     atomic_replicas: int
 
 
-def make_params(cfg: FluidConfig, n_vessels: int, atomic_replicas: int = 1) -> SPHParams:
+def make_params(cfg: FluidConfig, n_vessels: int, atomic_replicas: int = 1, densest_smoothing_ratio: float | None = None) -> SPHParams:
+    """The struct for ``cfg``. ``densest_smoothing_ratio``: h over the spacing of the densest liquid the particles
+    can pack to (``cosim.fluid.model.densest_smoothing_ratio``; None: the configured ratio): the Jacobi relaxation
+    is set for that lattice's gain, the largest any part of the liquid has."""
     p = SPHParams()
     h = cfg.smoothing_length
     p.dim = cfg.dim
@@ -89,6 +93,7 @@ def make_params(cfg: FluidConfig, n_vessels: int, atomic_replicas: int = 1) -> S
     p.max_iterations = cfg.max_solver_iterations
     p.lattice_density = lattice_kernel_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim)
     p.lattice_factor_denominator = lattice_gradient_square_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim) * (cfg.particle_mass / cfg.spacing ** (cfg.dim + 1)) ** 2
-    p.jacobi_relaxation = min(1.0, JACOBI_GAIN_LIMIT / lattice_jacobi_gain(cfg.kernel, cfg.smoothing_ratio, cfg.dim))
+    densest = cfg.smoothing_ratio if densest_smoothing_ratio is None else densest_smoothing_ratio
+    p.jacobi_relaxation = min(1.0, JACOBI_GAIN_LIMIT / lattice_jacobi_gain(cfg.kernel, densest, cfg.dim))
     p.atomic_replicas = atomic_replicas
     return p

@@ -166,6 +166,7 @@ class FluidSolver:
         self.state.v.assign(particles.velocities.astype(np.float32))
         self.state.rho.assign(particles.densities.astype(np.float32))
         self.state.active.fill_(1)
+        self.state.mass.fill_(self.config.particle_mass)
         self.state.pid.assign(np.arange(n, dtype=np.int32))
         wp.launch(wcsph.equation_of_state, dim=n, inputs=[m.params, self.state.rho], outputs=[self.state.p], device=d)
         if self.config.pressure_solver is PressureSolver.DFSPH:
@@ -183,7 +184,7 @@ class FluidSolver:
         replicas = self.layout.atomic_replicas  # rows per lane (check_convergence sums every row)
         self._solve_stats = wp.zeros((self.lanes.count * replicas, dfsph.STATS_ROW_STRIDE), dtype=wp.int64, device=d)
         self._lane_stats = PerLane(self._solve_stats[k * replicas : (k + 1) * replicas].flatten() for k in range(self.lanes.count))
-        capacity = pair_capacity(self.config.dim, self.config.smoothing_ratio)
+        capacity = pair_capacity(self.config.dim, self.model.densest_smoothing_ratio)
         self._pair_count = wp.zeros(n, dtype=wp.int32, device=d)
         by_column = self.layout.pairs_by_column
         self._pair_index = pair_table(n, capacity, wp.int32, d, by_column)
@@ -425,7 +426,7 @@ class FluidSolver:
         if self.config.free_liquid:
             stages.append(launch(
                 wcsph.update_free_liquid, n,
-                [prm, m.grid.spec, m.vessels, m.b_volume, self._motions, st.x, st.active, m.grid.cell_start, m.grid.cell_end,
+                [prm, m.grid.spec, m.vessels, m.b_volume, self._motions, st.x, st.active, st.mass, m.grid.cell_start, m.grid.cell_end,
                  self._bx, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end],
                 [st.free, st.rho, st.p],
             ))
@@ -439,7 +440,7 @@ class FluidSolver:
             wcsph.compute_forces, n,
             [
                 prm, m.grid.spec, m.vessels, m.b_volume, m.b_vessel,
-                self._motions, st.x, st.v, st.rho, st.p, st.active, st.free, m.grid.cell_start, m.grid.cell_end,
+                self._motions, st.x, st.v, st.rho, st.p, st.active, st.free, st.mass, m.grid.cell_start, m.grid.cell_end,
                 self._bx, self._bv, self._b_p, self._b_rho, self._b_v_noslip,
                 m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, self._row, self._pair_index.shape[1],
             ],
@@ -447,11 +448,11 @@ class FluidSolver:
         ))
         stages.append(launch(
             wcsph.compute_density_rate, n,
-            [prm, m.b_volume, st.x, st.v, self._acc, st.rho, self._rho_grad, st.active, self._dt, self._bv, *pairs],
+            [prm, m.b_volume, st.x, st.v, self._acc, st.rho, self._rho_grad, st.active, st.mass, self._dt, self._bv, *pairs],
             [self._drho],
         ))
         stages.append(launch(
-            wcsph.integrate, n, [*self._integrate_model_args(), self._drho, self._acc, st.free],
+            wcsph.integrate, n, [*self._integrate_model_args(), self._drho, self._acc, st.free, st.mass],
             [st.x, st.v, st.rho, st.p, st.active, self._wall_force, self._wall_torque, *diag],
         ))
         return stages
@@ -473,7 +474,7 @@ class FluidSolver:
             launch(
                 dfsph.compute_density_factor, n,
                 [
-                    prm, m.grid.spec, m.vessels, m.b_volume, self._pair_index.shape[1], int(self.config.free_liquid), self._motions, st.x, st.active,
+                    prm, m.grid.spec, m.vessels, m.b_volume, self._pair_index.shape[1], int(self.config.free_liquid), self._motions, st.x, st.active, st.mass,
                     *grid, *walls, self._row, st.kappa_divergence, st.free, st.rest_offset,
                 ],
                 [st.rho, self._alpha, *increments, *pairs, self._pair_mass_grad, stats, self._keep_going, diag_f, diag_i],
@@ -481,7 +482,7 @@ class FluidSolver:
             together(
                 launch(
                     dfsph.compute_wall_density_factor, nb,
-                    [prm, m.grid.spec, m.b_volume, m.b_wetted, self._b_pair_index.shape[1], st.x, *grid, *walls, self._row],
+                    [prm, m.grid.spec, m.b_volume, m.b_wetted, self._b_pair_index.shape[1], st.x, st.mass, *grid, *walls, self._row],
                     [self._b_rho, self._b_alpha, *b_pairs, stats, diag_i],
                 ),
                 launch(
@@ -492,7 +493,7 @@ class FluidSolver:
             self._jacobi_solve(st, dfsph.SOLVE_DIVERGENCE, st.v, st.kappa_divergence, self._b_kappa_divergence),
             together(
                 launch(
-                    dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.free, st.kappa_density],
+                    dfsph.compute_nonpressure, n, [prm, m.b_volume, st.x, st.v, st.rho, st.active, self._dt, self._bx, self._bv, *pairs, self._row, st.free, st.mass, st.kappa_density],
                     [self._v_star, *increments, stats, self._keep_going, diag_f],
                 ),
                 launch(
@@ -511,7 +512,7 @@ class FluidSolver:
                 ],
                 [self._wall_force, self._wall_torque, st.p],
             ),
-            launch(dfsph.integrate, n, [*self._integrate_model_args(), self._v_star, st.rho], [st.x, st.v, st.active, self._wall_force, self._wall_torque, diag_f, diag_i]),
+            launch(dfsph.integrate, n, [*self._integrate_model_args(), self._v_star, st.rho], [st.x, st.v, st.active, st.mass, st.free, self._wall_force, self._wall_torque, diag_f, diag_i]),
             self.lanes.on_lane(0, self._solve_stats.zero_),
         ]
 
@@ -582,7 +583,7 @@ class FluidSolver:
                 dfsph.gauss_seidel_density_sweep, self._sweep_threads(),
                 [
                     prm, color, m.b_volume, *cells, m.b_grid.order, m.b_grid.cell_start, m.b_grid.cell_end, st.rho, self._alpha, self._dt, self._bv, *pairs,
-                    self._b_rho, self._b_alpha, *b_pairs,
+                    self._b_rho, self._b_alpha, *b_pairs, st.mass,
                 ],
                 [self._v_star, st.kappa_density, self._b_kappa_density, self._lane_stats],
             )
@@ -670,6 +671,11 @@ class FluidSolver:
         last interval's substeps."""
         return self._in_id_order(self.state.p).astype(np.float64)
 
+    def masses(self) -> np.ndarray:
+        """(N,) SPH mass of each particle: kg (3-D), or kg per metre of depth (2-D), where a particle inside a vessel
+        of depth d carries rho0 dx^2 ``depth_2d`` / d once it has entered it (``cosim.fluid.model``)."""
+        return self._in_id_order(self.state.mass).astype(np.float64)
+
     def active_mask(self) -> np.ndarray:
         """(N,) bool: still simulated (False once spilled out of the domain)."""
         return self._in_id_order(self.state.active).astype(bool)
@@ -694,7 +700,8 @@ class FluidSolver:
 
     def vessel_wrenches(self) -> np.ndarray:
         """(V, 6): the liquid's force (N) and torque (N m) on each vessel about its centre of mass, world frame,
-        averaged over the last interval's substeps (2-D: per unit depth x ``depth_2d``)."""
+        averaged over the last interval's substeps (2-D: each particle's per-unit-depth force x its own depth,
+        ``cosim.fluid.model``)."""
         return self._wrench.copy()
 
     @property

@@ -105,10 +105,10 @@ def viscous_pair(
     prm: SPHParams, alpha: float, mass_j: float, r: wp.vec3, r2: float, gw: wp.vec3, v_rel: wp.vec3, v_rel_laminar: wp.vec3, rho_i: float,
     rho_j: float,
 ) -> wp.vec3:
-    """Acceleration (m/s^2) of particle i from neighbour j of mass ``mass_j``: Monaghan (1992) artificial viscosity
-    with coefficient ``alpha`` on the approaching relative velocity ``v_rel`` = v_i - v_j (scaled by the configured
-    c0) plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the neighbour's, or a wall's
-    no-slip, velocity)."""
+    """Acceleration (m/s^2) of particle i from neighbour j of mass ``mass_j`` (kg, or kg/m in 2-D): Monaghan (1992)
+    artificial viscosity with coefficient ``alpha`` on the approaching relative velocity ``v_rel`` = v_i - v_j
+    (scaled by the configured c0) plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the
+    neighbour's, or a wall's no-slip, velocity)."""
     # min(vr, 0) instead of a branch on the approach: about half the pairs approach, so the branch is mispredicted
     # about half the time (measured on the default pour's 2-D non-pressure stage: 165 against 219 us per launch of
     # this term alone); a receding pair adds exactly zero, as the branch skipped it
@@ -159,6 +159,8 @@ def finish_particle(
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=float),
+    free: wp.array(dtype=wp.int32),
     wall_force: wp.array2d(dtype=wp.vec3),
     wall_torque: wp.array2d(dtype=wp.vec3),
     diag_f: wp.array2d(dtype=float),
@@ -170,7 +172,14 @@ def finish_particle(
     N m about the vessel's centre of mass), so the reaction wrench balances every boundary force. Records wall
     corrections/breaches, per-vessel contents, speed, kinetic and potential energy (and the energy of a particle
     leaving the domain), and the active count in row ``s``. Returns 1 if the particle is still active (the caller
-    then stores its density and pressure), else 0."""
+    then stores its density and pressure), else 0.
+
+    A particle that enters a vessel (outside its inner volume at the substep's start, inside at its end) takes the
+    vessel's in-plane mass (``VesselGeometry.liquid_mass``, 2-D: its own 3-D mass spread over the vessel's depth)
+    where that differs from its own, and becomes free liquid: its density is then re-measured by summation with the
+    new mass until it is packed inside the vessel (:func:`next_free_state`), under both solvers, instead of carrying
+    a continuity density or a seeded offset that describe its old packing. One switch at the inlet: the stream
+    between the vessels keeps the depth of the vessel it left."""
     xi = x_new
     vi = v_new
     if prm.dim == 2:
@@ -198,6 +207,9 @@ def finish_particle(
                 wp.atomic_add(diag_i, s, DIAG_BREACHES, 1)
         if inside_vessel(q, geo, prm.dim) != 0:
             wp.atomic_add(diag_i, s, DIAG_INSIDE0 + k, 1)
+            if geo.liquid_mass > 0.0 and mass[i] != geo.liquid_mass and inside_vessel(q_old, geo, prm.dim) == 0:
+                mass[i] = geo.liquid_mass
+                free[i] = 1
     if not (wp.isfinite(xi) and wp.isfinite(vi) and wp.isfinite(rho_new)):
         wp.atomic_add(diag_i, s, DIAG_NONFINITE, 1)
         active[i] = 0
@@ -243,6 +255,7 @@ def gather_particles(
     kappa_divergence: wp.array(dtype=float),
     free: wp.array(dtype=wp.int32),
     rest_offset: wp.array(dtype=float),
+    mass: wp.array(dtype=float),
     x_out: wp.array(dtype=wp.vec3),
     v_out: wp.array(dtype=wp.vec3),
     rho_out: wp.array(dtype=float),
@@ -253,6 +266,7 @@ def gather_particles(
     kappa_divergence_out: wp.array(dtype=float),
     free_out: wp.array(dtype=wp.int32),
     rest_offset_out: wp.array(dtype=float),
+    mass_out: wp.array(dtype=float),
 ):
     """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
     i = lane_item(wp.tid(), lane)
@@ -267,6 +281,7 @@ def gather_particles(
     kappa_divergence_out[i] = kappa_divergence[src]
     free_out[i] = free[src]
     rest_offset_out[i] = rest_offset[src]
+    mass_out[i] = mass[src]
 
 
 @wp.kernel

@@ -94,6 +94,7 @@ def update_free_liquid(
     motions: wp.array(dtype=VesselMotion),
     x: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=float),
     cell_start: wp.array(dtype=wp.int32),
     cell_end: wp.array(dtype=wp.int32),
     bx: wp.array(dtype=wp.vec3),
@@ -109,7 +110,7 @@ def update_free_liquid(
     rim) is free, and stays free until, back inside a vessel, it is packed into the liquid there. Liquid leaving a
     vessel becomes free once it has separated (summation density below rho0); until then the continuity density
     goes on, so its pressure does not jump when it passes the rim. A free particle's density is the summation
-    density sum_j m W_ij + sum_b rho0 V_b W_ib (normalised by a resting lattice's kernel sum), clamped below at
+    density sum_j m_j W_ij + sum_b rho0 V_b W_ib (normalised by a resting lattice's kernel sum), clamped below at
     rho0: memoryless (it sees the packing, whatever the particle went through in flight) and without tension
     (liquid in the air is at ambient pressure; the continuity density's tension would pull the stream back toward
     the vessel it left). It becomes bound when its summation density reaches rho0 inside a
@@ -123,7 +124,7 @@ def update_free_liquid(
     if inside and free[i] == 0:
         return
     support2 = prm.support * prm.support
-    density = prm.mass * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
+    density = mass[i] * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     c = grid_cell(g, xi)
     for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
         for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
@@ -134,7 +135,7 @@ def update_free_liquid(
                     r2 = wp.dot(r, r)
                     if r2 >= support2 or r2 < 1.0e-24:
                         continue
-                    density += prm.mass * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                    density += mass[j] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
                 density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xi, density)
     density = density / prm.lattice_density
     state = next_free_state(free[i], inside, density, prm.rest_density)
@@ -165,6 +166,7 @@ def compute_forces(
     p: wp.array(dtype=float),
     active: wp.array(dtype=wp.int32),
     free: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=float),
     cell_start: wp.array(dtype=wp.int32),
     cell_end: wp.array(dtype=wp.int32),
     bx: wp.array(dtype=wp.vec3),
@@ -234,12 +236,13 @@ def compute_forces(
                     count += 1
                     vij = vi - v[j]
                     rhoj = rho[j]
-                    vol = prm.mass / rhoj
+                    mj = mass[j]
+                    vol = mj / rhoj
                     moment += vol * wp.outer(-r, gw)
                     gsum += (vol * (rhoj - rhoi)) * gw
-                    a -= prm.mass * (pi_term + p[j] / (rhoj * rhoj)) * gw
+                    a -= mj * (pi_term + p[j] / (rhoj * rhoj)) * gw
                     alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
-                    a += viscous_pair(prm, alpha, prm.mass, r, r2, gw, vij, vij, rhoi, rhoj)
+                    a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
                 for kk in range(b_cell_start[cell], b_cell_end[cell]):
                     b = b_order[kk]
                     xb = bx[b]
@@ -285,6 +288,7 @@ def compute_density_rate(
     rho: wp.array(dtype=float),
     rho_grad: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=float),
     dt: wp.array(dtype=float),
     bv: wp.array(dtype=wp.vec3),
     pair_count: wp.array(dtype=wp.int32),
@@ -317,9 +321,10 @@ def compute_density_rate(
             r2 = wp.dot(r, r)
             vij = vi - (v[j] + h * acc[j])
             rhoj = rho[j]
-            dr += prm.mass * wp.dot(vij, gw)
+            mj = mass[j]
+            dr += mj * wp.dot(vij, gw)
             psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + rho_grad[j], gw)
-            dr += diffusion * (prm.mass / rhoj) * psi
+            dr += diffusion * (mj / rhoj) * psi
         else:
             b = pair_wall(j)
             dr += prm.rest_density * b_volume[b] * wp.dot(vi - bv[b], gw)
@@ -342,8 +347,9 @@ def integrate(
     row: wp.array(dtype=wp.int32),
     drho: wp.array(dtype=float),
     acc: wp.array(dtype=wp.vec3),
-    free: wp.array(dtype=wp.int32),
     # State in/out
+    free: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=float),
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
     rho: wp.array(dtype=float),
@@ -373,7 +379,7 @@ def integrate(
         rhoi = rho[i]  # free liquid: the summation density, recomputed at the next substep's start
     kept = finish_particle(
         prm, vessels, motions, domain_min, domain_max, guard_margin, max_penetration, s, i, x_old, xi, vi, rhoi, h,
-        x, v, active, wall_force, wall_torque, diag_f, diag_i,
+        x, v, active, mass, free, wall_force, wall_torque, diag_f, diag_i,
     )
     if kept == 0:
         return
