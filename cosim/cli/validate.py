@@ -4,12 +4,11 @@ Human output is a table (case, quantity, measured, reference, error, tolerance, 
 case run; ``--json`` prints a machine-readable document instead (the contract for outside checks):
 ``{"passed": bool, "cases": [{"case", "passed", "wall_time_s", "parameters", "metrics": [...], <raw values>}]}``
 with the raw values of each case (slosh ``frequency_hz``; hydrostatic ``z``, ``pressure``, ``leaked``;
-dam-break ``a``, ``t``, ``front``; slosh-plant ``omega1_sph``, ``omega1_model`` (rad/s), ``hinge_height_sph``,
-``hinge_height_model`` (m above the inner floor), ``damping_ratio_sph``, ``pivots``, ``signed_amplitudes``,
-``identified_model``, ``t``, ``sigma``; outflow ``coefficient``, ``rehbock``, ``discharge`` (m^2/s), ``head`` (m), ``t``,
-``passed_area``, ``head_series``; dam-break's ``reference_points`` each with ``T``, ``Z_reference``, ``Z``, ``error``,
-``time_lead``). A failed validation is reported, not hidden; with ``--strict`` it also makes
-the exit status 1.
+dam-break ``a``, ``t``, ``front``, ``reference_points`` (each ``T``, ``Z_reference``, ``Z``, ``error``, ``time_lead``);
+slosh-plant ``omega1_sph``, ``omega1_model`` (rad/s), ``hinge_height_sph``, ``hinge_height_model`` (m above the inner
+floor), ``damping_ratio_sph``, ``pivots``, ``signed_amplitudes``, ``identified_model``, ``t``, ``sigma``; outflow
+``coefficient``, ``rehbock``, ``discharge`` (m^2/s), ``head`` (m), ``t``, ``passed_area``, ``head_series``). A failed
+validation is reported, not hidden; with ``--strict`` it also makes the exit status 1.
 """
 
 from __future__ import annotations
