@@ -39,7 +39,8 @@ def test_the_piston_plate_stands_on_the_floor_and_stays_behind_the_head_strip() 
     assert -ch.length < ch.piston_face - 6 * thickness  # the channel's back wall clear of the piston's trailing walls
 
 
-@pytest.mark.parametrize("kwargs, field", [({"dim": 3}, "dim"), ({"window": 2.0}, "window"), ({"head": 0.5}, "head")])
+@pytest.mark.parametrize("kwargs, field", [({"dim": 3}, "dim"), ({"window": 2.0}, "window"), ({"head": 0.5}, "head"),
+                                           ({"spacing": 0.011}, "spacing")])
 def test_bad_input_names_the_field(kwargs, field) -> None:
     with pytest.raises(InputError, match=rf"^{field}: "):
         weir.Params(**kwargs)

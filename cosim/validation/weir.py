@@ -75,6 +75,9 @@ class Params(FluidCaseParams):
         check_range("crest_height", self.crest_height, 0.02, 0.5, "m")
         check_positive("duration", self.duration, "s", 10.0)
         check_range("window", self.window, 0.05, self.duration, "s (at most the duration)")
+        if self.head / self.resolved_spacing < 4.0 - 1e-9:
+            raise InputError(f"spacing: {self.resolved_spacing:g} m gives {self.head / self.resolved_spacing:.1f} particles across "
+                             f"the {self.head:g} m head; needs >= 4")
 
     @property
     def resolved_spacing(self) -> float:
@@ -134,8 +137,7 @@ class Channel:
 
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
-    if p.head / dx < 4.0 - 1e-9:
-        raise InputError(f"spacing: {dx:g} m gives {p.head / dx:.1f} particles across the {p.head:g} m head; needs >= 4")
+    # the kernel's support (the domain does not matter to it) sets the dummy layers, and so the channel's layout
     support = case_fluid_config(2, dx, p.crest_height + p.head, DEPTH, (-1, -1, -1), (1, 1, 1), p.solver, numerics=p.numerics).support_radius
     thickness = numerical_wall_thickness(VesselSpec(), dx, support)  # the walls the liquid sees, both vessels'
     ch = Channel(p, dx, thickness)
