@@ -110,13 +110,14 @@ def fit_run(folder: Path, window: float = RATE_WINDOW, crest_length: float | Non
         summary = json.loads((folder / "summary.json").read_text())
         with open(folder / "series.csv", newline="") as f:
             rows = list(csv.DictReader(f))
-    except (OSError, ValueError) as err:
-        raise InputError(f"RUN: {folder} is not a readable run folder of `cosim pour` ({err})") from None
-    length = crest_length_of(summary) if crest_length is None else crest_length
-    column = lambda name: np.array([float(r[name]) for r in rows])  # noqa: E731
-    return fit_discharge_coefficient(
-        column("t"), column("h_q"), column("volume_in_pourer"), np.array([r["phase"] == "cfs" for r in rows]), length, window
-    )
+        length = crest_length_of(summary) if crest_length is None else crest_length
+        t, h_q, volume = (np.array([float(r[name]) for r in rows]) for name in ("t", "h_q", "volume_in_pourer"))
+        in_cfs = np.array([r["phase"] == "cfs" for r in rows])
+    except InputError:
+        raise
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        raise InputError(f"RUN: {folder} is not a readable run folder of `cosim pour` ({type(err).__name__}: {err})") from None
+    return fit_discharge_coefficient(t, h_q, volume, in_cfs, length, window)
 
 
 def report(fit: DischargeFit, assumed: float) -> str:
@@ -142,7 +143,10 @@ def main(argv: list[str] | None = None) -> int:
             check_positive("--crest-length", args.crest_length, "m", 2.0)
         fit = fit_run(args.run, args.window, args.crest_length)
         summary = json.loads((args.run / "summary.json").read_text())
-        assumed = float(summary["scene"]["controller"]["catcher"]["discharge_coefficient"])
+        try:
+            assumed = float(summary["scene"]["controller"]["catcher"]["discharge_coefficient"])
+        except (KeyError, TypeError, ValueError):
+            raise InputError(f"RUN: {args.run / 'summary.json'} has no scene.controller.catcher.discharge_coefficient") from None
     except InputError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
