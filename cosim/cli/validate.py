@@ -4,10 +4,11 @@ Human output is a table (case, quantity, measured, reference, error, tolerance, 
 case run; ``--json`` prints a machine-readable document instead (the contract for outside checks):
 ``{"passed": bool, "cases": [{"case", "passed", "wall_time_s", "parameters", "metrics": [...], <raw values>}]}``
 with the raw values of each case (slosh ``frequency_hz``; hydrostatic ``z``, ``pressure``, ``leaked``;
-dam-break ``a``, ``t``, ``front``; slosh-plant ``omega1_sph``, ``omega1_model`` (rad/s), ``hinge_height_sph``,
-``hinge_height_model`` (m above the inner floor), ``damping_ratio_sph``, ``pivots``, ``signed_amplitudes``,
-``identified_model``, ``t``, ``sigma``). A failed validation is reported, not hidden; with ``--strict`` it also makes
-the exit status 1.
+dam-break ``a``, ``t``, ``front``, ``reference_points`` (each ``T``, ``Z_reference``, ``Z``, ``error``, ``time_lead``);
+slosh-plant ``omega1_sph``, ``omega1_model`` (rad/s), ``hinge_height_sph``, ``hinge_height_model`` (m above the inner
+floor), ``damping_ratio_sph``, ``pivots``, ``signed_amplitudes``, ``identified_model``, ``t``, ``sigma``; outflow
+``coefficient``, ``rehbock``, ``discharge`` (m^2/s), ``head`` (m), ``t``, ``passed_area``, ``head_series``). A failed
+validation is reported, not hidden; with ``--strict`` it also makes the exit status 1.
 """
 
 from __future__ import annotations
@@ -59,7 +60,7 @@ def register(subparsers, summary: str) -> None:
 
 def _case_params(name: str, args) -> list:
     from cosim.pour_scene import FluidSettings
-    from cosim.validation import slosh
+    from cosim.validation import slosh, weir
 
     scene = FluidSettings()
     solver = args.solver or scene.pressure_solver.value
@@ -71,6 +72,8 @@ def _case_params(name: str, args) -> list:
     params = CASES[name].params
     if name in ("tilt", "shake", "free-fall", "coupling-static"):
         geometry.pop("width", None)  # the scene's pouring vessel
+    if name == "outflow":
+        return [params(**common, head=head) for head in weir.HEADS]  # the weir's own channel, at two heads
     if name == "slosh-plant" and args.shape is not None:
         geometry["shape"] = args.shape
     if name == "slosh" and args.fill is None:
@@ -89,7 +92,11 @@ def _table(results: list[CaseResult]) -> str:
     header = f"{'case':<12} {'quantity':<28} {'measured':>12} {'reference':>12} {'error':>9} {'tol':>7} {'pass':>5} {'wall s':>7}"
     lines = [header, "-" * len(header)]
     for r in results:
-        label = r.case if r.case != "slosh" else f"slosh A={r.parameters['fill']:.3f}"
+        label = r.case
+        if r.case == "slosh":
+            label = f"slosh A={r.parameters['fill']:.3f}"
+        elif r.case == "outflow":
+            label = f"outflow H0={r.parameters['head']:.3f}"
         for k, m in enumerate(r.metrics):
             err = f"{m.error:+.4f}" if m.absolute else f"{100 * m.error:+.2f}%"
             tol = ("-" if m.tolerance == float("inf") else (f"{m.tolerance:g}" if m.absolute else f"{100 * m.tolerance:g}%"))
@@ -118,6 +125,7 @@ def run(args) -> int:
                 print(f"  {extent} {built:.4g} m: {asked:g} m rounded to whole particle spacings", file=sys.stderr)
         if not args.no_plot:
             suffix = f"-A{result.parameters['fill']:.3f}" if name in ("slosh", "slosh-plant") else ""
+            suffix = f"-H{result.parameters['head']:.3f}" if name == "outflow" else suffix
             path = args.out / f"{name}{suffix}-{result.parameters['dim']}d.png"
             with atomic_path(path) as tmp:
                 CASES[name].plot(result, tmp)

@@ -1,0 +1,219 @@
+"""Outflow over a sharp-crested weir: the SPH discharge coefficient against Rehbock's.
+
+A 2-D channel (a box vessel, inner floor at z = 0) ends at its +x wall, the weir, whose crest stands P above the
+floor. A piston, a second box vessel turned on its side so that its floor is a vertical plate across the whole
+liquid depth, pushes the liquid toward the weir at the constant speed U, so that in steady flow the discharge per
+unit width is q = U D, D being the depth at the piston. The liquid starts level at P + H0 (the nominal head H0 over
+the crest), moving at U with the piston; U is Rehbock's discharge at H0 over that depth, so the head the flow
+settles at is the liquid's own answer.
+
+Over the last ``window`` s of the run the discharge q (m^2/s: the slope of the liquid area that has passed the
+weir's upstream face, the area of a 2-D particle being dx^2) and the head H (m: the liquid's level above the crest
+in a strip centred 4 H0 upstream of the weir, where the surface is level, from the liquid area in the strip) give
+the coefficient of the weir law
+
+    q = (2/3) C_d sqrt(2 g) H^(3/2)        (H^(3/2) averaged over the window),
+
+compared with Rehbock's C_d = 0.611 + 0.08 H / P (Rehbock 1929, as given by Henderson, "Open Channel Flow", 1966,
+Sec. 6.8), valid for a fully ventilated nappe, which the 2-D liquid has: nothing fills the space under it.
+
+The crest is the top of the weir's dummy-particle layers: flat, ceil(2h/dx) spacings thick (3 dx at the default
+h = 1.5 dx). A crest acts as a sharp one while the head is well above its thickness (the nappe springs clear of the
+upstream edge); H / thickness is reported.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from cosim.checks import check_positive, check_range
+from cosim.errors import InputError
+from cosim.fluid.config import GRAVITY
+from cosim.fluid.seeding import ParticleSet, liquid_block
+from cosim.fluid.solver import FluidSolver
+from cosim.fluid.wall_sampling import numerical_wall_thickness
+from cosim.frames import Pose
+from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
+from cosim.vessel import VesselSpec
+
+# Acceptance: the discharge coefficient within 5 % of Rehbock's at each head.
+COEFFICIENT_TOLERANCE = 0.05
+HEADS = (0.04, 0.025)  # m, the nominal heads the validation runs (H / P = 0.5 and 0.31 at P = 0.08 m)
+HEAD_SPACINGS = 10  # default resolution: particles across the nominal head
+STATION_HEADS = 4.0  # the head is measured this many nominal heads upstream of the weir
+STATION_SPACINGS = 10  # width of the head's strip, particle spacings
+PISTON_CLEARANCE_HEADS = 3.0  # the piston stays this many nominal heads behind the strip
+SAMPLE_INTERVAL = 0.01  # s
+WEIR_FACTOR = (2.0 / 3.0) * math.sqrt(2.0 * GRAVITY)  # m^(1/2)/s: q / (C_d H^(3/2))
+DEPTH = 0.1  # m, out-of-plane scale of the 2-D liquid (cancels in q per unit width)
+
+
+def rehbock(head: float, crest_height: float) -> float:
+    """Rehbock's discharge coefficient of a sharp-crested weir, head and crest height in m."""
+    return 0.611 + 0.08 * head / crest_height
+
+
+@dataclass(frozen=True)
+class Params(FluidCaseParams):
+    """head: m, nominal head H0 over the crest (sets the piston's speed). crest_height: m, P. duration: s simulated.
+    window: s, the final stretch over which q and H are measured (the flow settles before it)."""
+
+    head: float = HEADS[0]
+    crest_height: float = 0.08
+    duration: float = 1.6
+    window: float = 0.8
+
+    def __post_init__(self) -> None:
+        self.validate_common()
+        if self.dim != 2:
+            raise InputError("dim: the weir case runs in 2-D only (the pour plane); choose 2")
+        check_range("head", self.head, 0.005, 0.2, "m")
+        check_range("crest_height", self.crest_height, 0.02, 0.5, "m")
+        check_positive("duration", self.duration, "s", 10.0)
+        check_range("window", self.window, 0.05, self.duration, "s (at most the duration)")
+        if self.head / self.resolved_spacing < 4.0 - 1e-9:
+            raise InputError(f"spacing: {self.resolved_spacing:g} m gives {self.head / self.resolved_spacing:.1f} particles across "
+                             f"the {self.head:g} m head; needs >= 4")
+
+    @property
+    def resolved_spacing(self) -> float:
+        return self.spacing if self.spacing is not None else self.head / HEAD_SPACINGS
+
+
+def piston_speed(head: float, crest_height: float) -> float:
+    """m/s: the piston speed that supplies Rehbock's discharge at ``head`` through the depth P + head."""
+    return rehbock(head, crest_height) * WEIR_FACTOR * head**1.5 / (crest_height + head)
+
+
+class Channel:
+    """The channel, its piston and where things are measured (world frame, m; the weir's upstream face at x = 0)."""
+
+    def __init__(self, p: Params, dx: float, wall_thickness: float) -> None:
+        self.dx, self.crest, self.head, self.thickness = dx, p.crest_height, p.head, wall_thickness
+        self.speed = piston_speed(p.head, p.crest_height)
+        self.station = -STATION_HEADS * p.head
+        self.strip = STATION_SPACINGS * dx
+        start_gap = self.speed * p.duration + PISTON_CLEARANCE_HEADS * p.head + 0.5 * self.strip
+        self.piston_face = self.station - start_gap  # at t = 0
+        self.length = -self.piston_face + 7.0 * wall_thickness  # the channel's -x wall clear of the piston's trailing walls
+        self.plate = p.crest_height + 4.0 * p.head  # m, the piston plate's height above the floor
+
+    def tank(self) -> VesselSpec:
+        return VesselSpec(name="channel", inner_width=self.length, inner_depth=DEPTH, inner_height=self.crest)
+
+    def piston(self) -> VesselSpec:
+        """A box whose floor (spanning its inner width plus the walls) is the plate; its walls trail behind."""
+        return VesselSpec(name="piston", inner_width=self.plate - 2.0 * self.thickness, inner_depth=DEPTH, inner_height=4.0 * self.thickness)
+
+    def tank_pose(self) -> Pose:
+        return Pose((-0.5 * self.length, 0.0, 0.0))
+
+    def piston_pose(self, t: float) -> Pose:
+        """The piston's vessel frame turned -90 deg about y (its +z pointing to -x, its +x up): the floor's outer
+        face, the plate, faces the liquid at x = piston_face + U t, its lower edge on the channel's floor."""
+        turned = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
+        return Pose((self.piston_face - self.thickness + self.speed * t, 0.0, 0.5 * self.plate), turned)
+
+    def heads_at_station(self, x: np.ndarray, active: np.ndarray) -> tuple[float, float]:
+        """m, the level above the crest in the strip, twice: from the liquid area in the strip over its width (the
+        measured head), and from the free surface, the top particle of each column dx wide plus dx/2, averaged over
+        the columns (a check: where the flowing particles have left their lattice, a column without a top-row
+        particle reports the row below, so this one reads low by a fraction of dx)."""
+        inside = active & (np.abs(x[:, 0] - self.station) < 0.5 * self.strip)
+        column = np.floor((x[inside, 0] - self.station + 0.5 * self.strip) / self.dx).astype(int)
+        top = np.full(int(round(self.strip / self.dx)) + 1, -np.inf)
+        np.maximum.at(top, column, x[inside, 2])
+        surface = float(np.mean(top[np.isfinite(top)])) + 0.5 * self.dx if inside.any() else 0.0
+        return float(inside.sum()) * self.dx**2 / self.strip - self.crest, surface - self.crest
+
+    def passed_area(self, x: np.ndarray, active: np.ndarray) -> float:
+        """m^2, liquid area that has passed the weir's upstream face (still beyond it, or gone from the domain)."""
+        return float(((~active) | (x[:, 0] > 0.0)).sum()) * self.dx**2
+
+
+def run(p: Params) -> CaseResult:
+    dx = p.resolved_spacing
+    # the kernel's support (the domain does not matter to it) sets the dummy layers, and so the channel's layout
+    support = case_fluid_config(2, dx, p.crest_height + p.head, DEPTH, (-1, -1, -1), (1, 1, 1), p.solver, numerics=p.numerics).support_radius
+    thickness = numerical_wall_thickness(VesselSpec(), dx, support)  # the walls the liquid sees, both vessels'
+    ch = Channel(p, dx, thickness)
+    margin = 0.05  # m
+    cfg = case_fluid_config(
+        2, dx, p.crest_height + p.head, DEPTH,
+        (-ch.length - thickness - margin, -DEPTH, -margin), (thickness + margin, DEPTH, ch.plate + margin), p.solver, numerics=p.numerics,
+    )
+    block = liquid_block((ch.piston_face, -0.5 * DEPTH, 0.0), (0.0, 0.5 * DEPTH, p.crest_height + p.head), cfg)
+    moving = ParticleSet(block.positions, np.tile([ch.speed, 0.0, 0.0], (len(block), 1)), block.densities)
+    solver = FluidSolver(cfg, [ch.tank(), ch.piston()], [ch.tank_pose(), ch.piston_pose(0.0)], moving, device=p.device)
+    t, passed, heads, surface_heads = [0.0], [0.0], [p.head], [p.head]
+    start = time.perf_counter()
+    while solver.time < p.duration - 1e-9:
+        solver.set_vessel_poses([ch.tank_pose(), ch.piston_pose(solver.time + SAMPLE_INTERVAL)])
+        solver.advance(SAMPLE_INTERVAL)
+        x, active = solver.positions(), solver.active_mask()
+        t.append(solver.time)
+        passed.append(ch.passed_area(x, active))
+        head, surface_head = ch.heads_at_station(x, active)
+        heads.append(head)
+        surface_heads.append(surface_head)
+    wall_time = time.perf_counter() - start
+    t, passed, heads, surface_heads = np.array(t), np.array(passed), np.array(heads), np.array(surface_heads)
+    window = t >= t[-1] - p.window - 1e-9
+    q = float(np.polyfit(t[window], passed[window], 1)[0])
+    head15 = float(np.mean(np.clip(heads[window], 0.0, None) ** 1.5))
+    head = head15 ** (2.0 / 3.0)
+    coefficient = q / (WEIR_FACTOR * head15) if head15 > 0.0 else float("nan")
+    surface_head15 = float(np.mean(np.clip(surface_heads[window], 0.0, None) ** 1.5))
+    reference = rehbock(head, p.crest_height)
+    drift = float(np.polyfit(t[window], heads[window], 1)[0] * p.window)
+    metrics = [
+        Metric(f"C_d at H0={1e3 * p.head:g} mm", coefficient, reference, (coefficient - reference) / reference, COEFFICIENT_TOLERANCE),
+        Metric("head H over the crest", head, p.head, (head - p.head) / p.head, float("inf"), "m"),
+    ]
+    raw = {
+        "t": t.tolist(),
+        "passed_area": passed.tolist(),
+        "head_series": heads.tolist(),
+        "head_by_surface_series": surface_heads.tolist(),
+        "discharge": q,
+        "head": head,
+        "head_drift_in_window": drift,
+        "head_by_surface": surface_head15 ** (2.0 / 3.0),
+        "coefficient_by_surface_head": q / (WEIR_FACTOR * surface_head15) if surface_head15 > 0.0 else float("nan"),
+        "coefficient": coefficient,
+        "rehbock": reference,
+        "piston_speed": ch.speed,
+        "channel_length": ch.length,
+        "crest_thickness": thickness,
+        "head_over_crest_thickness": head / thickness,
+        "particles": solver.n_particles,
+        "steps": solver.step_count,
+    }
+    params = dict(head=p.head, crest_height=p.crest_height, spacing=dx, dim=2, device=p.device, solver=p.solver.value,
+                  duration=p.duration, window=p.window)
+    return CaseResult("outflow", params, metrics, raw, wall_time)
+
+
+def plot(result: CaseResult, path) -> None:
+    r = result.raw
+    fig, ax, plt = new_figure(f"Weir (2-D, P = {result.parameters['crest_height']:g} m): discharge coefficient, "
+                              f"H0 = {1e3 * result.parameters['head']:g} mm")
+    t, passed, heads = (np.asarray(r[k]) for k in ("t", "passed_area", "head_series"))
+    k = max(1, round(0.1 / SAMPLE_INTERVAL))  # 0.1 s differences
+    q = (passed[k:] - passed[:-k]) / (t[k:] - t[:-k])
+    h15 = np.array([np.mean(np.clip(heads[i : i + k + 1], 0.0, None) ** 1.5) for i in range(len(q))])
+    ax.plot(0.5 * (t[k:] + t[:-k]), q / (WEIR_FACTOR * np.maximum(h15, 1e-12)), "-", label="SPH, 0.1 s windows")
+    ax.axhline(r["rehbock"], color="k", ls="--", label=f"Rehbock at the measured H: {r['rehbock']:.3f}")
+    ax.axhspan(r["rehbock"] * (1 - COEFFICIENT_TOLERANCE), r["rehbock"] * (1 + COEFFICIENT_TOLERANCE), color="0.85")
+    ax.axvspan(t[-1] - result.parameters["window"], t[-1], color="g", alpha=0.1, label=f"measured: C_d = {r['coefficient']:.3f}")
+    ax.set_ylim(0.0, 1.2)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("C_d = q / ((2/3) sqrt(2g) H^1.5)")
+    ax.legend(loc="lower right")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
