@@ -1,8 +1,12 @@
-"""The task-space pose filter: jerk-limited, and calm under a target that chatters (CFS increments of either sign)."""
+"""The task-space pose filter: jerk-limited, and calm under a target that chatters (CFS increments of either sign);
+the linear smoothing after it."""
 
 import numpy as np
+import pytest
 
-from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
+from cosim.coupling.pose_filter import (
+    SMOOTHING_BANDWIDTH, SMOOTHING_DELAY, SMOOTHING_STAGES, PoseFilter, PoseFilterLimits, PoseSmoother,
+)
 from cosim.robots.planar import PlanarPose
 
 PERIOD = 0.01  # s, the control period
@@ -66,3 +70,39 @@ def test_pass_through_waits_until_the_filter_has_caught_up() -> None:
     tilts = [f(PlanarPose(0.0, 0.0, 0.5), pass_through=True).theta for _ in range(300)]
     assert tilts[-1] == 0.5  # caught up, then passed through exactly
     assert max(abs(b - a) for a, b in zip(tilts, tilts[1:])) <= PoseFilterLimits().tilt_velocity * PERIOD + 1e-12
+
+
+# The linear smoothing after the jerk-limited filter: a ramp comes out delayed by its stated delay (once the start has
+# died away), a bang-bang jerk (the filter's ripple) is rolled off, and the sampled rates stay within the input's.
+
+
+def _smoothed(tilts: list[float]) -> np.ndarray:
+    smoother = PoseSmoother(("theta",), PERIOD)
+    return np.array([smoother(PlanarPose(0.0, 0.0, tilt)).theta for tilt in tilts])
+
+
+def test_a_ramp_is_smoothed_with_its_stated_delay() -> None:
+    ramp = [RAMP_RATE * k * PERIOD for k in range(300)]
+    out = _smoothed(ramp)
+    # discrete stages y += a (x - y): each delays a ramp by (1 - a) / a periods, the continuous 1 / bandwidth to
+    # within (bandwidth x period)^2 / 12 of itself
+    lag = (np.array(ramp) - out)[-1] / RAMP_RATE
+    assert lag == pytest.approx(SMOOTHING_DELAY, rel=1e-9)
+    # each stage y += a (x - y) lags a ramp by (1 - a) / a periods
+    a = 1.0 - np.exp(-SMOOTHING_BANDWIDTH * PERIOD)
+    assert SMOOTHING_DELAY == pytest.approx(SMOOTHING_STAGES * (1.0 - a) / a * PERIOD, rel=1e-12)
+
+
+def test_a_bang_bang_jerk_is_rolled_off_and_the_rates_stay_within_the_input() -> None:
+    # a tilt whose jerk flips between +-20 rad/s^3 every period: the jerk-limited filter's ripple at the control rate
+    jerk = 20.0 * np.where(np.arange(400) % 2 == 0, 1.0, -1.0)
+    acceleration = np.cumsum(jerk) * PERIOD
+    tilt = np.cumsum(np.cumsum(acceleration) * PERIOD) * PERIOD
+    out = _smoothed(tilt.tolist())
+    for order in (1, 2, 3):
+        assert np.abs(np.diff(out, order)).max() <= np.abs(np.diff(tilt, order)).max() + 1e-15
+    ripple_in = np.abs(np.diff(tilt, 3)[200:]).max()
+    ripple_out = np.abs(np.diff(out, 3)[200:]).max()
+    # three stages at 60 rad/s pass a 50 Hz alternation as ((1 - (1 - a)) / (1 + (1 - a)))^3, a = 1 - exp(-0.6)
+    a = 1.0 - np.exp(-SMOOTHING_BANDWIDTH * PERIOD)
+    assert ripple_out == pytest.approx(ripple_in * (a / (2.0 - a)) ** 3, rel=0.01)

@@ -39,7 +39,7 @@ from cosim.coupling.exchange import ROLES, vessel_poses, wrench_at_body_com
 from cosim.coupling.landing import landing_accuracy
 from cosim.coupling.outflow import outflow_timing
 from cosim.coupling.measure import LiquidProbe, MeasurementGeometry
-from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
+from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits, PoseSmoother
 from cosim.coupling.settings import Compensation, Coupling, CouplingSettings
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.seeding import fill_vessel
@@ -125,6 +125,7 @@ class CoupledPour:
             ArmRole.POUR: PoseFilter("pourer_pose", ("dx", "dz", "theta"), pose_limits, controller.dt),
             ArmRole.CATCH: PoseFilter("catcher_pose", ("dx",), pose_limits, controller.dt),
         }
+        self.smoothers = {role: PoseSmoother(self.filters[role].coordinates, controller.dt) for role in ROLES}
         self._ik = {r: ArmIK(scene.model, scene.arms[r].joints, frame_site(scene.arms[r].vessel), scene.arms[r].home_q, TARGET_IK) for r in ROLES}
         self.geometry = geometry
         self.probe = LiquidProbe(geometry, fluid.n_particles, fluid.device)
@@ -182,7 +183,8 @@ class CoupledPour:
         smoothed = {}
         for role in ROLES:
             t = targets[role]
-            pose = self.filters[role](PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback)
+            limited = self.filters[role](PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback)
+            pose = self.smoothers[role](limited)
             smoothed[role] = pose
             pos, quat = scene.vessel_target(role, pose)
             label = f"{scene.arms[role].vessel.name} target (dx={pose.dx:.3f} m, dz={pose.dz:.3f} m, tilt={math.degrees(pose.theta):.1f} deg)"

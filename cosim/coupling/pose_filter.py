@@ -1,4 +1,4 @@
-"""Jerk-limited smoothing of the controller's vessel targets in task space, before inverse kinematics.
+"""Smoothing of the controller's vessel targets in task space, before inverse kinematics: jerk-limited, then linear.
 
 The controller's planar targets can change faster than a jerk-limited arm can follow (the seed's SIM excitation
 theta = phi sin(alpha t) starts with a velocity step); fed straight to IK, the joint trajectory then cuts across
@@ -7,6 +7,15 @@ ruckig generator in those coordinates first (the same :class:`TrajectoryGenerato
 stepped at the control rate; the joint generators then follow IK of the smoothed path within their limits. Each
 target is approached as a state at rest, so a moving target is followed with a small lag (a 0.35 rad/s ramp: 0.055
 rad, a jerk-limited stop's distance plus the re-planning) and a chattering one never sets the filter swinging.
+
+The jerk-limited filter's own motion is bang-bang in jerk (ruckig's phases use the limit jerk or none), re-planned
+every period toward a target that the controller moves every period: its path carries a ripple at the control rate
+that the joints would follow. :class:`PoseSmoother` removes it: :data:`SMOOTHING_STAGES` first-order low-passes at
+:data:`SMOOTHING_BANDWIDTH` in series (:class:`controllers.motion.CriticallyDampedSmoother`) on each coordinate of the
+limited pose (or of the pass-through command). Their impulse response is positive with unit sum, so the smoothed
+path's sampled velocity, acceleration and jerk stay within those of the limited path (within its limits), and it
+delays a ramp by :data:`SMOOTHING_DELAY` (36 ms), which the pour's feedback sees (the partial pour's stop fits the
+vessel's lag behind its command).
 """
 
 from __future__ import annotations
@@ -16,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from controllers.motion import CriticallyDampedSmoother
 from cosim.checks import check_positive
 from cosim.robots.planar import PlanarPose
 from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
@@ -25,6 +35,11 @@ POSE_RANGE = 10.0  # m / rad: the filter's own position bounds (the arms' ranges
 # m / rad: how close the filtered pose must be to a pass-through command before the filter hands over to it; a
 # step of this size in a 10 ms target is 0.1 m/s or rad/s, well inside the arms' limits.
 PASS_THROUGH_JOIN = 1e-3
+# rad/s and count: the linear smoothing after the jerk-limited filter. The bandwidth is the controller's own command
+# smoothing's (controllers.config PidDesignSpec.smoothing_bandwidth); three stages roll the ripple at the control rate
+# off as f^-3 where two leave more of it; the delay is about half the jerk-limited filter's own lag on a CFS path.
+SMOOTHING_BANDWIDTH = 60.0
+SMOOTHING_STAGES = 3
 
 
 @dataclass(frozen=True)
@@ -102,4 +117,28 @@ class PoseFilter:
         self._generator.set_target(values, zero, zero)
         q, _, _ = self._generator.step()
         values = dict(zip(self.coordinates, map(float, q)))
+        return PlanarPose(values.get("dx", 0.0), values.get("dz", 0.0), values.get("theta", 0.0))
+
+
+def _smoothing_delay(period: float) -> float:
+    """s, the delay of a ramp through the smoothing at the control ``period``: each stage ``y += a (x - y)`` lags it
+    by ``(1 - a) / a`` periods."""
+    a = 1.0 - math.exp(-SMOOTHING_BANDWIDTH * period)
+    return SMOOTHING_STAGES * (1.0 - a) / a * period
+
+
+SMOOTHING_DELAY = _smoothing_delay(0.01)  # s, at the default 10 ms control period
+
+
+class PoseSmoother:
+    """Linear smoothing of one vessel's planar pose, per coordinate (see the module docstring); ``coordinates`` as
+    :class:`PoseFilter`'s, starting at rest at the home pose (all zero)."""
+
+    def __init__(self, coordinates: tuple[str, ...], control_period: float):
+        self.coordinates = coordinates
+        self._smoothers = {c: CriticallyDampedSmoother(SMOOTHING_BANDWIDTH, control_period, SMOOTHING_STAGES) for c in coordinates}
+
+    def __call__(self, pose: PlanarPose) -> PlanarPose:
+        """The smoothed pose for the next control period's ``pose``."""
+        values = {c: smoother.step(getattr(pose, c)) for c, smoother in self._smoothers.items()}
         return PlanarPose(values.get("dx", 0.0), values.get("dz", 0.0), values.get("theta", 0.0))
