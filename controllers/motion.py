@@ -58,11 +58,20 @@ class CriticallyDampedSmoother:
         check_range("smoother.dt", dt, 0.0, 1.0, "s", lo_open=True)
         check_range("smoother.stages", stages, 1, None)
         self.gain = 1.0 - math.exp(-bandwidth * dt)
+        self.dt = float(dt)
         self._stages = [0.0] * int(stages)
 
-    def reset(self, value: float) -> None:
-        """Every stage at rest at ``value``."""
-        self._stages = [float(value)] * len(self._stages)
+    @property
+    def delay(self) -> float:
+        """s, how far the output lags a ramp once the start has died away: ``(1 - a) / a`` periods per stage."""
+        return len(self._stages) * (1.0 - self.gain) / self.gain * self.dt
+
+    def reset(self, value: float, rate: float = 0.0) -> None:
+        """Every stage as on a ramp at ``rate`` (units/s; 0: at rest) whose output is ``value`` now: each stage ahead
+        of the next by the ramp's lag through one stage, ``rate (1 - a) / a dt``."""
+        lag = rate * (1.0 - self.gain) / self.gain * self.dt
+        n = len(self._stages)
+        self._stages = [float(value) + (n - 1 - k) * lag if lag else float(value) for k in range(n)]
 
     def step(self, x: float) -> float:
         """One sample of input ``x``; returns the smoothed output."""

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from cosim.coupling.pose_filter import (
-    SMOOTHING_BANDWIDTH, SMOOTHING_DELAY, SMOOTHING_STAGES, PoseFilter, PoseFilterLimits, PoseSmoother,
+    HANDOVER_TIME, SMOOTHING_BANDWIDTH, SMOOTHING_DELAY, SMOOTHING_STAGES, PoseFilter, PoseFilterLimits, PoseSmoother,
 )
 from cosim.robots.planar import PlanarPose
 
@@ -106,3 +106,17 @@ def test_a_bang_bang_jerk_is_rolled_off_and_the_rates_stay_within_the_input() ->
     # three stages at 60 rad/s pass a 50 Hz alternation as ((1 - (1 - a)) / (1 + (1 - a)))^3, a = 1 - exp(-0.6)
     a = 1.0 - np.exp(-SMOOTHING_BANDWIDTH * PERIOD)
     assert ripple_out == pytest.approx(ripple_in * (a / (2.0 - a)) ** 3, rel=0.01)
+
+
+def test_a_passed_through_command_is_not_delayed_and_the_hand_overs_have_no_step() -> None:
+    smoother = PoseSmoother(("theta",), PERIOD)
+    rate = 0.2  # rad/s: a ramp filtered for 1 s, passed through for 1 s, filtered again
+    out = np.array([smoother(PlanarPose(0.0, 0.0, rate * k * PERIOD), passing=100 <= k < 200).theta for k in range(300)])
+    command = rate * np.arange(300) * PERIOD
+    blended = 100 + round(HANDOVER_TIME / PERIOD)
+    assert np.all(out[blended:200] == command[blended:200])  # passed through, once the hand-over's blend is over
+    assert out[299] == pytest.approx(command[299] - rate * SMOOTHING_DELAY, abs=1e-9)  # filtering again: delayed
+    # each hand-over blends out the smoothing's lag d = rate x delay: its acceleration peaks at 5.77 d / time^2
+    # (the quintic blend), the ramp's own is zero; a step in the path or its rate would show as far more
+    peak = 5.78 * rate * SMOOTHING_DELAY / HANDOVER_TIME**2
+    assert np.abs(np.diff(out[50:], 2)).max() / PERIOD**2 <= peak

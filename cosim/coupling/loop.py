@@ -184,7 +184,7 @@ class CoupledPour:
         for role in ROLES:
             t = targets[role]
             limited = self.filters[role](PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback)
-            pose = self.smoothers[role](limited)
+            pose = self.smoothers[role](limited, passing=self.filters[role].passing)
             smoothed[role] = pose
             pos, quat = scene.vessel_target(role, pose)
             label = f"{scene.arms[role].vessel.name} target (dx={pose.dx:.3f} m, dz={pose.dz:.3f} m, tilt={math.degrees(pose.theta):.1f} deg)"

@@ -12,7 +12,7 @@ The jerk-limited filter's own motion is bang-bang in jerk (ruckig's phases use t
 every period toward a target that the controller moves every period: its path carries a ripple at the control rate
 that the joints would follow. :class:`PoseSmoother` removes it: :data:`SMOOTHING_STAGES` first-order low-passes at
 :data:`SMOOTHING_BANDWIDTH` in series (:class:`controllers.motion.CriticallyDampedSmoother`) on each coordinate of the
-limited pose (or of the pass-through command). Their impulse response is positive with unit sum, so the smoothed
+limited pose (a passed-through command is not delayed again, :class:`PoseSmoother`). Their impulse response is positive with unit sum, so the smoothed
 path's sampled velocity, acceleration and jerk stay within those of the limited path (within its limits), and it
 delays a ramp by :data:`SMOOTHING_DELAY` (36 ms), which the pour's feedback sees (the partial pour's stop fits the
 vessel's lag behind its command).
@@ -40,6 +40,10 @@ PASS_THROUGH_JOIN = 1e-3
 # off as f^-3 where two leave more of it; the delay is about half the jerk-limited filter's own lag on a CFS path.
 SMOOTHING_BANDWIDTH = 60.0
 SMOOTHING_STAGES = 3
+# s: how long the difference between the smoothed path and a passed-through command is blended out after a hand-over;
+# the blend of a difference d peaks at 1.9 d / HANDOVER_TIME in rate and 5.8 d / HANDOVER_TIME^2 in acceleration
+# (d = 36 ms x 0.1 rad/s = 3.6 mrad, a slosh damping's rate: 0.03 rad/s, 0.5 rad/s^2).
+HANDOVER_TIME = 0.2
 
 
 @dataclass(frozen=True)
@@ -90,6 +94,7 @@ class PoseFilter:
         self._generator = TrajectoryGenerator(arm, np.zeros(len(coordinates)), settings)
         self._period = control_period
         self._passed: list[np.ndarray] = []  # the last pass-through targets (at most three), for their rates
+        self.passing = False  # the last call passed its target through
 
     def __call__(self, target: PlanarPose, pass_through: bool = False) -> PlanarPose:
         """The smoothed pose one control period after the previous call, heading for ``target``; with
@@ -102,6 +107,7 @@ class PoseFilter:
         if pass_through and not self._passed:  # join the command only where the filtered path has reached it
             position = self._generator.state[0]
             pass_through = bool(np.all(np.abs(values - position) <= PASS_THROUGH_JOIN))
+        self.passing = pass_through
         if pass_through:
             self._passed = (self._passed + [values])[-3:]
             rates = np.diff(self._passed, axis=0) / self._period
@@ -120,25 +126,55 @@ class PoseFilter:
         return PlanarPose(values.get("dx", 0.0), values.get("dz", 0.0), values.get("theta", 0.0))
 
 
-def _smoothing_delay(period: float) -> float:
-    """s, the delay of a ramp through the smoothing at the control ``period``: each stage ``y += a (x - y)`` lags it
-    by ``(1 - a) / a`` periods."""
-    a = 1.0 - math.exp(-SMOOTHING_BANDWIDTH * period)
-    return SMOOTHING_STAGES * (1.0 - a) / a * period
+SMOOTHING_DELAY = CriticallyDampedSmoother(SMOOTHING_BANDWIDTH, 0.01, SMOOTHING_STAGES).delay  # s, at a 10 ms period
 
 
-SMOOTHING_DELAY = _smoothing_delay(0.01)  # s, at the default 10 ms control period
+def _blend_out(s: float) -> float:
+    """1 at ``s <= 0`` down to 0 at ``s >= 1`` with zero first and second derivatives at both ends (the quintic
+    ``1 - (10 s^3 - 15 s^4 + 6 s^5)``)."""
+    s = min(max(s, 0.0), 1.0)
+    return 1.0 - s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)
 
 
 class PoseSmoother:
     """Linear smoothing of one vessel's planar pose, per coordinate (see the module docstring); ``coordinates`` as
-    :class:`PoseFilter`'s, starting at rest at the home pose (all zero)."""
+    :class:`PoseFilter`'s, starting at rest at the home pose (all zero).
+
+    A command the pose filter passes through (the slosh damping's feedback, whose delay the controller's design
+    includes with its own smoothing) is not delayed again. The output is always a path plus a residual: the smoothed
+    limited pose, or the passed command itself, plus what is left of the difference at the last hand-over, blended
+    out over :data:`HANDOVER_TIME` with zero rate and acceleration at both ends (:func:`_blend_out`). At a hand-over to
+    pass-through the residual is the output's lag behind the command; back to filtering, the smoothing stages restart
+    as on a ramp at the command's last rate into its last value, and the residual is the output's lead over theirs.
+    So neither hand-over puts a step in the path, its rate or its acceleration."""
 
     def __init__(self, coordinates: tuple[str, ...], control_period: float):
         self.coordinates = coordinates
+        self._period = control_period
         self._smoothers = {c: CriticallyDampedSmoother(SMOOTHING_BANDWIDTH, control_period, SMOOTHING_STAGES) for c in coordinates}
+        self._passing = False
+        self._residual = {c: 0.0 for c in coordinates}  # the difference at the last hand-over
+        self._since = 0  # control periods since the last hand-over
+        self._last_command = {c: 0.0 for c in coordinates}
+        self._last_output = {c: 0.0 for c in coordinates}
 
-    def __call__(self, pose: PlanarPose) -> PlanarPose:
-        """The smoothed pose for the next control period's ``pose``."""
-        values = {c: smoother.step(getattr(pose, c)) for c, smoother in self._smoothers.items()}
+    def __call__(self, pose: PlanarPose, passing: bool = False) -> PlanarPose:
+        """The smoothed pose for the next control period's ``pose``; ``passing``: ``pose`` is a passed-through
+        command (:attr:`PoseFilter.passing`)."""
+        handover = passing != self._passing
+        self._since = 0 if handover else self._since + 1
+        values = {}
+        for c, smoother in self._smoothers.items():
+            x = getattr(pose, c)
+            if handover and passing:
+                self._residual[c] = self._last_output[c] - self._last_command[c]
+            elif handover:
+                rate = (x - self._last_command[c]) / self._period
+                restart = self._last_command[c] - rate * smoother.delay  # the ramp's smoothed value there
+                smoother.reset(restart, rate)
+                self._residual[c] = self._last_output[c] - restart
+            path = x if passing else smoother.step(x)
+            values[c] = path + self._residual[c] * _blend_out((self._since + 1) * self._period / HANDOVER_TIME)
+            self._last_command[c], self._last_output[c] = x, values[c]
+        self._passing = passing
         return PlanarPose(values.get("dx", 0.0), values.get("dz", 0.0), values.get("theta", 0.0))
