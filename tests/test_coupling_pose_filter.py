@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from cosim.coupling.pose_filter import (
-    HANDOVER_TIME, SMOOTHING_BANDWIDTH, SMOOTHING_DELAY, SMOOTHING_STAGES, PoseFilter, PoseFilterLimits, PoseSmoother,
+    HANDOVER_TIME, PASS_THROUGH_JOIN, SMOOTHING_BANDWIDTH, SMOOTHING_DELAY, SMOOTHING_STAGES, PoseFilter, PoseFilterLimits,
+    PoseSmoother,
 )
 from cosim.robots.planar import PlanarPose
 
@@ -120,3 +121,12 @@ def test_a_passed_through_command_is_not_delayed_and_the_hand_overs_have_no_step
     # (the quintic blend), the ramp's own is zero; a step in the path or its rate would show as far more
     peak = 5.78 * rate * SMOOTHING_DELAY / HANDOVER_TIME**2
     assert np.abs(np.diff(out[50:], 2)).max() / PERIOD**2 <= peak
+
+
+def test_a_command_joined_off_the_path_is_blended_in_without_a_step() -> None:
+    # at rest, then passed a command PASS_THROUGH_JOIN away (the most the pose filter joins): no step in the output,
+    # its acceleration at most the blend's 5.77 d / time^2
+    smoother = PoseSmoother(("theta",), PERIOD)
+    out = np.array([smoother(PlanarPose(0.0, 0.0, PASS_THROUGH_JOIN if k >= 50 else 0.0), passing=k >= 50).theta for k in range(100)])
+    assert np.abs(np.diff(out, 2)).max() / PERIOD**2 <= 5.78 * PASS_THROUGH_JOIN / HANDOVER_TIME**2
+    assert out[-1] == PASS_THROUGH_JOIN

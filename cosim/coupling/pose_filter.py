@@ -144,7 +144,8 @@ class PoseSmoother:
     includes with its own smoothing) is not delayed again. The output is always a path plus a residual: the smoothed
     limited pose, or the passed command itself, plus what is left of the difference at the last hand-over, blended
     out over :data:`HANDOVER_TIME` with zero rate and acceleration at both ends (:func:`_blend_out`). At a hand-over to
-    pass-through the residual is the output's lag behind the command; back to filtering, the smoothing stages restart
+    pass-through the residual is where the output would be at its last rate less the command (the pose filter joins
+    a command up to a millimetre or milliradian away from its own path, :data:`PASS_THROUGH_JOIN`); back to filtering, the smoothing stages restart
     as on a ramp at the command's last rate into its last value, and the residual is the output's lead over theirs.
     So neither hand-over puts a step in the path, its rate or its acceleration."""
 
@@ -157,6 +158,7 @@ class PoseSmoother:
         self._since = 0  # control periods since the last hand-over
         self._last_command = {c: 0.0 for c in coordinates}
         self._last_output = {c: 0.0 for c in coordinates}
+        self._previous_output = {c: 0.0 for c in coordinates}
 
     def __call__(self, pose: PlanarPose, passing: bool = False) -> PlanarPose:
         """The smoothed pose for the next control period's ``pose``; ``passing``: ``pose`` is a passed-through
@@ -166,8 +168,8 @@ class PoseSmoother:
         values = {}
         for c, smoother in self._smoothers.items():
             x = getattr(pose, c)
-            if handover and passing:
-                self._residual[c] = self._last_output[c] - self._last_command[c]
+            if handover and passing:  # the output as continued at its last rate, less the command
+                self._residual[c] = 2.0 * self._last_output[c] - self._previous_output[c] - x
             elif handover:
                 rate = (x - self._last_command[c]) / self._period
                 restart = self._last_command[c] - rate * smoother.delay  # the ramp's smoothed value there
@@ -175,6 +177,6 @@ class PoseSmoother:
                 self._residual[c] = self._last_output[c] - restart
             path = x if passing else smoother.step(x)
             values[c] = path + self._residual[c] * _blend_out((self._since + 1) * self._period / HANDOVER_TIME)
-            self._last_command[c], self._last_output[c] = x, values[c]
+            self._last_command[c], self._previous_output[c], self._last_output[c] = x, self._last_output[c], values[c]
         self._passing = passing
         return PlanarPose(values.get("dx", 0.0), values.get("dz", 0.0), values.get("theta", 0.0))
