@@ -52,8 +52,8 @@ a state that must overshoot by ``a^2 / (2 j)`` (1e-4 rad/s for 0.15 rad/s^2 at 1
 state is made admissible, ``|a| <= sqrt(2 j (max_velocity -+ v))`` (:func:`_admissible_acceleration`), a spline
 segment is played only when it ends in such a state, and the arm's state stays one from which the limits can be held.
 
-A path the arm cannot follow within its velocity limit (its velocity, estimated from the last three targets or given,
-above ``max_velocity``) is clipped to the limit and the arm falls behind; with
+A path the arm cannot follow within its velocity limit (the spline segment's peak speed, exactly, or a given target
+velocity above ``max_velocity``) is clipped to the limit and the arm falls behind; with
 :attr:`GeneratorSettings.stop_beyond_velocity_limit` (the arms' generators in a pour)
 :meth:`TrajectoryGenerator.set_target` raises :class:`UntrackablePathError` at the first such target instead, naming
 arm, joint, time and limit, so a run never continues on a path it cannot follow.
@@ -170,6 +170,19 @@ def _spline_state(points: np.ndarray, u: float, period: float) -> tuple[np.ndarr
     velocity = (w * w * d0 + (1.0 + 2.0 * u - 2.0 * u * u) * d1 + u * u * d2) / (2.0 * period)
     acceleration = (w * (d1 - d0) + u * (d2 - d1)) / (period * period)
     return position, velocity, acceleration
+
+
+def _peak_speed(points: np.ndarray, period: float) -> np.ndarray:
+    """(n,) rad/s: the largest speed over the B-spline segment with control points ``points`` (4, n) spaced
+    ``period`` s, exactly: its velocity ``(c0 + c1 u + c2 u^2) / (2 period)`` (:func:`_spline_state`) peaks at an end
+    or at its vertex ``u = -c1 / (2 c2)`` inside the segment."""
+    d0, d1, d2 = np.diff(points, axis=0)
+    c0, c1, c2 = d0 + d1, 2.0 * (d1 - d0), d0 - 2.0 * d1 + d2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = np.where(c2 != 0.0, -c1 / (2.0 * c2), 0.0)
+    vertex = np.clip(vertex, 0.0, 1.0)
+    speeds = [np.abs(c0 + c1 * u + c2 * u * u) for u in (0.0, 1.0, vertex)]
+    return np.max(speeds, axis=0) / (2.0 * period)
 
 
 def _control_points(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, period: float) -> list[np.ndarray]:
@@ -290,9 +303,9 @@ class TrajectoryGenerator:
         est_qd, est_qdd = _quadratic_derivatives(times, self._history_q)
         qd = est_qd if qd is None else _vector(f"{self.limits.arm}: target velocity", qd, n)
         qdd = est_qdd if qdd is None else _vector(f"{self.limits.arm}: target acceleration", qdd, n)
-        if self.settings.stop_beyond_velocity_limit:
-            self._check_trackable(qd, clamped)
         if explicit:
+            if self.settings.stop_beyond_velocity_limit:
+                self._check_trackable(qd, clamped)
             self._points, self._segment = [], None
             error = float(np.max(np.abs(np.array(self._input.current_position) - q)))
             self._follow_with_ruckig(q, qd, qdd, clamped, interval, 0.0, error)
@@ -302,6 +315,8 @@ class TrajectoryGenerator:
             self._points = _control_points(*self._state, period)
         self._points = self._points[-3:] + [q]
         points = np.array(self._points)
+        if self.settings.stop_beyond_velocity_limit:
+            self._check_trackable(_peak_speed(points, period), clamped)
         start = _spline_state(points, 0.0, period)
         end = _spline_state(points, 1.0, period)
         error = float(np.max(np.abs(self._state[0] - start[0])))
@@ -360,8 +375,9 @@ class TrajectoryGenerator:
         self._new_target = True
 
     def _check_trackable(self, qd: np.ndarray, clamped: np.ndarray) -> None:
-        """Raise :class:`UntrackablePathError` for the first joint (not clamped onto its range) whose path velocity
-        ``qd`` (n,) rad/s is above its ``max_velocity``."""
+        """Raise :class:`UntrackablePathError` for the first joint (not clamped onto its range) whose path speed
+        ``qd`` (n,) rad/s (a target's velocity, or the peak over the spline segment a stream point starts) is above
+        its ``max_velocity``."""
         beyond = np.flatnonzero(~clamped & (np.abs(qd) > self._vmax))
         if beyond.size:
             j = int(beyond[0])
