@@ -30,7 +30,7 @@ import numpy as np
 
 from controllers.config import CatcherConfig, PourConfig
 from controllers.geometry import VesselGeometry
-from controllers.measurement import PourCommand
+from controllers.measurement import Phase, PourCommand
 from controllers.pour import PourController
 from controllers.catcher import fall_time
 from cosim.coupling.arm_load import ArmLoadMonitor
@@ -57,6 +57,10 @@ CATCHER_TRAVEL = 0.15  # m each way along x: the catcher workspace the robot sce
 # IK of the smoothed vessel targets: converged far below the trajectory checks' tolerances (looser solves add
 # solver noise that shows up as joint acceleration, trajectory tests).
 TARGET_IK = IKSettings(position_tolerance=1e-10, rotation_tolerance=1e-10, max_iterations=200)
+# The slosh induction's phases: the excitation, the hold that waits for the slosh's zero crossing and the damping's
+# feedback are timed against the liquid's own oscillation and the arm's known delay, so the pourer's path in them is
+# not delayed by the pose smoothing (cosim.coupling.pose_filter.PoseSmoother).
+SLOSH_INDUCTION = (Phase.SIM_EXCITE, Phase.SIM_HOLD, Phase.SIM_DAMP)
 
 
 def coupled_step(
@@ -184,7 +188,8 @@ class CoupledPour:
         for role in ROLES:
             t = targets[role]
             limited = self.filters[role](PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback)
-            pose = self.smoothers[role](limited, passing=self.filters[role].passing)
+            undelayed = self.filters[role].passing or (role is ArmRole.POUR and cmd.phase in SLOSH_INDUCTION)
+            pose = self.smoothers[role](limited, passing=undelayed)
             smoothed[role] = pose
             pos, quat = scene.vessel_target(role, pose)
             label = f"{scene.arms[role].vessel.name} target (dx={pose.dx:.3f} m, dz={pose.dz:.3f} m, tilt={math.degrees(pose.theta):.1f} deg)"

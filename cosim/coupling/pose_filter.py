@@ -140,9 +140,10 @@ class PoseSmoother:
     """Linear smoothing of one vessel's planar pose, per coordinate (see the module docstring); ``coordinates`` as
     :class:`PoseFilter`'s, starting at rest at the home pose (all zero).
 
-    A command the pose filter passes through (the slosh damping's feedback, whose delay the controller's design
-    includes with its own smoothing) is not delayed again. The output is always a path plus a residual: the smoothed
-    limited pose, or the passed command itself, plus what is left of the difference at the last hand-over, blended
+    A path that must not be delayed (a command the pose filter passes through, the slosh damping's feedback, whose
+    delay the controller's design includes with its own smoothing; the coupling also passes the slosh induction's
+    path) is not delayed. The output is always a path plus a residual: the smoothed limited pose, or the undelayed
+    path itself, plus what is left of the difference at the last hand-over, blended
     out over :data:`HANDOVER_TIME` with zero rate and acceleration at both ends (:func:`_blend_out`). At a hand-over to
     pass-through the residual is where the output would be at its last rate less the command (the pose filter joins
     a command up to a millimetre or milliradian away from its own path, :data:`PASS_THROUGH_JOIN`); back to filtering, the smoothing stages restart
@@ -161,8 +162,8 @@ class PoseSmoother:
         self._previous_output = {c: 0.0 for c in coordinates}
 
     def __call__(self, pose: PlanarPose, passing: bool = False) -> PlanarPose:
-        """The smoothed pose for the next control period's ``pose``; ``passing``: ``pose`` is a passed-through
-        command (:attr:`PoseFilter.passing`)."""
+        """The smoothed pose for the next control period's ``pose``; ``passing``: ``pose`` is a path not to delay
+        (e.g. a command the pose filter passed through, :attr:`PoseFilter.passing`)."""
         handover = passing != self._passing
         self._since = 0 if handover else self._since + 1
         values = {}
