@@ -130,3 +130,14 @@ def test_a_command_joined_off_the_path_is_blended_in_without_a_step() -> None:
     out = np.array([smoother(PlanarPose(0.0, 0.0, PASS_THROUGH_JOIN if k >= 50 else 0.0), passing=k >= 50).theta for k in range(100)])
     assert np.abs(np.diff(out, 2)).max() / PERIOD**2 <= 5.78 * PASS_THROUGH_JOIN / HANDOVER_TIME**2
     assert out[-1] == PASS_THROUGH_JOIN
+
+
+def test_a_change_of_the_undelayed_source_is_blended_like_a_hand_over() -> None:
+    # undelayed throughout, the source switches from a path at rest to a command PASS_THROUGH_JOIN away
+    smoother = PoseSmoother(("theta",), PERIOD)
+    out = np.array([
+        smoother(PlanarPose(0.0, 0.0, PASS_THROUGH_JOIN if k >= 50 else 0.0), passing=True, source="command" if k >= 50 else "limited").theta
+        for k in range(100)
+    ])
+    assert np.abs(np.diff(out, 2)).max() / PERIOD**2 <= 5.78 * PASS_THROUGH_JOIN / HANDOVER_TIME**2
+    assert out[-1] == PASS_THROUGH_JOIN

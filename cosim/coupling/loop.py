@@ -188,8 +188,9 @@ class CoupledPour:
         for role in ROLES:
             t = targets[role]
             limited = self.filters[role](PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback)
-            undelayed = self.filters[role].passing or (role is ArmRole.POUR and cmd.phase in SLOSH_INDUCTION)
-            pose = self.smoothers[role](limited, passing=undelayed)
+            passed = self.filters[role].passing
+            undelayed = passed or (role is ArmRole.POUR and cmd.phase in SLOSH_INDUCTION)
+            pose = self.smoothers[role](limited, passing=undelayed, source="command" if passed else "limited")
             smoothed[role] = pose
             pos, quat = scene.vessel_target(role, pose)
             label = f"{scene.arms[role].vessel.name} target (dx={pose.dx:.3f} m, dz={pose.dz:.3f} m, tilt={math.degrees(pose.theta):.1f} deg)"

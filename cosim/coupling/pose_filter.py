@@ -155,16 +155,20 @@ class PoseSmoother:
         self._period = control_period
         self._smoothers = {c: CriticallyDampedSmoother(SMOOTHING_BANDWIDTH, control_period, SMOOTHING_STAGES) for c in coordinates}
         self._passing = False
+        self._source = ""
         self._residual = {c: 0.0 for c in coordinates}  # the difference at the last hand-over
         self._since = 0  # control periods since the last hand-over
         self._last_command = {c: 0.0 for c in coordinates}
         self._last_output = {c: 0.0 for c in coordinates}
         self._previous_output = {c: 0.0 for c in coordinates}
 
-    def __call__(self, pose: PlanarPose, passing: bool = False) -> PlanarPose:
+    def __call__(self, pose: PlanarPose, passing: bool = False, source: str = "") -> PlanarPose:
         """The smoothed pose for the next control period's ``pose``; ``passing``: ``pose`` is a path not to delay
-        (e.g. a command the pose filter passed through, :attr:`PoseFilter.passing`)."""
-        handover = passing != self._passing
+        (e.g. a command the pose filter passed through, :attr:`PoseFilter.passing`); ``source``: what ``pose`` is
+        (the limited path or the command): a change is a hand-over too (the pose filter joins a command off its own
+        path), blended out like one."""
+        handover = passing != self._passing or (passing and source != self._source)
+        self._source = source
         self._since = 0 if handover else self._since + 1
         values = {}
         for c, smoother in self._smoothers.items():
