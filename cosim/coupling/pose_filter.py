@@ -12,10 +12,11 @@ The jerk-limited filter's own motion is bang-bang in jerk (ruckig's phases use t
 every period toward a target that the controller moves every period: its path carries a ripple at the control rate
 that the joints would follow. :class:`PoseSmoother` removes it: :data:`SMOOTHING_STAGES` first-order low-passes at
 :data:`SMOOTHING_BANDWIDTH` in series (:class:`controllers.motion.CriticallyDampedSmoother`) on each coordinate of the
-limited pose (a passed-through command is not delayed again, :class:`PoseSmoother`). Their impulse response is positive with unit sum, so the smoothed
-path's sampled velocity, acceleration and jerk stay within those of the limited path (within its limits), and it
-delays a ramp by :data:`SMOOTHING_DELAY` (36 ms), which the pour's feedback sees (the partial pour's stop fits the
-vessel's lag behind its command).
+limited pose (a path whose timing the controller designs, such as a passed-through command, is not delayed:
+:class:`PoseSmoother`). Their impulse response is positive with unit sum, so the smoothed path's sampled velocity,
+acceleration and jerk stay within those of the limited path (within its limits), and it delays a ramp by
+:data:`SMOOTHING_DELAY` (36 ms), which the pour's feedback sees (the partial pour's stop fits the vessel's lag behind
+its command).
 """
 
 from __future__ import annotations
