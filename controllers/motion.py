@@ -44,33 +44,46 @@ class RateLimitedTracker:
 
 
 class CriticallyDampedSmoother:
-    """Two first-order low-passes in series at a fixed sample time: y1 += a (x - y1), y2 += a (y1 - y2),
-    a = 1 - exp(-bandwidth dt); output y2. A linear, amplitude-independent smoother (unlike a limit-based one),
-    whose transfer function (:meth:`transfer_function_coefficients`) a feedback design can include: its low-frequency
-    delay is 2 / bandwidth and its output's acceleration stays bounded for bounded input steps.
-    ``bandwidth`` in rad/s, ``dt`` in s; units of x and y are the caller's.
+    """``stages`` first-order low-passes in series at a fixed sample time: y1 += a (x - y1), y_k += a (y_{k-1} - y_k),
+    a = 1 - exp(-bandwidth dt); output the last. A linear, amplitude-independent smoother (unlike a limit-based one),
+    whose transfer function (:meth:`transfer_function_coefficients`) a feedback design can include: its
+    low-frequency delay is stages / bandwidth and its output's acceleration stays bounded for bounded input steps.
+    Its impulse response is positive with unit sum, so its output's differences of any order are never larger than
+    the input's largest (what limits a path's sampled rates holds after it). ``bandwidth`` in rad/s, ``dt`` in s,
+    ``stages`` >= 1 (default 2); units of x and y are the caller's.
     """
 
-    def __init__(self, bandwidth: float, dt: float) -> None:
+    def __init__(self, bandwidth: float, dt: float, stages: int = 2) -> None:
         check_range("smoother.bandwidth", bandwidth, 0.0, None, "rad/s", lo_open=True)
         check_range("smoother.dt", dt, 0.0, 1.0, "s", lo_open=True)
+        check_range("smoother.stages", stages, 1, None)
         self.gain = 1.0 - math.exp(-bandwidth * dt)
-        self._first = self._second = 0.0
+        self.dt = float(dt)
+        self._stages = [0.0] * int(stages)
 
-    def reset(self, value: float) -> None:
-        """Both stages at rest at ``value``."""
-        self._first = self._second = float(value)
+    @property
+    def delay(self) -> float:
+        """s, how far the output lags a ramp once the start has died away: ``(1 - a) / a`` periods per stage."""
+        return len(self._stages) * (1.0 - self.gain) / self.gain * self.dt
+
+    def reset(self, value: float, rate: float = 0.0) -> None:
+        """Every stage as on a ramp at ``rate`` (units/s; 0: at rest) whose output is ``value`` now: each stage ahead
+        of the next by the ramp's lag through one stage, ``rate (1 - a) / a dt``."""
+        lag = rate * (1.0 - self.gain) / self.gain * self.dt
+        n = len(self._stages)
+        self._stages = [float(value) + (n - 1 - k) * lag if lag else float(value) for k in range(n)]
 
     def step(self, x: float) -> float:
         """One sample of input ``x``; returns the smoothed output."""
-        self._first += self.gain * (x - self._first)
-        self._second += self.gain * (self._first - self._second)
-        return self._second
+        for k, y in enumerate(self._stages):
+            self._stages[k] = y + self.gain * (x - y)
+            x = self._stages[k]
+        return x
 
     def transfer_function_coefficients(self) -> tuple[list[float], list[float]]:
-        """(numerator, denominator) in z, highest power first: a^2 z^2 / (z - (1 - a))^2."""
-        a = self.gain
-        return [a * a, 0.0, 0.0], [1.0, -2.0 * (1.0 - a), (1.0 - a) ** 2]
+        """(numerator, denominator) in z, highest power first: a^n z^n / (z - (1 - a))^n, n the stages."""
+        a, n = self.gain, len(self._stages)
+        return [a**n] + [0.0] * n, np.poly([1.0 - a] * n).tolist()
 
 
 def stop_time(distance: float, max_rate: float, max_accel: float) -> float:

@@ -7,7 +7,7 @@ Outputs, in a new run folder (``recordings/<UTC time>-<scene name>/``, never an 
 checked against the joints' rated torques too), ``series.csv`` (per-control-step signals,
 :mod:`cosim.io.pour_series`), ``summary.json`` (volumes, the volume left in the pourer and a partial pour's error
 first, phases, timings, the arms' load: vessel deviation caused by the liquid, peak servo and required torques against
-the rated ones; versions, the scene). Everything is
+the rated ones; the trajectory's smoothness per joint, :mod:`cosim.trajectory.smoothness`; versions, the scene). Everything is
 written into a hidden temporary folder next to the destination and renamed into place only when the run
 succeeded, so a failed or interrupted run leaves no half-written folder behind.
 """
@@ -41,6 +41,7 @@ from cosim.reproducibility import blas_description
 from cosim.trajectory.checks import check_torques
 from cosim.trajectory.driver_names import driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
+from cosim.trajectory.smoothness import trajectory_smoothness
 from cosim.trajectory.torques import required_torques
 
 DEFAULT_RECORDINGS = Path("recordings")
@@ -227,6 +228,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
                 "late_targets": {r.value: pour.generators[r].late_targets for r in ROLES},
                 "max_target_error_rad": {r.value: pour.generators[r].max_target_error for r in ROLES},
                 "clamped_targets": {r.value: pour.generators[r].clamped_targets for r in ROLES},
+                "smoothness": trajectory_smoothness(trajectory),
             },
             versions=package_versions(),
             outputs=sorted(p.name for p in work.iterdir()) + ["summary.json"],

@@ -1,8 +1,13 @@
-"""The task-space pose filter: jerk-limited, and calm under a target that chatters (CFS increments of either sign)."""
+"""The task-space pose filter: jerk-limited, and calm under a target that chatters (CFS increments of either sign);
+the linear smoothing after it."""
 
 import numpy as np
+import pytest
 
-from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
+from cosim.coupling.pose_filter import (
+    HANDOVER_TIME, PASS_THROUGH_JOIN, SMOOTHING_BANDWIDTH, SMOOTHING_DELAY, SMOOTHING_STAGES, PoseFilter, PoseFilterLimits,
+    PoseSmoother,
+)
 from cosim.robots.planar import PlanarPose
 
 PERIOD = 0.01  # s, the control period
@@ -66,3 +71,73 @@ def test_pass_through_waits_until_the_filter_has_caught_up() -> None:
     tilts = [f(PlanarPose(0.0, 0.0, 0.5), pass_through=True).theta for _ in range(300)]
     assert tilts[-1] == 0.5  # caught up, then passed through exactly
     assert max(abs(b - a) for a, b in zip(tilts, tilts[1:])) <= PoseFilterLimits().tilt_velocity * PERIOD + 1e-12
+
+
+# The linear smoothing after the jerk-limited filter: a ramp comes out delayed by its stated delay (once the start has
+# died away), a bang-bang jerk (the filter's ripple) is rolled off, and the sampled rates stay within the input's.
+
+
+def _smoothed(tilts: list[float]) -> np.ndarray:
+    smoother = PoseSmoother(("theta",), PERIOD)
+    return np.array([smoother(PlanarPose(0.0, 0.0, tilt)).theta for tilt in tilts])
+
+
+def test_a_ramp_is_smoothed_with_its_stated_delay() -> None:
+    ramp = [RAMP_RATE * k * PERIOD for k in range(300)]
+    out = _smoothed(ramp)
+    # discrete stages y += a (x - y): each delays a ramp by (1 - a) / a periods, the continuous 1 / bandwidth to
+    # within (bandwidth x period)^2 / 12 of itself
+    lag = (np.array(ramp) - out)[-1] / RAMP_RATE
+    assert lag == pytest.approx(SMOOTHING_DELAY, rel=1e-9)
+    # each stage y += a (x - y) lags a ramp by (1 - a) / a periods
+    a = 1.0 - np.exp(-SMOOTHING_BANDWIDTH * PERIOD)
+    assert SMOOTHING_DELAY == pytest.approx(SMOOTHING_STAGES * (1.0 - a) / a * PERIOD, rel=1e-12)
+
+
+def test_a_bang_bang_jerk_is_rolled_off_and_the_rates_stay_within_the_input() -> None:
+    # a tilt whose jerk flips between +-20 rad/s^3 every period: the jerk-limited filter's ripple at the control rate
+    jerk = 20.0 * np.where(np.arange(400) % 2 == 0, 1.0, -1.0)
+    acceleration = np.cumsum(jerk) * PERIOD
+    tilt = np.cumsum(np.cumsum(acceleration) * PERIOD) * PERIOD
+    out = _smoothed(tilt.tolist())
+    for order in (1, 2, 3):
+        assert np.abs(np.diff(out, order)).max() <= np.abs(np.diff(tilt, order)).max() + 1e-15
+    ripple_in = np.abs(np.diff(tilt, 3)[200:]).max()
+    ripple_out = np.abs(np.diff(out, 3)[200:]).max()
+    # three stages at 60 rad/s pass a 50 Hz alternation as ((1 - (1 - a)) / (1 + (1 - a)))^3, a = 1 - exp(-0.6)
+    a = 1.0 - np.exp(-SMOOTHING_BANDWIDTH * PERIOD)
+    assert ripple_out == pytest.approx(ripple_in * (a / (2.0 - a)) ** 3, rel=0.01)
+
+
+def test_a_passed_through_command_is_not_delayed_and_the_hand_overs_have_no_step() -> None:
+    smoother = PoseSmoother(("theta",), PERIOD)
+    rate = 0.2  # rad/s: a ramp filtered for 1 s, passed through for 1 s, filtered again
+    out = np.array([smoother(PlanarPose(0.0, 0.0, rate * k * PERIOD), passing=100 <= k < 200).theta for k in range(300)])
+    command = rate * np.arange(300) * PERIOD
+    blended = 100 + round(HANDOVER_TIME / PERIOD)
+    assert np.all(out[blended:200] == command[blended:200])  # passed through, once the hand-over's blend is over
+    assert out[299] == pytest.approx(command[299] - rate * SMOOTHING_DELAY, abs=1e-9)  # filtering again: delayed
+    # each hand-over blends out the smoothing's lag d = rate x delay: its acceleration peaks at 5.77 d / time^2
+    # (the quintic blend), the ramp's own is zero; a step in the path or its rate would show as far more
+    peak = 5.78 * rate * SMOOTHING_DELAY / HANDOVER_TIME**2
+    assert np.abs(np.diff(out[50:], 2)).max() / PERIOD**2 <= peak
+
+
+def test_a_command_joined_off_the_path_is_blended_in_without_a_step() -> None:
+    # at rest, then passed a command PASS_THROUGH_JOIN away (the most the pose filter joins): no step in the output,
+    # its acceleration at most the blend's 5.77 d / time^2
+    smoother = PoseSmoother(("theta",), PERIOD)
+    out = np.array([smoother(PlanarPose(0.0, 0.0, PASS_THROUGH_JOIN if k >= 50 else 0.0), passing=k >= 50).theta for k in range(100)])
+    assert np.abs(np.diff(out, 2)).max() / PERIOD**2 <= 5.78 * PASS_THROUGH_JOIN / HANDOVER_TIME**2
+    assert out[-1] == PASS_THROUGH_JOIN
+
+
+def test_a_change_of_the_undelayed_source_is_blended_like_a_hand_over() -> None:
+    # undelayed throughout, the source switches from a path at rest to a command PASS_THROUGH_JOIN away
+    smoother = PoseSmoother(("theta",), PERIOD)
+    out = np.array([
+        smoother(PlanarPose(0.0, 0.0, PASS_THROUGH_JOIN if k >= 50 else 0.0), passing=True, source="command" if k >= 50 else "limited").theta
+        for k in range(100)
+    ])
+    assert np.abs(np.diff(out, 2)).max() / PERIOD**2 <= 5.78 * PASS_THROUGH_JOIN / HANDOVER_TIME**2
+    assert out[-1] == PASS_THROUGH_JOIN

@@ -44,5 +44,7 @@ def test_a_limit_below_the_pours_need_stops_the_run_at_once_naming_it(tmp_path, 
     )
     assert found, err
     assert float(found.group(3)) == float(f"{limit:.6g}")
-    assert abs(float(found.group(1)) - first_beyond) <= CONTROL_PERIOD  # at the target where the arm first needed more
+    # at the target where the arm first needed more: the target that starts the spline segment it is exceeded in
+    # (1e-9 s: the round-off of the two printed times' difference)
+    assert abs(float(found.group(1)) - first_beyond) <= CONTROL_PERIOD + 1e-9
     assert not (tmp_path / "limited").exists()

@@ -227,7 +227,8 @@ def _corrupt(trajectory: JointTrajectory, how: str) -> JointTrajectory:
 @pytest.mark.parametrize(
     ("how", "message"),
     [
-        ("position jump", r"arm pour_arm, joint elbow, t=4\.9980 s: \|position step\| 0\.01\d* rad above max_velocity \* h 0\.00628318 rad$"),
+        # the 0.01 rad jump plus the path's own step there (at the pour's peak, a fraction of a micro-radian either way)
+        ("position jump", r"arm pour_arm, joint elbow, t=4\.9980 s: \|position step\| 0\.0(09999|1)\d* rad above max_velocity \* h 0\.00628318 rad$"),
         ("velocity jump", r"arm pour_arm, joint elbow, t=4\.9980 s: \|velocity step\| 0\.05\d* rad/s above max_acceleration \* h 0\.01 rad/s$"),
         ("acceleration spike", r"arm pour_arm, joint elbow, t=5\.0000 s: \|acceleration\| 6 rad/s\^2 above max_acceleration 5 rad/s\^2$"),
         ("out of range", r"arm catch_arm, joint wrist_1, t=0\.0000 s: position -6\.5\d+ rad below min_position -6\.28319 rad$"),
@@ -259,7 +260,8 @@ def test_driver_names_that_do_not_fit_the_arms_are_refused_and_nothing_written(e
     [
         (JointLimitOverride(max_velocity=0.2), r"\|velocity\| 0\.2\d* rad/s above max_velocity 0\.2 rad/s$"),
         (JointLimitOverride(max_acceleration=0.5), r"\|acceleration\| 0\.5\d* rad/s\^2 above max_acceleration 0\.5 rad/s\^2$"),
-        (JointLimitOverride(max_jerk=50.0), r"\|jerk \(acceleration difference / h\)\| \d+(\.\d+)? rad/s\^3 above max_jerk 50 rad/s\^3$"),
+        # the pour needs 2.03 rad/s^3 on wrist_1
+        (JointLimitOverride(max_jerk=2.0), r"\|jerk \(acceleration difference / h\)\| 2\.0\d* rad/s\^3 above max_jerk 2 rad/s\^3$"),
     ],
 )
 def test_tighter_limits_refuse_the_pour(scene, exported, tmp_path, override, message):

@@ -17,7 +17,7 @@ import pytest
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
-from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator, UntrackablePathError
+from cosim.trajectory.generator import STREAM_DELAY_PERIODS, GeneratorSettings, TrajectoryGenerator, UntrackablePathError, _peak_speed, _spline_state
 from cosim.trajectory.limits import ArmLimits, JointLimitOverride, JointLimits, arm_limits
 from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
 from cosim.trajectory.recorder import TrajectoryRecorder
@@ -62,9 +62,10 @@ def _replayed(scene, pour, limits: dict[ArmRole, ArmLimits], stop: bool):
     settings = GeneratorSettings(stop_beyond_velocity_limit=stop)
     generators = [TrajectoryGenerator(limits[r], pour.targets[r][0], settings) for r in ArmRole]
     recorder = TrajectoryRecorder(generators)
-    for k in range(len(pour.targets[ArmRole.POUR])):
+    count = len(pour.targets[ArmRole.POUR])
+    for k in range(count):
         for generator, role in zip(generators, ArmRole):
-            generator.set_target(pour.targets[role][k])
+            generator.set_target(pour.targets[role][min(k + STREAM_DELAY_PERIODS, count - 1)])
         for _ in range(CYCLES_PER_TARGET):
             for generator in generators:
                 generator.step()
@@ -107,3 +108,14 @@ def test_a_user_limit_below_the_pours_need_stops_the_arm_generators_at_once(scen
     assert abs(float(found.group(1)) - first) <= CONTROL_PERIOD  # at the target where the arm first needed more
     with pytest.raises(UntrackablePathError, match="arm pour_arm, joint wrist_1"):  # the scripted runs stop alike
         generate_scripted(scene, pour_poses(scene, POUR), limits=limits)
+
+
+def test_the_stop_uses_the_spline_segments_exact_peak_speed():
+    """The untrackable-velocity stop of a stream point checks the speed the arm will have on its spline segment: the
+    largest of the segment's velocity, which a dense sampling of the segment reaches."""
+    rng = np.random.default_rng(3)
+    for _ in range(100):
+        points = rng.normal(size=(4, 2))
+        dense = np.max([np.abs(_spline_state(points, u, 0.01)[1]) for u in np.linspace(0.0, 1.0, 4001)], axis=0)
+        peak = _peak_speed(points, 0.01)
+        assert np.all(peak >= dense * (1.0 - 1e-12)) and np.all(peak <= dense * (1.0 + 1e-6))

@@ -4,7 +4,10 @@ Plays a joint trajectory (a CSV file, :mod:`cosim.trajectory.csv_file`) through 
 MuJoCo without liquid (the liquid as a rigid payload, full by default) and reports per-joint tracking error and
 the vessel lips' path errors (:mod:`cosim.trajectory.replay`), then a verdict: PASS when every vessel lip stays
 within ``--tolerance-mm`` (default 2 mm) of its commanded path and nothing collides, else FAIL with the reasons. The
-exit status says it, so that a script or CI job can gate on it: 0 pass, 1 fail, 2 bad input (a bad trajectory file,
+servos get the inverse dynamics of the commanded motion as feedforward by default, as an arm's model-based
+controller does; with gravity compensation only, a PD servo lags its command by about the torque the motion's
+acceleration needs over its gain, and a trajectory using the acceleration limit fails by that alone. The exit
+status says it, so that a script or CI job can gate on it: 0 pass, 1 fail, 2 bad input (a bad trajectory file,
 scene or option: one line). ``--json`` prints a JSON object with ``verdict`` ("pass" or "fail"), ``tolerance_m``, ``failures`` (the reasons),
 ``max_error_m`` (largest pour-lip position error, m), ``joint_max_error_rad`` (per-joint maxima) and the rest.
 """
@@ -48,8 +51,10 @@ def register(subparsers: argparse._SubParsersAction, summary: str) -> None:
         help="rigid liquid payload: full (pourer full to the rim, catcher holding that volume) or empty",
     )
     parser.add_argument(
-        "--feedforward", choices=[f.value for f in Feedforward], default=Feedforward.GRAVITY.value,
-        help="servo feedforward: gravity compensation only, or plus inverse dynamics of the commanded motion",
+        "--feedforward", choices=[f.value for f in Feedforward], default=Feedforward.DYNAMICS.value,
+        help="servo feedforward: plus inverse dynamics of the commanded motion, as an arm's model-based controller "
+        "(default), or gravity compensation only (the lip then lags by about the commanded acceleration x inertia / "
+        "servo gain)",
     )
     parser.set_defaults(func=run)
 

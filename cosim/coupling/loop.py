@@ -30,7 +30,7 @@ import numpy as np
 
 from controllers.config import CatcherConfig, PourConfig
 from controllers.geometry import VesselGeometry
-from controllers.measurement import PourCommand
+from controllers.measurement import Phase, PourCommand
 from controllers.pour import PourController
 from controllers.catcher import fall_time
 from cosim.coupling.arm_load import ArmLoadMonitor
@@ -39,7 +39,7 @@ from cosim.coupling.exchange import ROLES, vessel_poses, wrench_at_body_com
 from cosim.coupling.landing import landing_accuracy
 from cosim.coupling.outflow import outflow_timing
 from cosim.coupling.measure import LiquidProbe, MeasurementGeometry
-from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits
+from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits, PoseSmoother
 from cosim.coupling.settings import Compensation, Coupling, CouplingSettings
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.seeding import fill_vessel
@@ -57,6 +57,10 @@ CATCHER_TRAVEL = 0.15  # m each way along x: the catcher workspace the robot sce
 # IK of the smoothed vessel targets: converged far below the trajectory checks' tolerances (looser solves add
 # solver noise that shows up as joint acceleration, trajectory tests).
 TARGET_IK = IKSettings(position_tolerance=1e-10, rotation_tolerance=1e-10, max_iterations=200)
+# The slosh induction's phases: the excitation, the hold that waits for the slosh's zero crossing and the damping's
+# feedback are timed against the liquid's own oscillation and the arm's known delay, so the pourer's path in them is
+# not delayed by the pose smoothing (cosim.coupling.pose_filter.PoseSmoother).
+SLOSH_INDUCTION = (Phase.SIM_EXCITE, Phase.SIM_HOLD, Phase.SIM_DAMP)
 
 
 def coupled_step(
@@ -125,6 +129,7 @@ class CoupledPour:
             ArmRole.POUR: PoseFilter("pourer_pose", ("dx", "dz", "theta"), pose_limits, controller.dt),
             ArmRole.CATCH: PoseFilter("catcher_pose", ("dx",), pose_limits, controller.dt),
         }
+        self.smoothers = {role: PoseSmoother(self.filters[role].coordinates, controller.dt) for role in ROLES}
         self._ik = {r: ArmIK(scene.model, scene.arms[r].joints, frame_site(scene.arms[r].vessel), scene.arms[r].home_q, TARGET_IK) for r in ROLES}
         self.geometry = geometry
         self.probe = LiquidProbe(geometry, fluid.n_particles, fluid.device)
@@ -182,7 +187,10 @@ class CoupledPour:
         smoothed = {}
         for role in ROLES:
             t = targets[role]
-            pose = self.filters[role](PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback)
+            limited = self.filters[role](PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback)
+            passed = self.filters[role].passing
+            undelayed = passed or (role is ArmRole.POUR and cmd.phase in SLOSH_INDUCTION)
+            pose = self.smoothers[role](limited, passing=undelayed, source="command" if passed else "limited")
             smoothed[role] = pose
             pos, quat = scene.vessel_target(role, pose)
             label = f"{scene.arms[role].vessel.name} target (dx={pose.dx:.3f} m, dz={pose.dz:.3f} m, tilt={math.degrees(pose.theta):.1f} deg)"

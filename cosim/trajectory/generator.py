@@ -1,61 +1,72 @@
-"""Online jerk-limited joint trajectory generation for one arm with ruckig (community build: state to state only).
+"""Online joint trajectory generation for one arm: smooth on the target stream, ruckig (community build) to catch up.
 
 The coupling streams inverse-kinematics joint targets at the control rate (:meth:`TrajectoryGenerator.set_target`,
-every 10 ms) and advances the generator once per MuJoCo step (:meth:`TrajectoryGenerator.step`, 2 ms), sending the
-returned state ``(q, qd, qdd)`` (rad, rad/s, rad/s^2, arrays of the arm's joints, base to tip) to the arm's servos.
+every ``T`` = 10 ms) and advances the generator once per MuJoCo step (:meth:`TrajectoryGenerator.step`, 2 ms), sending
+the returned state ``(q, qd, qdd)`` (rad, rad/s, rad/s^2, arrays of the arm's joints, base to tip) to the arm's servos.
 
-How a target is tracked. A call ``set_target(q_k)`` at generator time ``t_k`` means "the path is at ``q_k`` now".
-Its velocity and acceleration are the caller's or, when not given, estimated from the last three targets (the
-derivatives at ``t_k`` of the quadratic through them, exact for paths up to second order in time). The generator
-extrapolates this path state at constant acceleration and asks ruckig for the jerk-limited motion from the arm's
-current state to the path's state ``H`` seconds ahead, with
+How the stream is followed. The path is the uniform cubic B-spline whose control points are the targets, spaced
+``T`` (de Boor, A Practical Guide to Splines, 1978). When target ``P_k`` arrives, the arm plays the segment of
+``P_{k-3} .. P_k`` over the next ``T``: from the knot state ``((P_{k-3} + 4 P_{k-2} + P_{k-1}) / 6,
+(P_{k-1} - P_{k-3}) / 2T, (P_{k-3} - 2 P_{k-2} + P_{k-1}) / T^2)`` to the next one. Consecutive segments join with
+equal position, velocity and acceleration (the spline is C2), the acceleration is linear and the jerk
+``(P_k - 3 P_{k-1} + 3 P_{k-2} - P_{k-3}) / T^3`` constant over each segment: the jerk changes sign only where the
+stream's third difference does, so a smooth stream gives a smooth motion. The spline is what a robotics engineer
+writes through waypoints by hand; it is also a mild low-pass of the stream (gain ``sinc^4(f T)``: 0.94 at 10 Hz,
+0.66 at 25 Hz). Its price is a delay: the knot states sit at the targets of :data:`STREAM_DELAY_PERIODS` periods
+before (exactly for a stream moving at constant velocity; a stream accelerating at ``a`` is cut inside by
+``a T^2 / 6``, 4e-5 rad at 2.5 rad/s^2). A caller that knows its targets ahead (:mod:`cosim.trajectory.scripted`)
+sends them that much early; the coupling's targets are its task-space filter's poses for one period ahead.
 
-* the target velocity and acceleration of the path, so the arm arrives moving with the path instead of stopping at
-  every target (ruckig's default, target at rest: the vessel strays by up to 28 mm on a 100 deg pour);
-* ``minimum_duration = H``, so it arrives exactly when the path does instead of early, waiting;
-* time synchronisation: every joint arrives together, so the arm moves along the joint-space path, not each joint
-  on its own clock;
-* ``H`` = the target interval ``T`` (10 ms) while the arm is on the path: it then follows the path with no lag
-  (vessel lip within 0.001 mm of a scripted 100 deg pour, ``tests/test_trajectory_generation.py``). When the arm
-  has fallen behind (a path that starts moving abruptly, a step in the path's acceleration), ``H`` is the shortest
-  horizon at which ruckig can meet the extrapolated path, found by bisection on ruckig's duration (to one cycle, at
-  most :data:`MAX_HORIZON`): the arm catches up time-optimally and re-plans at every target (a 0.5 rad/s ramp
-  started from rest is caught in 0.35 s). Aiming at the next target alone instead makes a running-away target look
-  like one to back up for, and recovers over seconds.
+The re-planned ruckig profiles this replaces kept the jerk at its limit in short pulses of either sign on most
+samples even on an in-limit 2 Hz sinusoid (their phases use the limit jerk or none): a chatter of the acceleration at
+the control rate, not a motion.
 
-Limits of the scheme: it follows paths within the limits; a path that needs more (a joint speed or acceleration
-above its limit, or a velocity step that keeps the arm behind for longer than :data:`MAX_HORIZON`) is left through
-extrapolations of the path that are far off it, and the vessel cuts across by centimetres (the seed's SIM
-excitation, tilt 0.3 sin(3.2 t) about the vessel bottom from rest: 45 mm; the same tilt through a jerk-limited filter,
-1.5 rad/s, 2.5 rad/s^2, 40 rad/s^3: 0.5 mm; ``tests/test_trajectory_generation.py``). Feed it paths within the
-limits, smoothed in the controller's own coordinates (tilt angle, catcher position), where a timing difference does
-not take the vessel off its path; :attr:`TrajectoryGenerator.late_targets` and
-:attr:`TrajectoryGenerator.max_target_error` tell when the arm was behind the path.
+Limits hold by construction. The segment's velocity is a quadratic B-spline with control points ``dP / T``, its
+acceleration the line between the ``d^2 P / T^2``, its jerk ``d^3 P / T^3``: each within the hull of those
+differences, its positions within the hull of the (clamped) targets. A segment is played only when these differences
+are within ``max_velocity``, ``max_acceleration`` and ``max_jerk``, its end state is admissible (below), the arm is on
+the spline (its state equals the segment's start within :data:`SPLINE_TOLERANCE`) and the target came one period after
+the last. Otherwise ruckig takes the arm toward the segment's end state (extrapolated at constant acceleration beyond
+it), with
 
-ruckig's profiles use the jerk limit or zero jerk in each phase, so the sampled jerk of a tracked path often sits at
-``max_jerk`` in short pulses while the acceleration stays within about path jerk x ``T`` of the smooth path's.
+* ``minimum_duration`` = the horizon ``H``, so the arm arrives when the path does instead of early, waiting;
+* time synchronisation: every joint arrives together, along the joint-space path;
+* ``H`` = ``T`` when that end state is reachable within the limits, and the arm is then on the spline again; when
+  it has fallen behind (a stream that starts moving abruptly, a step in its acceleration), the shortest horizon at
+  which ruckig can meet the extrapolated path, found by bisection on ruckig's duration (to one cycle, at most
+  :data:`MAX_HORIZON`): the arm catches up time-optimally and re-plans at every target (a 0.5 rad/s ramp started
+  from rest is caught in 0.35 s). :attr:`TrajectoryGenerator.late_targets` and
+  :attr:`TrajectoryGenerator.max_target_error` tell when the arm was behind the path.
 
-Everything the arm is sent is within the limits, by construction. ruckig keeps velocity, acceleration and jerk
-within them between two admissible states, but it accepts a target state from which no jerk-limited motion can
-continue within them: at ``v`` with acceleration ``a`` (same sign), bringing ``a`` to zero at the jerk limit ``j``
-adds ``a |a| / (2 j)`` to the velocity. Arriving at ``v = max_velocity`` with ``a > 0`` (a path clipped to the limit
-while still accelerating), the next plan starts from a state that must overshoot by ``a^2 / (2 j)`` (1e-4 rad/s for
-0.15 rad/s^2 at 100 rad/s^3). So every target state is made admissible: ``|a| <= sqrt(2 j (max_velocity -+ v))``
-(:func:`_admissible_acceleration`), and the arm's state stays one from which the limits can be held.
+A stream that needs more than the limits (a joint speed or acceleration above its limit, or a velocity step that keeps
+the arm behind for longer than :data:`MAX_HORIZON`) is left through extrapolations of the path that are far off it,
+and the vessel cuts across by centimetres (tilt 0.3 sin(3.2 t) about the vessel bottom from rest: 45 mm; the same tilt
+through a jerk-limited filter, 1.5 rad/s, 2.5 rad/s^2, 40 rad/s^3: 0.5 mm; ``tests/test_trajectory_generation.py``).
+Feed it paths within the limits, smoothed in the controller's own coordinates (tilt angle, catcher position).
 
-A path the arm cannot follow within its velocity limit (its velocity, given or estimated, above ``max_velocity``)
-is clipped to the limit and the arm falls behind; with :attr:`GeneratorSettings.stop_beyond_velocity_limit` (the
-arms' generators in a pour) :meth:`TrajectoryGenerator.set_target` raises :class:`UntrackablePathError` at the first
-such target instead, naming arm, joint, time and limit, so a run never continues on a path it cannot follow.
+Admissible states. ruckig keeps velocity, acceleration and jerk within the limits between two admissible states, but
+it accepts a target state from which no jerk-limited motion can continue within them: at ``v`` with acceleration
+``a`` (same sign), bringing ``a`` to zero at the jerk limit ``j`` adds ``a |a| / (2 j)`` to the velocity. Arriving at
+``v = max_velocity`` with ``a > 0`` (a path clipped to the limit while still accelerating), the next plan starts from
+a state that must overshoot by ``a^2 / (2 j)`` (1e-4 rad/s for 0.15 rad/s^2 at 100 rad/s^3). So every ruckig target
+state is made admissible, ``|a| <= sqrt(2 j (max_velocity -+ v))`` (:func:`_admissible_acceleration`), a spline
+segment is played only when it ends in such a state, and the arm's state stays one from which the limits can be held.
 
-ruckig's community build ignores position limits, so targets outside the joint range are clamped onto it (that joint then at rest) and
-counted in :attr:`clamped_targets`, and a joint whose time-optimal stop (plus one target interval of travel) would
-end beyond its range is sent to rest on the boundary, so the motion itself stays in range.
+A path the arm cannot follow within its velocity limit (the spline segment's peak speed, exactly, or a given target
+velocity above ``max_velocity``) is clipped to the limit and the arm falls behind; with
+:attr:`GeneratorSettings.stop_beyond_velocity_limit` (the arms' generators in a pour)
+:meth:`TrajectoryGenerator.set_target` raises :class:`UntrackablePathError` at the first such target instead, naming
+arm, joint, time and limit, so a run never continues on a path it cannot follow.
+
+ruckig's community build ignores position limits, so targets outside the joint range are clamped onto it (that joint
+then at rest) and counted in :attr:`clamped_targets`, and a joint whose time-optimal stop (plus one target interval of
+travel) would end beyond its range is sent to rest on the boundary, so the motion itself stays in range.
 
 Stopping is jerk-limited too: :meth:`hold` brakes to rest wherever the arm gets to (ruckig's velocity interface);
-``set_target(q, zeros, zeros)`` stops at ``q`` (for ``q`` = the current position the arm comes back to it). If no new
-target arrives after the last one is reached while the path was moving, the generator holds by itself instead of
-extrapolating the path's motion.
+``set_target(q, zeros, zeros)`` stops at ``q`` with ruckig (a target with its velocity and acceleration given is the
+path's state now, not a stream point; for ``q`` = the current position the arm comes back to it). If no new target
+arrives after the last segment or target is reached while the path was moving, the generator holds by itself instead
+of extrapolating the path's motion.
 
 Timing: the generator's clock :attr:`time` starts at 0 and advances by ``cycle_time`` per :meth:`step`;
 ``step()`` returns the state at the new time, the end of the MuJoCo step about to be taken (what a real arm's servo
@@ -83,6 +94,13 @@ TIME_EPSILON = 1e-9
 # Chosen on paths beyond the limits (a rate-limited tilt at 2 rad/s and 5 rad/s^2, the SIM excitation): of 0.1, 0.2,
 # 0.3 and 1 s, 0.3 s kept the vessel closest to them; the effect is erratic, such paths need smoothing upstream.
 MAX_HORIZON = 0.3
+# rad: the arm is on the spline path when its position, velocity x period and acceleration x period^2 differ from the
+# spline's by at most this: round-off of the knot formulas and of ruckig landing on a spline state (~1e-15 rad), far
+# below a path step (a joint at 0.01 rad/s moves 1e-4 rad per period).
+SPLINE_TOLERANCE = 1e-9
+# Periods by which the arm follows its target stream late: a segment played from the arrival of P_k ends on the knot of
+# P_{k-1} (the module docstring).
+STREAM_DELAY_PERIODS = 2
 
 
 @dataclass(frozen=True)
@@ -137,6 +155,45 @@ def _quadratic_derivatives(times: list[float], points: list[np.ndarray]) -> tupl
     return qd, qdd
 
 
+def _spline_state(points: np.ndarray, u: float, period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, qd, qdd)`` at ``u`` in [0, 1] of the uniform cubic B-spline segment with control points ``points``
+    (4, n) spaced ``period`` s (de Boor, A Practical Guide to Splines, 1978): ``q(u) = sum_i B_i(u) P_i`` with the
+    basis ``B = ((1-u)^3, 3u^3 - 6u^2 + 4, -3u^3 + 3u^2 + 3u + 1, u^3) / 6``; the velocity, the quadratic B-spline of
+    the differences ``D_i = P_{i+1} - P_i``, ``((1-u)^2 D_0 + (1 + 2u - 2u^2) D_1 + u^2 D_2) / (2 period)``; the
+    acceleration, the line between the second differences, ``((1-u) E_0 + u E_1) / period^2``. Written out term by
+    term (no BLAS, whose kernels round differently) and in differences, which keeps the velocity and acceleration
+    within the hull of theirs up to one rounding."""
+    w = 1.0 - u
+    p0, p1, p2, p3 = points
+    d0, d1, d2 = p1 - p0, p2 - p1, p3 - p2
+    position = (w * w * w * p0 + (3.0 * u**3 - 6.0 * u * u + 4.0) * p1 + (1.0 + 3.0 * u + 3.0 * u * u - 3.0 * u**3) * p2 + u**3 * p3) / 6.0
+    velocity = (w * w * d0 + (1.0 + 2.0 * u - 2.0 * u * u) * d1 + u * u * d2) / (2.0 * period)
+    acceleration = (w * (d1 - d0) + u * (d2 - d1)) / (period * period)
+    return position, velocity, acceleration
+
+
+def _peak_speed(points: np.ndarray, period: float) -> np.ndarray:
+    """(n,) rad/s: the largest speed over the B-spline segment with control points ``points`` (4, n) spaced
+    ``period`` s, exactly: its velocity ``(c0 + c1 u + c2 u^2) / (2 period)`` (:func:`_spline_state`) peaks at an end
+    or at its vertex ``u = -c1 / (2 c2)`` inside the segment."""
+    d0, d1, d2 = np.diff(points, axis=0)
+    c0, c1, c2 = d0 + d1, 2.0 * (d1 - d0), d0 - 2.0 * d1 + d2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        vertex = np.where(c2 != 0.0, -c1 / (2.0 * c2), 0.0)
+    vertex = np.clip(vertex, 0.0, 1.0)
+    speeds = [np.abs(c0 + c1 * u + c2 * u * u) for u in (0.0, 1.0, vertex)]
+    return np.max(speeds, axis=0) / (2.0 * period)
+
+
+def _control_points(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, period: float) -> list[np.ndarray]:
+    """Three control points (spaced ``period`` s) whose B-spline is at ``(q, qd, qdd)`` at the knot after the middle
+    one: ``P1 = q - qdd period^2 / 6``, ``P0, P2 = P1 -+ qd period + qdd period^2 / 2`` (inverting
+    ``q = (P0 + 4 P1 + P2) / 6``, ``qd = (P2 - P0) / (2 period)``, ``qdd = (P0 - 2 P1 + P2) / period^2``)."""
+    middle = q - qdd * period * period / 6.0
+    half = 0.5 * qdd * period * period
+    return [middle - qd * period + half, middle, middle + qd * period + half]
+
+
 def _clip(x: float, lo: float, hi: float) -> float:
     """``min(max(x, lo), hi)`` with numpy ``clip``'s tie-breaking (the second argument when neither is larger),
     so a signed zero comes out as numpy's does."""
@@ -170,7 +227,8 @@ class TrajectoryGenerator:
         self._lo, self._hi = limits.array("min_position"), limits.array("max_position")
         self._vmax, self._amax = limits.array("max_velocity"), limits.array("max_acceleration")
         self._lo_floats, self._hi_floats, self._vmax_floats = self._lo.tolist(), self._hi.tolist(), self._vmax.tolist()
-        self._jmax_floats = limits.array("max_jerk").tolist()
+        self._jmax = limits.array("max_jerk")
+        self._jmax_floats = self._jmax.tolist()
         q0 = _vector(f"{limits.arm}: start position", q0, n)
         outside = np.flatnonzero((q0 < self._lo) | (q0 > self._hi))
         if outside.size:
@@ -205,6 +263,10 @@ class TrajectoryGenerator:
         self._state = (q0.copy(), np.zeros(n), np.zeros(n))
         self._path = self._state  # the latest target path state (q, qd, qdd) at its time
         self._path_floats = tuple(a.tolist() for a in self._path)  # the same as lists of floats, for _predict
+        self._path_lead = 0.0  # s, how far ahead of now _path lies (a spline segment's end: one period)
+        self._points: list[np.ndarray] = []  # the spline path's last control points (at most four)
+        self._segment: tuple[np.ndarray, int] | None = None  # (control points (4, n), start step) of a spline segment
+        self._on_segment = False  # the last step followed the spline segment
         self._history_steps: list[int] = []  # step index of each recent target (at most three)
         self._history_q: list[np.ndarray] = []
         self._new_target = False
@@ -215,15 +277,19 @@ class TrajectoryGenerator:
 
     # ---- inputs ----------------------------------------------------------------------------------------------------
     def set_target(self, q: np.ndarray, qd: np.ndarray | None = None, qdd: np.ndarray | None = None) -> None:
-        """Track the joint target ``q`` (n,) rad, the path's position now; ``qd`` (n,) rad/s and ``qdd`` (n,) rad/s^2
-        are its velocity and acceleration now (estimated from the recent targets when ``None``). Components outside
-        the joint range are clamped onto it (counted in :attr:`clamped_targets`). Takes effect at the next
-        :meth:`step`."""
+        """Track the joint target ``q`` (n,) rad. Without ``qd`` and ``qdd``: the next point of the target stream,
+        followed on the B-spline through the stream (the module docstring). With them (rad/s, rad/s^2, either may be
+        ``None`` for the estimate from the recent targets): the path's state now, reached by ruckig (a stop:
+        ``set_target(q, zeros, zeros)``). Components outside the joint range are clamped onto it (counted in
+        :attr:`clamped_targets`). Takes effect at the next :meth:`step`."""
         n = len(self.limits.joints)
+        explicit = qd is not None or qdd is not None
         q = _vector(f"{self.limits.arm}: target position", q, n)
         if self._history_steps and self._history_steps[-1] == self._steps:  # a second target in the same cycle
             self._history_steps.pop()
             self._history_q.pop()
+            if self._points:
+                self._points.pop()
         if self._history_steps:
             interval = (self._steps - self._history_steps[-1]) * self.settings.cycle_time
         else:
@@ -231,20 +297,75 @@ class TrajectoryGenerator:
         clamped = (q < self._lo) | (q > self._hi)
         self._clamped += clamped
         q = np.clip(q, self._lo, self._hi)
-        error = float(np.max(np.abs(np.array(self._input.current_position) - q)))
-        self._max_target_error = max(self._max_target_error, error)
         self._history_steps = (self._history_steps + [self._steps])[-3:]
         self._history_q = (self._history_q + [q])[-3:]
         times = [s * self.settings.cycle_time for s in self._history_steps]
         est_qd, est_qdd = _quadratic_derivatives(times, self._history_q)
         qd = est_qd if qd is None else _vector(f"{self.limits.arm}: target velocity", qd, n)
         qdd = est_qdd if qdd is None else _vector(f"{self.limits.arm}: target acceleration", qdd, n)
+        if explicit:
+            if self.settings.stop_beyond_velocity_limit:
+                self._check_trackable(qd, clamped)
+            self._points, self._segment = [], None
+            error = float(np.max(np.abs(np.array(self._input.current_position) - q)))
+            self._follow_with_ruckig(q, qd, qdd, clamped, interval, 0.0, error)
+            return
+        period = self.settings.control_period
+        if len(self._points) < 3:  # a new stream: the spline starts from the arm's state
+            self._points = _control_points(*self._state, period)
+        self._points = self._points[-3:] + [q]
+        points = np.array(self._points)
         if self.settings.stop_beyond_velocity_limit:
-            self._check_trackable(qd, clamped)
+            self._check_trackable(_peak_speed(points, period), clamped)
+        start = _spline_state(points, 0.0, period)
+        end = _spline_state(points, 1.0, period)
+        error = float(np.max(np.abs(self._state[0] - start[0])))
+        offset = max(error, float(np.max(np.abs(self._state[1] - start[1]))) * period,
+                     float(np.max(np.abs(self._state[2] - start[2]))) * period * period)
+        if offset <= SPLINE_TOLERANCE and abs(interval - period) <= TIME_EPSILON and self._spline_within_limits(points, end):
+            self._max_target_error = max(self._max_target_error, error)
+            self._segment = (points, self._steps)
+            inp = self._input
+            inp.target_position, inp.target_velocity, inp.target_acceleration = (list(a) for a in end)
+            self._new_target = True
+            return
+        self._segment = None
+        self._follow_with_ruckig(end[0], end[1], end[2], clamped, interval, period, error)
+
+    def _spline_within_limits(self, points: np.ndarray, end: tuple[np.ndarray, np.ndarray, np.ndarray]) -> bool:
+        """Whether the B-spline segment with control points ``points`` (4, n) keeps every limit, exactly: its
+        velocity is a quadratic B-spline with control points ``dP / T``, its acceleration the line between the
+        ``d^2 P / T^2``, its jerk ``d^3 P / T^3`` (``T`` the control period), so each lies within the hull of those
+        differences; its positions lie within the hull of the control points, which must lie in the joint range (the
+        targets are clamped onto it, the points made from the arm's state may not be). And its end state is
+        admissible (:func:`_admissible_acceleration`), so that ruckig can take over from it within the limits."""
+        period = self.settings.control_period
+        if np.any((points < self._lo) | (points > self._hi)):  # a state's virtual control points may lie beyond
+            return False
+        if np.any(np.abs(np.diff(points, 1, axis=0)) > self._vmax * period):
+            return False
+        if np.any(np.abs(np.diff(points, 2, axis=0)) > self._amax * period**2):
+            return False
+        if np.any(np.abs(np.diff(points, 3, axis=0)) > self._jmax * period**3):
+            return False
+        _, v, a = end
+        return all(
+            _admissible_acceleration(vj, aj, vmax, jmax) == aj
+            for vj, aj, vmax, jmax in zip(v.tolist(), a.tolist(), self._vmax_floats, self._jmax_floats)
+        )
+
+    def _follow_with_ruckig(
+        self, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray, clamped: np.ndarray, interval: float, lead: float, error: float
+    ) -> None:
+        """Plan ruckig toward the path state ``(q, qd, qdd)`` (n,) at ``lead`` s from now (0: a target now; one
+        period: a spline segment's end), clamped joints at rest, made admissible, met at the shortest horizon
+        (:meth:`_intercept_horizon`); ``error`` (rad) is the arm's distance to the path now."""
+        self._max_target_error = max(self._max_target_error, error)
         qd = np.where(clamped, 0.0, np.clip(qd, -self._vmax, self._vmax))
         qdd = np.where(clamped, 0.0, np.clip(qdd, -self._amax, self._amax))
         self._path = self._stop_at_range(q, qd, qdd, interval)
         self._path_floats = tuple(a.tolist() for a in self._path)
+        self._path_lead = lead
         horizon = self._intercept_horizon(interval)
         self._late_targets += horizon > interval + TIME_EPSILON
         inp = self._input
@@ -254,8 +375,9 @@ class TrajectoryGenerator:
         self._new_target = True
 
     def _check_trackable(self, qd: np.ndarray, clamped: np.ndarray) -> None:
-        """Raise :class:`UntrackablePathError` for the first joint (not clamped onto its range) whose path velocity
-        ``qd`` (n,) rad/s is above its ``max_velocity``."""
+        """Raise :class:`UntrackablePathError` for the first joint (not clamped onto its range) whose path speed
+        ``qd`` (n,) rad/s (a target's velocity, or the peak over the spline segment a stream point starts) is above
+        its ``max_velocity``."""
         beyond = np.flatnonzero(~clamped & (np.abs(qd) > self._vmax))
         if beyond.size:
             j = int(beyond[0])
@@ -287,7 +409,8 @@ class TrajectoryGenerator:
         return target, np.where(braking, 0.0, qd), np.where(braking, 0.0, qdd)
 
     def _predict(self, tau: float) -> tuple[list[float], list[float], list[float]]:
-        """The target path's state ``tau`` s ahead, extrapolated at constant acceleration, made admissible: velocity
+        """The target path's state ``tau`` s ahead (``tau`` minus the path state's own lead beyond its time),
+        extrapolated at constant acceleration, made admissible: velocity
         and acceleration clamped to the limits, the acceleration then to what the velocity limit leaves
         (:func:`_admissible_acceleration`), positions clamped to the joint range (those joints then at rest).
 
@@ -296,6 +419,7 @@ class TrajectoryGenerator:
         tie-breaking of numpy's ``clip`` (``_clip``): the same bits as the array expressions."""
         pos, vel, acc = [], [], []
         limits = zip(self._lo_floats, self._hi_floats, self._vmax_floats, self._jmax_floats)
+        tau = tau - self._path_lead
         for q, qd, qdd, (lo, hi, vmax, jmax) in zip(*self._path_floats, limits):
             p = q + qd * tau + 0.5 * qdd * tau * tau
             if p < lo or p > hi:
@@ -355,7 +479,9 @@ class TrajectoryGenerator:
         self._state = (q.copy(), qd.copy(), qdd.copy())
         self._path = self._state
         self._path_floats = tuple(a.tolist() for a in self._path)
+        self._path_lead = 0.0
         self._history_steps, self._history_q = [], []
+        self._points, self._segment = [], None
         self._new_target = True
 
     def hold(self) -> None:
@@ -368,27 +494,43 @@ class TrajectoryGenerator:
         inp.target_velocity = [0.0] * n
         inp.target_acceleration = [0.0] * n
         self._history_steps, self._history_q = [], []
+        self._points, self._segment = [], None
         self._new_target = True
 
     # ---- stepping --------------------------------------------------------------------------------------------------
     def step(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Advance one cycle; returns ``(q, qd, qdd)`` (n,) at the new :attr:`time` (rad, rad/s, rad/s^2)."""
         inp = self._input
+        if self._segment is not None and not self._new_target and self._segment_u(self._steps) >= 1.0 - TIME_EPSILON:
+            self._segment = None  # the segment is played to its end and no next target came
         if self._finished and not self._new_target and self._target_moving():
             self.hold()  # the last target was reached and no new one came: do not extrapolate its motion
-        try:
-            result = self._otg.update(inp, self._output)
-        except ruckig.RuckigError as exc:
-            raise SimulationError(f"{self.limits.arm}: ruckig refused the input at t={self.time:.4f} s: {exc}") from None
-        if result not in (ruckig.Result.Working, ruckig.Result.Finished):
-            raise SimulationError(f"{self.limits.arm}: ruckig failed at t={self.time:.4f} s: {result}")
-        out = self._output
-        out.pass_to_input(inp)
+        if self._segment is not None:
+            state = _spline_state(self._segment[0], self._segment_u(self._steps + 1), self.settings.control_period)
+            inp.current_position, inp.current_velocity, inp.current_acceleration = (a.tolist() for a in state)
+            self._on_segment = True
+            self._finished = self._segment_u(self._steps + 1) >= 1.0 - TIME_EPSILON
+        else:
+            try:
+                result = self._otg.update(inp, self._output)
+            except ruckig.RuckigError as exc:
+                raise SimulationError(f"{self.limits.arm}: ruckig refused the input at t={self.time:.4f} s: {exc}") from None
+            if result not in (ruckig.Result.Working, ruckig.Result.Finished):
+                raise SimulationError(f"{self.limits.arm}: ruckig failed at t={self.time:.4f} s: {result}")
+            out = self._output
+            out.pass_to_input(inp)
+            self._on_segment = False
+            self._finished = result == ruckig.Result.Finished
+            state = (self._in_range(out.new_position), np.array(out.new_velocity), np.array(out.new_acceleration))
         self._steps += 1
         self._new_target = False
-        self._finished = result == ruckig.Result.Finished
-        self._state = (np.array(out.new_position), np.array(out.new_velocity), np.array(out.new_acceleration))
+        self._state = state
         return self.state
+
+    def _segment_u(self, step: int) -> float:
+        """The spline segment's parameter in [0, 1] at generator step ``step``."""
+        assert self._segment is not None
+        return (step - self._segment[1]) * self.settings.cycle_time / self.settings.control_period
 
     def state_at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(q, qd, qdd)`` (n,) at time ``t`` s inside the last step, ``[time - cycle_time, time]`` (the exact motion
@@ -397,9 +539,19 @@ class TrajectoryGenerator:
             return self.state
         if not self.time - self.settings.cycle_time - TIME_EPSILON <= t <= self.time:
             raise ValueError(f"t={t!r} s is outside the last step [{self.time - self.settings.cycle_time!r}, {self.time!r}] s")
+        if self._on_segment:
+            assert self._segment is not None
+            points, start = self._segment
+            u = (t - start * self.settings.cycle_time) / self.settings.control_period
+            return _spline_state(points, min(max(u, 0.0), 1.0), self.settings.control_period)
         out = self._output
         q, qd, qdd = out.trajectory.at_time(max(out.time - (self.time - t), 0.0))
-        return np.array(q), np.array(qd), np.array(qdd)
+        return self._in_range(q), np.array(qd), np.array(qdd)
+
+    def _in_range(self, q: list[float]) -> np.ndarray:
+        """ruckig's positions (rad) clipped onto the joint range: its braking onto a boundary lands on it up to
+        round-off (measured: 1e-12 rad beyond), which the range check must not see."""
+        return np.clip(np.array(q), self._lo, self._hi)
 
     # ---- state -----------------------------------------------------------------------------------------------------
     @property

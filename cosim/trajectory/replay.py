@@ -14,7 +14,17 @@ Errors, sampled at every step (world frame, SI units):
 * peak actuator torque as a fraction of each joint's torque limit (1.0 = saturated).
 
 Verdict (:meth:`ReplayReport.failures`): the replay passes a tolerance (m) when every vessel's lip stays within it
-of its commanded path (largest lip path error) and nothing collides; :data:`DEFAULT_TOLERANCE_M` is 2 mm.
+of its commanded path (largest lip path error, with the time it occurs) and nothing collides;
+:data:`DEFAULT_TOLERANCE_M` is 2 mm, about the shift of the stream's landing point such an error causes, small
+against the catcher's opening.
+
+What the lip path error is. The payload is rigid and the servos' gravity compensation knows it exactly, so at rest
+the lip is where commanded: the error is the servos' dynamic lag behind the commanded motion. A PD servo without
+inertia feedforward needs a position error of about ``M qdd / Kp`` to accelerate the arm, so the error follows the
+commanded acceleration: the verdict says whether the trajectory's accelerations are ones the servos track within
+the tolerance. With ``DYNAMICS`` feedforward (the servo knows the motion's inertia torques, as a real arm's
+model-based controller does; ``cosim replay``'s default) that lag is removed and what remains is the servos' response
+to what the feedforward misses: the commanded motion between samples (interpolated) and the servos' own transients.
 
 Feedforward (:class:`Feedforward`): gravity compensation is part of the model (the servos always get it, computed
 from the model including the rigid payload, as a UR controller does from its configured payload). ``DYNAMICS`` adds
@@ -55,7 +65,8 @@ class ReplayReport:
     """Tracking results of one replay (see the module docstring for definitions).
 
     joint_names: (J,) the trajectory's joints. joint_max_error, joint_rms_error: (J,) rad.
-    lip_max_error, lip_rms_error: m, per vessel name. peak_torque_fraction: (J,), |tau| / limit.
+    lip_max_error, lip_rms_error: m, per vessel name; lip_max_time: s, per vessel, when its largest error occurred.
+    peak_torque_fraction: (J,), |tau| / limit.
     duration: s simulated. steps: simulation steps. timestep: s.
     first_contact: the first contact, or None. contact_steps: steps with at least one contact.
     """
@@ -71,6 +82,7 @@ class ReplayReport:
     timestep: float
     first_contact: ContactEvent | None
     contact_steps: int
+    lip_max_time: dict[str, float] = field(default_factory=dict)
     pour_vessel: str = field(default="pourer")
 
     @property
@@ -82,7 +94,7 @@ class ReplayReport:
         """Why the replay fails at ``tolerance`` (m): one line per vessel lip whose largest path error exceeds it and
         one for a contact; empty when it passes."""
         lines = [
-            f"{vessel} lip path error {error * 1000:.3f} mm above {tolerance * 1000:.3f} mm"
+            f"{vessel} lip path error {error * 1000:.3f} mm (at t={self.lip_max_time.get(vessel, math.nan):.3f} s) above {tolerance * 1000:.3f} mm"
             for vessel, error in self.lip_max_error.items()
             if error > tolerance
         ]
@@ -105,6 +117,7 @@ class ReplayReport:
             "joint_rms_error_rad": dict(zip(self.joint_names, map(float, self.joint_rms_error))),
             "lip_max_error_m": dict(self.lip_max_error),
             "lip_rms_error_m": dict(self.lip_rms_error),
+            "lip_max_time_s": dict(self.lip_max_time),
             "peak_torque_fraction": dict(zip(self.joint_names, map(float, self.peak_torque_fraction))),
             "duration_s": self.duration,
             "steps": self.steps,
@@ -168,6 +181,7 @@ def replay(scene: RobotScene, trajectory: JointTrajectory, feedforward: Feedforw
     max_joint = np.zeros_like(sq_joint)
     lip_sq = {name: 0.0 for name in vessels}
     lip_max = {name: 0.0 for name in vessels}
+    lip_max_time = {name: trajectory.time[0] for name in vessels}
     peak_torque = np.zeros_like(sq_joint)
     first_contact, contact_steps = None, 0
     for k in range(steps):
@@ -186,7 +200,8 @@ def replay(scene: RobotScene, trajectory: JointTrajectory, feedforward: Feedforw
         for name, arm in vessels.items():
             e = float(np.linalg.norm(fk.site_xpos[arm.lip_site] - measured.site_xpos[arm.lip_site]))
             lip_sq[name] += e * e
-            lip_max[name] = max(lip_max[name], e)
+            if e > lip_max[name]:
+                lip_max[name], lip_max_time[name] = e, t
         if data.ncon > 0:
             contact_steps += 1
             if first_contact is None:
@@ -218,5 +233,6 @@ def replay(scene: RobotScene, trajectory: JointTrajectory, feedforward: Feedforw
         timestep=dt,
         first_contact=first_contact,
         contact_steps=contact_steps,
+        lip_max_time=lip_max_time,
         pour_vessel=scene.arms[ArmRole.POUR].vessel.name,
     )

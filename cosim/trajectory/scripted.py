@@ -6,8 +6,9 @@ previous solution, to :data:`SCRIPT_IK` tolerances), streams the joint targets i
 per arm as the coupling does (``set_target`` every ``target_period``, ``step`` every MuJoCo time step), then brings
 both arms to rest on the last target, samples at ``sample_rate_hz`` and checks the result (:func:`check_trajectory`).
 
-Target ``k`` is sent at ``k * target_period`` as the path's state at that time, like a live target; the generator
-extrapolates it one period ahead, so the trajectory follows the script without lag.
+The generator follows its target stream :data:`cosim.trajectory.generator.STREAM_DELAY_PERIODS` periods late (on the
+B-spline through the targets), so target ``k`` is sent that many periods before its time: the script is known in
+advance, and the trajectory follows it without lag.
 
 ``python -m cosim.tools.scripted_pour --out DIR`` writes the files of such a trajectory.
 """
@@ -26,7 +27,7 @@ from cosim.robots.planar import PlanarPose
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
-from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
+from cosim.trajectory.generator import STREAM_DELAY_PERIODS, GeneratorSettings, TrajectoryGenerator
 from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits, scene_limits
 from cosim.trajectory.pour_motion import PourMotionSpec, task_poses
@@ -46,7 +47,8 @@ class ScriptedRun:
 
     trajectory: the checked samples of both arms (columns in :class:`ArmRole` order).
     limits: the arms' limits, column order. sample_rate_hz: Hz.
-    targets: per arm, (K, n) rad, the IK joint target sent at ``k * target_period``.
+    targets: per arm, (K, n) rad, the IK joint target for ``k * target_period`` (sent
+    :data:`STREAM_DELAY_PERIODS` periods earlier).
     clamped_targets: per joint, targets clamped onto the joint range.
     late_targets, max_target_error: per arm, :attr:`TrajectoryGenerator.late_targets` and
     :attr:`TrajectoryGenerator.max_target_error` (rad).
@@ -97,7 +99,11 @@ def generate_scripted(
         targets[role].append(seeds[role])
         return seeds[role]
 
-    generators = {r: TrajectoryGenerator(limits[r], solve(r, 0), settings) for r in roles}
+    count = counts.pop()
+    for k in range(count):
+        for r in roles:
+            solve(r, k)
+    generators = {r: TrajectoryGenerator(limits[r], targets[r][0], settings) for r in roles}
     recorder = TrajectoryRecorder([generators[r] for r in roles], sample_rate_hz)
 
     def advance(steps: int) -> None:
@@ -106,9 +112,9 @@ def generate_scripted(
                 g.step()
             recorder.record()
 
-    for k in range(counts.pop()):
+    for k in range(count):
         for r in roles:
-            generators[r].set_target(targets[r][0] if k == 0 else solve(r, k))
+            generators[r].set_target(targets[r][min(k + STREAM_DELAY_PERIODS, count - 1)])
         advance(per_target)
     for r in roles:
         zero = np.zeros(len(limits[r].joints))
