@@ -41,7 +41,7 @@ def jet_path(
 
 
 def weir_velocity(h_q: float, discharge_coefficient: float, gravity: float = GRAVITY) -> float:
-    """Mean outflow velocity over a sharp crest (seed Sec. 2.2): v_q = (2/3) C_d sqrt(2 g h_q) (m/s); 0 if h_q <= 0."""
+    """Mean outflow velocity over a sharp crest (Camporredondo et al. 2019, Sec. 2.2): v_q = (2/3) C_d sqrt(2 g h_q) (m/s); 0 if h_q <= 0."""
     return (2.0 / 3.0) * discharge_coefficient * math.sqrt(2.0 * gravity * max(h_q, 0.0))
 
 

@@ -1,7 +1,7 @@
-"""Where the SPH stream actually lands, against where the catcher controller predicted it would (issue 4).
+"""Where the SPH stream actually lands, against where the catcher controller predicted it would.
 
 The controller predicts, each control step, the world x at which liquid leaving the pour lip *now* crosses the
-height of vessel B's rim (seed Eqs. 6-7 with the SPH v_q). The liquid it speaks about arrives there one fall time
+height of vessel B's rim (Camporredondo et al. 2019, Eqs. 6-7, with the SPH v_q). The liquid it speaks about arrives there one fall time
 later. So the prediction made at the launch time t_l = t - t_fall is compared with the stream measured crossing the
 rim plane at t: the median x of the falling particles in a thin band around the rim height
 (:meth:`cosim.coupling.measure.LiquidProbe.stream_crossing_x`, on the fluid's device).

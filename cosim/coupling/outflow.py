@@ -1,6 +1,6 @@
-"""When the outflow starts and when it becomes steady: the measure of issue 4's SIM-against-open-loop comparison.
+"""When the outflow starts and when it becomes steady: the measure of the SIM-against-open-loop comparison.
 
-The point of SIM (seed Sec. 3.1) is to reach a steady outflow sooner. Steady here: the outflow rate, averaged over
+The point of SIM (Camporredondo et al. 2019, Sec. 3.1) is to reach a steady outflow sooner. Steady here: the outflow rate, averaged over
 a trailing window of RATE_WINDOW s, stays within +-STEADY_TOLERANCE of its own mean for STEADY_HOLD s, that mean
 being at least MIN_RATE_FRACTION of the run's peak rate (a trickle is not the pour). The window smooths the
 particle-count steps of the SPH volume (one particle of the default 2-D scene is 3.6 mL). The steady outflow is

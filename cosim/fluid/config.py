@@ -1,8 +1,8 @@
 """Fluid configuration: frozen dataclasses validated on construction (SI units).
 
-Defaults follow the seed (Tait EOS, rho0 = 1000 kg/m^3, gamma = 7) with the changes DESIGN.md requires: an
-artificial speed of sound c0 = ``sound_speed_factor`` x ``max_expected_speed`` (>= 10 v_max keeps the density error
-near 1 %, see shared/reference/README.md) instead of the seed's 1480 m/s, delta-SPH density diffusion and a CFL
+Defaults follow Camporredondo et al. (2019) (Tait EOS, rho0 = 1000 kg/m^3, gamma = 7) with the weakly compressible
+form of Monaghan (1994): an artificial speed of sound c0 = ``sound_speed_factor`` x ``max_expected_speed``
+(>= 10 v_max keeps the density error near (v_max / c0)^2 = 1 %) instead of the paper's 1480 m/s, delta-SPH density diffusion and a CFL
 time step that includes the vessel wall speed.
 """
 
@@ -27,7 +27,7 @@ MAX_CPU_THREADS = 256  # most threads a CPU substep may be split over (FluidConf
 class KernelType(Enum):
     """SPH smoothing kernel (both with compact support 2h)."""
 
-    CUBIC_SPLINE = "cubic_spline"  # Monaghan (1992) M4 spline, the seed's kernel
+    CUBIC_SPLINE = "cubic_spline"  # Monaghan (1992) M4 spline, the paper's kernel
     WENDLAND_C2 = "wendland_c2"  # Wendland (1995) C2; no pairing instability at large neighbour counts
 
 

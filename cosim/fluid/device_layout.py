@@ -3,9 +3,9 @@
 The CPU runs a particle kernel as one loop per lane (``cosim.fluid.lanes``): a particle's data should be contiguous
 for the cache. CUDA runs a thread per particle in warps of 32 that load together: the same field of 32 neighbouring
 particles should be contiguous (coalesced loads), and no one address should take an atomic from every particle.
-The first profile on an H200 (``python -m cosim.bench.kernel_profile``, 3-D WCSPH at 1M particles, 21.6 ms a
-substep) found all three costs: the pair loops reading rows of the pair tables (compute_density_rate 4.1 ms), the
-wrench reduction's 64 sequential chunks (4.8 ms) and integrate's atomics on one diagnostics row (4.4 ms).
+A kernel profile on a GPU (``python -m cosim.bench.kernel_profile``, 3-D WCSPH at 1M particles; figures in
+docs/benchmarks.md) shows all three costs: the pair loops reading rows of the pair tables, the wrench reduction's
+sequential chunks and integrate's atomics on one diagnostics row.
 
 - Pair tables (n x capacity, indexed ``[i, k]``): a row per particle on the CPU; on CUDA stored slot-major
   (capacity x n) and passed transposed, so ``[i, k]`` of 32 consecutive particles is 32 consecutive addresses. The

@@ -60,8 +60,8 @@ substep.
 The stopping test reads one int32 flag that ``check_convergence`` writes on the device, driven by
 ``wp.capture_while``: captured, it becomes a conditional graph node on CUDA and a while operation of warp's
 operation stream on the CPU; launched one by one, warp reads the flag each iteration (on CUDA through a copy to
-the host). Run on an H200 (2026-12-04, ``python -m cosim.bench.device_check``): captured and launched one by one,
-the CUDA runs gave the same results to the bit (docs/benchmarks.md, On the GPU).
+the host). Captured and launched one by one, CUDA runs give the same results to the bit
+(``python -m cosim.bench.device_check``; docs/benchmarks.md, On the GPU).
 The average error is summed as integers (quanta of ``ERROR_QUANTUM``) so it does not depend on the order of the atomic adds: the
 iteration count, and with it the trajectory, is deterministic on every device.
 
@@ -109,7 +109,7 @@ from cosim.fluid.sph_kernels import kernel_w
 # blows up), a small one leaves the whole hydrostatic load to the Jacobi iterations. Measured: density 0.5 leaves the
 # least motion in a resting column (max speed after 1 s at 12 particles across 0.069 m/s; 0.25 / 0.75: 0.046 /
 # 0.108 with no divergence warm start); the divergence warm start trades that motion against the shallow slosh
-# frequency (A = 54 mm, seed Eq. 17): 0.5 gives -2.3 % and 0.069 m/s, 0.25 -6.4 % and 0.059 m/s, 0 -10.2 % and
+# frequency (A = 54 mm, Eq. 17 of Camporredondo et al. 2019): 0.5 gives -2.3 % and 0.069 m/s, 0.25 -6.4 % and 0.059 m/s, 0 -10.2 % and
 # 0.032 m/s. 0.5 for both, as SPlisHSPlasH.
 WARM_START_DENSITY = wp.constant(0.5)
 WARM_START_DIVERGENCE = wp.constant(0.5)

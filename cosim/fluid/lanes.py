@@ -27,7 +27,7 @@ from typing import Callable, Sequence, Union
 import warp as wp
 
 # Fewest particles per lane the automatic thread count gives a lane. Measured on the 2-core CPU (a resting 2-D tank,
-# `python -m cosim.fluid.benchmark --counts2d 400 800 1600 --solvers dfsph wcsph --threads 1 2`): 2 lanes run 1.57,
+# `python -m cosim.bench.fluid_throughput --counts2d 400 800 1600 --solvers dfsph wcsph --threads 1 2`): 2 lanes run 1.57,
 # 1.52 and 1.79 x the particle-steps of one under DFSPH at 400, 784 and 1600 particles, 1.58, 1.74 and 1.84 x under
 # WCSPH; smaller liquids were not measured (the benchmark's tank needs 400), so 400 particles get 2 lanes, fewer one.
 MIN_PARTICLES_PER_LANE = 200

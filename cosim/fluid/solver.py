@@ -17,7 +17,7 @@ or DFSPH (``cosim.fluid.dfsph``)
 entirely on the device (no host copies inside; only the interval's plan and its diagnostics cross; DFSPH's
 convergence loops read a device flag through ``wp.capture_while``, see ``cosim.fluid.dfsph``). From the second
 interval on each substep is replayed as one captured graph: a CUDA graph on a CUDA device (the same results to the
-bit as the launches on an H200, ``python -m cosim.bench.device_check``), on the CPU warp's operation stream
+bit as the launches, ``python -m cosim.bench.device_check``), on the CPU warp's operation stream
 (APIC), which replays the launches in C++ without Python's per-launch argument handling (same results to the bit,
 tests/test_fluid_graphs.py). On the CPU the particle kernels are split over threads, each replaying its own graph of
 its share of the particles with barriers between the stages (``cosim.fluid.lanes``, ``cpu_threads``; same results to

@@ -1,6 +1,6 @@
 """SPH smoothing kernels (warp functions), both with compact support 2h, for 2-D and 3-D.
 
-Cubic spline: Monaghan (1992), the seed's kernel; sigma = 10/(7 pi h^2) (2-D), 1/(pi h^3) (3-D).
+Cubic spline: Monaghan (1992), the kernel of Camporredondo et al. (2019); sigma = 10/(7 pi h^2) (2-D), 1/(pi h^3) (3-D).
 Wendland C2: Wendland (1995), W = sigma (1 - q/2)^4 (2q + 1); sigma = 7/(4 pi h^2) (2-D), 21/(16 pi h^3) (3-D).
 q = r / h. ``kind`` is :class:`cosim.fluid.config.KernelType` as an int (see ``KERNEL_IDS``).
 """

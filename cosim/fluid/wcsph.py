@@ -57,7 +57,7 @@ MIN_DENSITY_RATIO = wp.constant(0.8)
 
 @wp.func
 def tait_pressure(prm: SPHParams, rho: float) -> float:
-    """Tait equation of state (seed Eq. 5) with the artificial sound speed, p = B ((rho/rho0)^gamma - 1), its
+    """Tait equation of state (Camporredondo et al. 2019, Eq. 5) with the artificial sound speed, p = B ((rho/rho0)^gamma - 1), its
     tension clamped at ``max_tension`` (``FluidConfig.max_tension``)."""
     return wp.max(prm.eos_b * (wp.pow(rho / prm.rest_density, prm.gamma) - 1.0), -prm.max_tension)
 

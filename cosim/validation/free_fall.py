@@ -7,7 +7,7 @@ velocities at every 2 ms sample): its launch state is taken at the first sample 
 ``launch_spacings`` particle spacings beyond the lip (the outer top edge of the wall the liquid sees), outside the
 vessel; it lands where it first crosses the plane ``drop`` below the lip (linear interpolation between samples).
 Its landing error is the landed x minus the x its own launch state predicts for free fall (z = z0 + v_z t -
-g t^2 / 2, x = x0 + v_x t; shared/reference/README.md, "free fall of the outflow jet").
+g t^2 / 2, x = x0 + v_x t; the ballistic jet of Camporredondo et al. 2019, Eqs. 6-7).
 
 This isolates the liquid's physics from the controller's measurement of the jet (``cosim pour``'s landing
 prediction from the mean outflow velocity at the lip): a stream that the liquid's own forces pull back while it
