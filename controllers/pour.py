@@ -105,6 +105,8 @@ class PourController:
         # the outflow rate, for the after-flow prediction, which scales that rate by (head / this)^(3/2)
         self._h_q = math.nan
         self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
+        self._theta1_rate = 0.0  # rad/s, of the measured free-surface angle over the last step
+        self._last_theta1 = 0.0
         self._last_poured = 0.0
         self._sigma_prev = 0.0
         self._since = math.nan  # start of the current settle (SIM_DAMP) or max-tilt (CFS) interval, s
@@ -164,6 +166,8 @@ class PourController:
             gain = min((m.t - self._last_t) / OUTFLOW_FILTER_TIME, 1.0)
             self._outflow_rate += gain * (rate - self._outflow_rate)
             self._h_q += gain * (max(m.h_q, 0.0) - self._h_q)
+            self._theta1_rate = (m.theta1 - self._last_theta1) / (m.t - self._last_t)
+        self._last_theta1 = m.theta1
         self._last_t, self._last_poured = m.t, m.poured_volume
 
         for _ in Phase:  # a step may pass several phases; each at most once
@@ -215,9 +219,13 @@ class PourController:
             # filter lags a large excitation) would otherwise be a step in the path it passes to the arm.
             self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
             self._reference = self._damp_reference(m)
-            self._pid.reset(u0=self.pose.theta, y0=m.theta1, r0=self._reference)
+            # Bumpless in rate too: the PID's first outputs continue the command's motion (at rest in the hold) with
+            # the measured surface moving at its current rate; a PID started at rest with the surface moving steps
+            # its output's rate, which the arm can only follow at its jerk limit.
+            self._pid.reset(u0=self.pose.theta, y0=m.theta1, r0=self._reference, y_rate=self._theta1_rate,
+                            u_rate=self._tilt_rate)
+            self._smoother.reset(self.pose.theta, self._tilt_rate)
             self._held_tilt = self.pose.theta
-            self._smoother.reset(self.pose.theta)
         elif phase is Phase.APPROACH:
             self._reference = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
             self._approach.reset(self.pose.theta)

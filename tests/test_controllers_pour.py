@@ -242,6 +242,22 @@ def test_commands_move_without_steps() -> None:
     assert all(c.catcher.dz == 0.0 and c.catcher.theta == 0.0 for c in trace.commands)
 
 
+def test_slosh_damping_starts_without_a_step_in_the_command_rate() -> None:
+    """The PID starts bumpless in rate: its first two commands continue the hold (at rest), though the surface
+    moves fast at the slosh's zero crossing and the reference is off the held tilt. (Started with its derivative at
+    rest, the second command moved by 0.4 mrad, an acceleration step of 4 rad/s^2 within one period.)"""
+    config = _config(target_volume=0.3 * _config().initial_volume)
+    _, _, trace = _run(config, duration=3.0, arm_delay_steps=8)
+    phases = _phases(trace)
+    k = int(np.argmax(phases == Phase.SIM_DAMP))
+    theta = np.array([c.pourer.theta for c in trace.commands])
+    assert np.all(np.diff(theta[k - 3:k + 1]) == 0.0)  # the hold
+    assert abs(np.diff(trace.series("theta1"))[k - 1]) / config.dt > 0.1  # rad/s: the surface is moving
+    assert abs(theta[k + 1] - theta[k]) <= 1e-3 * config.sim.max_tilt_rate * config.dt
+    acceleration = np.diff(theta[k - 1:k + 20], 2) / config.dt**2
+    assert np.max(np.abs(np.diff(acceleration[:3]))) < 2.5  # rad/s^2 per period
+
+
 def test_catcher_sits_under_the_predicted_landing_point_in_cfs() -> None:
     config = _config(target_volume=0.3 * _config().initial_volume)
     _, _, trace = _run(config)
