@@ -168,17 +168,34 @@ class CfsConfig:
 
 @dataclass(frozen=True)
 class ReturnConfig:
-    """Back upright after the pour, rate- and acceleration-limited (no back-slosh over the rim).
+    """Back upright after the pour, rate-, acceleration- and jerk-limited (no back-slosh over the rim).
 
-    max_rate: rad/s. (0, 3]   max_accel: rad/s^2. (0, 20]
+    max_rate: rad/s. (0, 3]   max_accel: rad/s^2, turning back. (0, 20]   max_jerk: rad/s^3. (0, 1000]
+    stop_accel: rad/s^2, slowing down into upright. (0, max_accel]
+    The stop is gentler than the turn so that a follower that lags the return stops with it well within its own
+    limits. The arms get the path through a task-space filter that approaches each target as one to stop at, with
+    limits that keep the arms' joints within theirs for a tilt alone (A = 2.5 rad/s^2, 20 rad/s^3): at rate v it
+    lags by about its stopping distance L(v) = v^2 / (2 A). While the return slows at a, that lag shrinks at
+    a v / A, so the follower moves at v (1 + a / A) and slows at a (1 + a / A). The return's straight line in
+    (dx, dz, theta) adds a translation to the tilt, which the joints carry too, so that is held to half the tilt's
+    limit: a (1 + a / A) <= A / 2, i.e. stop_accel <= (sqrt(3) - 1) / 2 A = 0.9 rad/s^2. (With the stop at 2.5 or
+    1.5 rad/s^2 the follower stopped at its limits after the return had ended, and the joints, asked for more than
+    their acceleration limit, followed in a catch-up.) The turn back starts from the pour's slow tilt rate, where
+    the follower's lag is small; it stays as brisk as before, which the partial pour's stop prediction relies on
+    (the after-flow while the crest rises over the head). The jerk: half the follower's, its lag adding to the jerk
+    it needs as to the acceleration.
     """
 
     max_rate: float = 1.0
     max_accel: float = 2.5
+    max_jerk: float = 10.0
+    stop_accel: float = 0.9
 
     def __post_init__(self) -> None:
         check_range("returning.max_rate", self.max_rate, 0.0, 3.0, "rad/s", lo_open=True)
         check_range("returning.max_accel", self.max_accel, 0.0, 20.0, "rad/s^2", lo_open=True)
+        check_range("returning.max_jerk", self.max_jerk, 0.0, 1000.0, "rad/s^3", lo_open=True)
+        check_range("returning.stop_accel", self.stop_accel, 0.0, self.max_accel, "rad/s^2", lo_open=True)
 
 
 @dataclass(frozen=True)

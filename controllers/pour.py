@@ -35,7 +35,7 @@ from controllers.config import Damping, Handover, PourConfig, SimMode
 from controllers.errors import ControllerInputError, MeasurementError
 from controllers.geometry import PlanarPose, static_tilt_for_h_q
 from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
-from controllers.motion import CriticallyDampedSmoother, RateLimitedTracker, fitted_delay
+from controllers.motion import CriticallyDampedSmoother, JerkLimitedMove, RateLimitedTracker, fitted_delay
 from controllers.pid import DiscretePid, PidDesign, design_filtered_pid
 from controllers.slosh_induction import excitation_duration, excitation_tilt, sim_needed
 
@@ -86,7 +86,6 @@ class PourController:
         self.sim_frequency = sim.frequency_ratio * self.model.omega1  # alpha, rad/s
         self.sim_amplitude = math.nan  # phi, rad; set from the first measurement's volume
         self._approach = RateLimitedTracker(config.approach.max_rate, config.approach.max_accel, self.dt)
-        self._return = RateLimitedTracker(config.returning.max_rate, config.returning.max_accel, self.dt)
         c = config.catcher
         self._catcher = CatcherFollower(
             c.home_x, (c.travel_min, c.travel_max), c.max_speed, c.max_accel, self.dt, c.filter_time
@@ -115,6 +114,7 @@ class PourController:
         self._reference = 0.0  # rad, tilt reference of SIM_DAMP / target of APPROACH
         self._held_tilt = 0.0  # rad, SIM_DAMP's open-loop tilt command (sim.damping = hold)
         self._return_from = PlanarPose()
+        self._return: JerkLimitedMove | None = None
 
         self._check: dict[Phase, Callable[[LiquidMeasurement], Transition]] = {
             Phase.IDLE: self._check_idle,
@@ -235,7 +235,18 @@ class PourController:
             self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
         elif phase is Phase.RETURN:
             self._return_from = self.pose
-            self._return.reset(self.pose.theta, self._tilt_rate)  # brakes the forward motion it inherits
+            ret = self.config.returning
+            # from the pour's tilt rate (its mean over the last LAG_WINDOW s: the last step's CFS increment jitters)
+            rate = min(max(self._mean_tilt_rate(), -ret.max_rate), ret.max_rate)
+            self._return = JerkLimitedMove(self.pose.theta, rate, 0.0, ret.max_rate, ret.max_accel, ret.max_jerk,
+                                           ret.stop_accel)
+
+    def _mean_tilt_rate(self) -> float:
+        """rad/s, of the commanded tilt over the last LAG_WINDOW s of steps (0 before two steps)."""
+        if len(self._tilt_history) < 2:
+            return 0.0
+        (t0, theta0, _), (t1, theta1, _) = self._tilt_history[0], self._tilt_history[-1]
+        return (theta1 - theta0) / (t1 - t0)
 
     def _lag(self) -> float:
         """Time (s) the vessel runs behind its commanded tilt, fitted over the last LAG_WINDOW s of steps."""
@@ -276,7 +287,12 @@ class PourController:
             # head both decay after an earlier spill, and their ratio rate / head^(3/2), which the prediction scales
             # by, grows without bound as they do.)
             head = self._h_q if m.h_q > 0.0 else 0.0
-            after = after_flow_volume(self._outflow_rate, head, lever, ret.max_rate, ret.max_accel, self._tilt_rate, lag)
+            # The return's jerk limit ramps its acceleration up over max_accel / max_jerk s, which after the ramp
+            # leaves it where the acceleration-limited turn would be max_accel / (2 max_jerk) s earlier: that delay
+            # counts as lag (the positions differ by max_accel^3 / (24 max_jerk^2), 1.4 mrad with the defaults).
+            ramp = ret.max_accel / (2.0 * ret.max_jerk)
+            after = after_flow_volume(self._outflow_rate, head, lever, ret.max_rate, ret.max_accel,
+                                      self._mean_tilt_rate(), lag + ramp)
             after = min(after, m.volume_in_pourer)  # what is there is the most that can still leave
             to_go = target - m.poured_volume - after
             if to_go <= 0.0:
@@ -379,8 +395,13 @@ class PourController:
         return None
 
     def _check_return(self, m: LiquidMeasurement) -> Transition:
-        if self._return.at(0.0, ARRIVAL_TOLERANCE):
-            return Phase.DONE, "upright at home"
+        """Done once the command is upright at rest and the vessel has stopped following it (it moved less than
+        ARRIVAL_TOLERANCE over the last step): the pour is over when the vessel is, not its command."""
+        assert self._return is not None
+        if self._elapsed(m) + self.dt < self._return.duration or len(self._tilt_history) < 2:
+            return None
+        if abs(m.tilt - self._tilt_history[-1][2]) <= ARRIVAL_TOLERANCE:
+            return Phase.DONE, "upright at home, the vessel at rest"
         return None
 
     # ---- actions ----------------------------------------------------------------------------------------------
@@ -419,8 +440,9 @@ class PourController:
         return self.pose.rotated_about(pivot, min(max(theta + step, 0.0), cfs.max_tilt))
 
     def _act_return(self, m: LiquidMeasurement) -> PlanarPose:
+        assert self._return is not None
         start = self._return_from
-        theta = self._return.step(0.0)
+        theta = self._return.at(self._elapsed(m) + self.dt)
         f = min(max(theta / start.theta, 0.0), 1.0) if start.theta > 0.0 else 0.0
         return PlanarPose(start.dx * f, start.dz * f, theta)
 

@@ -258,6 +258,30 @@ def test_slosh_damping_starts_without_a_step_in_the_command_rate() -> None:
     assert np.max(np.abs(np.diff(acceleration[:3]))) < 2.5  # rad/s^2 per period
 
 
+def test_return_is_jerk_limited_and_ends_with_the_vessel_at_rest() -> None:
+    """The return's tilt command keeps the return's acceleration and jerk limits (a gentler stop than turn), so a
+    follower with finite jerk stays on it; the pour is done when the vessel (here an arm 8 periods late) has stopped, not when its command
+    has."""
+    config = _config(target_volume=0.3 * _config().initial_volume)
+    _, _, trace = _run(config, arm_delay_steps=8)
+    phases = _phases(trace)
+    ret, dt = config.returning, config.dt
+    back = np.flatnonzero(phases == Phase.RETURN)
+    theta = np.array([c.pourer.theta for c in trace.commands])[back[0] - 1:back[-1] + 2]
+    assert theta[-1] == 0.0
+    acceleration = np.diff(theta, 2) / dt**2
+    assert np.min(acceleration) >= -ret.max_accel * (1 + 1e-6)  # turning back
+    assert np.max(acceleration) <= ret.stop_accel * (1 + 1e-6)  # slowing down into upright
+    assert np.max(acceleration) >= 0.99 * ret.stop_accel  # ... which takes the whole of that limit
+    assert np.max(np.abs(np.diff(theta, 3)[1:])) / dt**3 <= ret.max_jerk * (1 + 1e-6)
+    assert trace.commands[-1].phase is Phase.DONE
+    tilt = trace.series("tilt")
+    assert abs(tilt[-1] - tilt[-2]) <= 1e-4  # the vessel at rest
+    assert abs(tilt[-1]) <= 1e-3  # rad: the last of a jerk-limited stop moves less than 1e-4 rad a period
+    upright = int(np.argmax(theta == 0.0)) + back[0] - 1  # the first step commanding upright
+    assert len(trace.commands) - 1 > upright  # done after the command arrived, once the vessel has
+
+
 def test_catcher_sits_under_the_predicted_landing_point_in_cfs() -> None:
     config = _config(target_volume=0.3 * _config().initial_volume)
     _, _, trace = _run(config)
