@@ -104,6 +104,7 @@ class PourController:
         # the outflow rate, for the after-flow prediction, which scales that rate by (head / this)^(3/2)
         self._h_q = math.nan
         self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
+        self._cfs_head = 0.0  # m, the measured h_q through CFS's head filter (cfs.head_filter_fraction)
         self._theta1_rate = 0.0  # rad/s, of the measured free-surface angle over the last step
         self._last_theta1 = 0.0
         self._last_poured = 0.0
@@ -211,6 +212,7 @@ class PourController:
         self.phase, self.reason, self._phase_start = phase, reason, m.t
         self._since = math.nan
         self._cfs_history.clear()
+        self._cfs_head = m.h_q  # the head filter starts on the measurement (no step into CFS)
         if phase is Phase.SIM_HOLD:
             self._sigma_prev = m.slosh_angle
         elif phase is Phase.SIM_DAMP:
@@ -426,11 +428,13 @@ class PourController:
 
     def _act_cfs(self, m: LiquidMeasurement) -> PlanarPose:
         cfs, geom, theta = self.config.cfs, self.config.vessel, self.pose.theta
+        tau = cfs.head_filter_fraction * cfs.time_constant
+        self._cfs_head += (1.0 - math.exp(-self.dt / tau) if tau > 0.0 else 1.0) * (m.h_q - self._cfs_head)
         step = cfs_increment(
             geom,
             theta,
             self._area(m),
-            m.h_q,
+            self._cfs_head,
             self._head_reference(self.phase),
             self.dt / cfs.time_constant,
             self._outflow_rate * self.dt,
