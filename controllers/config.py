@@ -142,6 +142,14 @@ class CfsConfig:
       (and with it the after-flow the stop has to predict) is smaller when it stops; 1 disables the stage. (0, 1]
     final_stage_time: s, the final stage starts when the volume still to pour before the predicted after-flow
       would leave in this time at the current outflow rate. [0, 10]
+    head_filter_fraction: the law reads the measured h_q through a first-order low-pass whose time constant is
+      this fraction of time_constant (0: unfiltered). [0, 1] The SPH head is quantised by the particles at the
+      crest, and the law would turn each sample's noise into a tilt increment. Linearised, the integral law with
+      a lag tau in its loop is tau T s^2 + T s + 1 (T = time_constant), damped at zeta = sqrt(T / tau) / 2; the
+      loop's lag is this filter's plus the arm's (its task-space filter and servos: 0.08-0.1 s in the coupled
+      pour). zeta >= 0.7 needs their sum <= T / 2 = 0.15 s, which leaves at most 0.05 s for the filter; the
+      default, 0.1 T = 0.03 s, keeps a margin for the slosh mode the law also acts on. (At 0.25 T a partial pour
+      with an arm 90 ms late on the pendulum plant stopped 12 % short.)
     """
 
     h_q_ref: float = 0.005
@@ -153,6 +161,7 @@ class CfsConfig:
     pivot_margin: float = 0.1
     final_head_fraction: float = 0.5
     final_stage_time: float = 0.8
+    head_filter_fraction: float = 0.1
 
     def __post_init__(self) -> None:
         check_range("cfs.h_q_ref", self.h_q_ref, 0.001, CFS_MAX_HEAD, "m")
@@ -164,21 +173,39 @@ class CfsConfig:
         check_range("cfs.pivot_margin", self.pivot_margin, 0.0, 0.2, "m")
         check_range("cfs.final_head_fraction", self.final_head_fraction, 0.0, 1.0, lo_open=True)
         check_range("cfs.final_stage_time", self.final_stage_time, 0.0, 10.0, "s")
+        check_range("cfs.head_filter_fraction", self.head_filter_fraction, 0.0, 1.0)
 
 
 @dataclass(frozen=True)
 class ReturnConfig:
-    """Back upright after the pour, rate- and acceleration-limited (no back-slosh over the rim).
+    """Back upright after the pour, rate-, acceleration- and jerk-limited (no back-slosh over the rim).
 
-    max_rate: rad/s. (0, 3]   max_accel: rad/s^2. (0, 20]
+    max_rate: rad/s. (0, 3]   max_accel: rad/s^2, turning back. (0, 20]   max_jerk: rad/s^3. (0, 1000]
+    stop_accel: rad/s^2, slowing down into upright. (0, max_accel]
+    The stop is gentler than the turn so that a follower that lags the return stops with it well within its own
+    limits. The arms get the path through a task-space filter that approaches each target as one to stop at, with
+    limits that keep the arms' joints within theirs for a tilt alone (A = 2.5 rad/s^2, 20 rad/s^3): at rate v it
+    lags by about its stopping distance L(v) = v^2 / (2 A). While the return slows at a, that lag shrinks at
+    a v / A, so the follower moves at v (1 + a / A) and slows at a (1 + a / A). The return's straight line in
+    (dx, dz, theta) adds a translation to the tilt, which the joints carry too, so that is held to half the tilt's
+    limit: a (1 + a / A) <= A / 2, i.e. stop_accel <= (sqrt(3) - 1) / 2 A = 0.9 rad/s^2. (With the stop at 2.5 or
+    1.5 rad/s^2 the follower stopped at its limits after the return had ended, and the joints, asked for more than
+    their acceleration limit, followed in a catch-up.) The turn back starts from the pour's slow tilt rate, where
+    the follower's lag is small; it stays as brisk as before, which the partial pour's stop prediction relies on
+    (the after-flow while the crest rises over the head). The jerk: half the follower's, its lag adding to the jerk
+    it needs as to the acceleration.
     """
 
     max_rate: float = 1.0
     max_accel: float = 2.5
+    max_jerk: float = 10.0
+    stop_accel: float = 0.9
 
     def __post_init__(self) -> None:
         check_range("returning.max_rate", self.max_rate, 0.0, 3.0, "rad/s", lo_open=True)
         check_range("returning.max_accel", self.max_accel, 0.0, 20.0, "rad/s^2", lo_open=True)
+        check_range("returning.max_jerk", self.max_jerk, 0.0, 1000.0, "rad/s^3", lo_open=True)
+        check_range("returning.stop_accel", self.stop_accel, 0.0, self.max_accel, "rad/s^2", lo_open=True)
 
 
 @dataclass(frozen=True)

@@ -1,8 +1,8 @@
-"""Rate- and acceleration-limited 1-D tracking: moves a coordinate toward a target without large steps; and the
-delay of a follower behind its command.
+"""Rate- and acceleration-limited 1-D tracking: moves a coordinate toward a target without large steps; a
+jerk-limited move to rest; and the delay of a follower behind its command.
 
-Used for the catcher's position (m), the approach tilt and the return tilt (rad). Units follow the coordinate:
-``max_rate`` per second, ``max_accel`` per second squared, ``dt`` in s.
+Used for the catcher's position (m), the approach tilt (rad) and, jerk-limited, the return tilt (rad). Units follow
+the coordinate: ``max_rate`` per second, ``max_accel`` per second squared, ``max_jerk`` per second cubed, ``dt`` in s.
 """
 
 from __future__ import annotations
@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import ruckig
 
 from controllers.checks import check_range
 
@@ -41,6 +42,43 @@ class RateLimitedTracker:
     def at(self, target: float, tol: float) -> bool:
         """True when within ``tol`` of ``target`` and (almost) at rest."""
         return abs(target - self.position) <= tol and abs(self.velocity) <= self.max_accel * self.dt
+
+
+class JerkLimitedMove:
+    """The time-optimal move of one coordinate from ``position`` at ``velocity`` (and zero acceleration) to rest at
+    ``target`` within rate, acceleration and jerk limits (ruckig's profile): continuous in acceleration, so a
+    follower with finite jerk can stay on it. The acceleration stays within [-max_accel, max_accel], and within
+    ``stop_accel`` (default max_accel) in the direction that slows a move toward the target (so a move can set
+    off briskly and stop gently). :meth:`at` samples it at a time (s) since the start."""
+
+    def __init__(self, position: float, velocity: float, target: float, max_rate: float, max_accel: float,
+                 max_jerk: float, stop_accel: float | None = None) -> None:
+        check_range("move.max_rate", max_rate, 0.0, None, lo_open=True)
+        check_range("move.max_accel", max_accel, 0.0, None, lo_open=True)
+        check_range("move.max_jerk", max_jerk, 0.0, None, lo_open=True)
+        stop = max_accel if stop_accel is None else check_range("move.stop_accel", stop_accel, 0.0, max_accel, lo_open=True)
+        inp = ruckig.InputParameter(1)
+        inp.current_position, inp.current_velocity, inp.current_acceleration = [position], [velocity], [0.0]
+        inp.target_position, inp.target_velocity, inp.target_acceleration = [target], [0.0], [0.0]
+        inp.max_velocity, inp.max_jerk = [max_rate], [max_jerk]
+        # toward a lower target the stop accelerates upward: the upper bound is the stop's, and the other way round
+        down = target < position
+        inp.max_acceleration, inp.min_acceleration = ([stop], [-max_accel]) if down else ([max_accel], [-stop])
+        self._trajectory = ruckig.Trajectory(1)
+        # the start's rate lies within max_rate (a return starts from the pour's slow tilt rate): always solvable
+        ruckig.Ruckig(1).calculate(inp, self._trajectory)
+        self.target = float(target)
+
+    @property
+    def duration(self) -> float:
+        """s, until at rest on the target."""
+        return float(self._trajectory.duration)
+
+    def at(self, t: float) -> float:
+        """Position at ``t`` s after the start (the target from :attr:`duration` on)."""
+        if t >= self.duration:
+            return self.target
+        return float(self._trajectory.at_time(max(t, 0.0))[0][0])
 
 
 class CriticallyDampedSmoother:

@@ -407,11 +407,21 @@ class DiscretePid:
         self.t_track = max(math.sqrt(max(gains.kd, 0.0) / gains.ki), dt)
         self.reset(u0=0.0, y0=0.0, r0=0.0)
 
-    def reset(self, u0: float, y0: float, r0: float) -> None:
-        """Bumpless start: the next :meth:`step` with (r0, y0) outputs exactly ``u0``."""
-        self._integral = u0 - self.gains.kp * (r0 - y0)
-        self._deriv = 0.0
-        self._y_prev = y0
+    def reset(self, u0: float, y0: float, r0: float, y_rate: float = 0.0, u_rate: float = 0.0) -> None:
+        """Bumpless start in value and rate: the next :meth:`step` with (r0, y0) outputs exactly ``u0``, and the one
+        after it, with the reference unchanged and the measurement moved on at ``y_rate`` (rad/s), ``u0 + u_rate dt``
+        (within the limits). The integral I and the derivative's filter state D are solved for those two outputs:
+        with a = tf / (tf + dt), b = kd / (tf + dt), e = r0 - y0 and the measurement's last value y0 - y_rate dt,
+        D1 = a D - b y_rate dt and u0 = kp e + I + D1; the second output's change kp (-y_rate dt) + dt ki e + (a - 1) D1
+        - b y_rate dt = u_rate dt gives D1 = -(tf + dt) (u_rate + (kp + b) y_rate - ki e).
+        Only the controller's initial state is chosen: its dynamics, and so the loop's design, are unchanged; D's
+        departure from its steady value decays with the derivative filter's time constant tf."""
+        k, dt = self.gains, self.dt
+        e, b = r0 - y0, k.kd / (k.tf + dt)
+        d1 = -(k.tf + dt) * (u_rate + (k.kp + b) * y_rate - k.ki * e)
+        self._deriv = (d1 + b * y_rate * dt) * (k.tf + dt) / k.tf
+        self._integral = u0 - k.kp * e - d1
+        self._y_prev = y0 - y_rate * dt
         self._u_prev = u0
 
     def step(self, r: float, y: float) -> float:

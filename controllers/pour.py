@@ -35,7 +35,7 @@ from controllers.config import Damping, Handover, PourConfig, SimMode
 from controllers.errors import ControllerInputError, MeasurementError
 from controllers.geometry import PlanarPose, static_tilt_for_h_q
 from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
-from controllers.motion import CriticallyDampedSmoother, RateLimitedTracker, fitted_delay
+from controllers.motion import CriticallyDampedSmoother, JerkLimitedMove, RateLimitedTracker, fitted_delay
 from controllers.pid import DiscretePid, PidDesign, design_filtered_pid
 from controllers.slosh_induction import excitation_duration, excitation_tilt, sim_needed
 
@@ -86,7 +86,6 @@ class PourController:
         self.sim_frequency = sim.frequency_ratio * self.model.omega1  # alpha, rad/s
         self.sim_amplitude = math.nan  # phi, rad; set from the first measurement's volume
         self._approach = RateLimitedTracker(config.approach.max_rate, config.approach.max_accel, self.dt)
-        self._return = RateLimitedTracker(config.returning.max_rate, config.returning.max_accel, self.dt)
         c = config.catcher
         self._catcher = CatcherFollower(
             c.home_x, (c.travel_min, c.travel_max), c.max_speed, c.max_accel, self.dt, c.filter_time
@@ -105,6 +104,9 @@ class PourController:
         # the outflow rate, for the after-flow prediction, which scales that rate by (head / this)^(3/2)
         self._h_q = math.nan
         self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
+        self._cfs_head = 0.0  # m, the measured h_q through CFS's head filter (cfs.head_filter_fraction)
+        self._theta1_rate = 0.0  # rad/s, of the measured free-surface angle over the last step
+        self._last_theta1 = 0.0
         self._last_poured = 0.0
         self._sigma_prev = 0.0
         self._since = math.nan  # start of the current settle (SIM_DAMP) or max-tilt (CFS) interval, s
@@ -113,6 +115,7 @@ class PourController:
         self._reference = 0.0  # rad, tilt reference of SIM_DAMP / target of APPROACH
         self._held_tilt = 0.0  # rad, SIM_DAMP's open-loop tilt command (sim.damping = hold)
         self._return_from = PlanarPose()
+        self._return: JerkLimitedMove | None = None
 
         self._check: dict[Phase, Callable[[LiquidMeasurement], Transition]] = {
             Phase.IDLE: self._check_idle,
@@ -164,6 +167,8 @@ class PourController:
             gain = min((m.t - self._last_t) / OUTFLOW_FILTER_TIME, 1.0)
             self._outflow_rate += gain * (rate - self._outflow_rate)
             self._h_q += gain * (max(m.h_q, 0.0) - self._h_q)
+            self._theta1_rate = (m.theta1 - self._last_theta1) / (m.t - self._last_t)
+        self._last_theta1 = m.theta1
         self._last_t, self._last_poured = m.t, m.poured_volume
 
         for _ in Phase:  # a step may pass several phases; each at most once
@@ -207,6 +212,7 @@ class PourController:
         self.phase, self.reason, self._phase_start = phase, reason, m.t
         self._since = math.nan
         self._cfs_history.clear()
+        self._cfs_head = m.h_q  # the head filter starts on the measurement (no step into CFS)
         if phase is Phase.SIM_HOLD:
             self._sigma_prev = m.slosh_angle
         elif phase is Phase.SIM_DAMP:
@@ -215,9 +221,13 @@ class PourController:
             # filter lags a large excitation) would otherwise be a step in the path it passes to the arm.
             self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
             self._reference = self._damp_reference(m)
-            self._pid.reset(u0=self.pose.theta, y0=m.theta1, r0=self._reference)
+            # Bumpless in rate too: the PID's first outputs continue the command's motion (at rest in the hold) with
+            # the measured surface moving at its current rate; a PID started at rest with the surface moving steps
+            # its output's rate, which the arm can only follow at its jerk limit.
+            self._pid.reset(u0=self.pose.theta, y0=m.theta1, r0=self._reference, y_rate=self._theta1_rate,
+                            u_rate=self._tilt_rate)
+            self._smoother.reset(self.pose.theta, self._tilt_rate)
             self._held_tilt = self.pose.theta
-            self._smoother.reset(self.pose.theta)
         elif phase is Phase.APPROACH:
             self._reference = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
             self._approach.reset(self.pose.theta)
@@ -227,7 +237,18 @@ class PourController:
             self.pose = self.pose.rotated_about((0.0, 0.0), m.tilt)
         elif phase is Phase.RETURN:
             self._return_from = self.pose
-            self._return.reset(self.pose.theta, self._tilt_rate)  # brakes the forward motion it inherits
+            ret = self.config.returning
+            # from the pour's tilt rate (its mean over the last LAG_WINDOW s: the last step's CFS increment jitters)
+            rate = min(max(self._mean_tilt_rate(), -ret.max_rate), ret.max_rate)
+            self._return = JerkLimitedMove(self.pose.theta, rate, 0.0, ret.max_rate, ret.max_accel, ret.max_jerk,
+                                           ret.stop_accel)
+
+    def _mean_tilt_rate(self) -> float:
+        """rad/s, of the commanded tilt over the last LAG_WINDOW s of steps (0 before two steps)."""
+        if len(self._tilt_history) < 2:
+            return 0.0
+        (t0, theta0, _), (t1, theta1, _) = self._tilt_history[0], self._tilt_history[-1]
+        return (theta1 - theta0) / (t1 - t0)
 
     def _lag(self) -> float:
         """Time (s) the vessel runs behind its commanded tilt, fitted over the last LAG_WINDOW s of steps."""
@@ -268,7 +289,12 @@ class PourController:
             # head both decay after an earlier spill, and their ratio rate / head^(3/2), which the prediction scales
             # by, grows without bound as they do.)
             head = self._h_q if m.h_q > 0.0 else 0.0
-            after = after_flow_volume(self._outflow_rate, head, lever, ret.max_rate, ret.max_accel, self._tilt_rate, lag)
+            # The return's jerk limit ramps its acceleration up over max_accel / max_jerk s, which after the ramp
+            # leaves it where the acceleration-limited turn would be max_accel / (2 max_jerk) s earlier: that delay
+            # counts as lag (the positions differ by max_accel^3 / (24 max_jerk^2), 1.4 mrad with the defaults).
+            ramp = ret.max_accel / (2.0 * ret.max_jerk)
+            after = after_flow_volume(self._outflow_rate, head, lever, ret.max_rate, ret.max_accel,
+                                      self._mean_tilt_rate(), lag + ramp)
             after = min(after, m.volume_in_pourer)  # what is there is the most that can still leave
             to_go = target - m.poured_volume - after
             if to_go <= 0.0:
@@ -371,8 +397,13 @@ class PourController:
         return None
 
     def _check_return(self, m: LiquidMeasurement) -> Transition:
-        if self._return.at(0.0, ARRIVAL_TOLERANCE):
-            return Phase.DONE, "upright at home"
+        """Done once the command is upright at rest and the vessel has stopped following it (it moved less than
+        ARRIVAL_TOLERANCE over the last step): the pour is over when the vessel is, not its command."""
+        assert self._return is not None
+        if self._elapsed(m) + self.dt < self._return.duration or len(self._tilt_history) < 2:
+            return None
+        if abs(m.tilt - self._tilt_history[-1][2]) <= ARRIVAL_TOLERANCE:
+            return Phase.DONE, "upright at home, the vessel at rest"
         return None
 
     # ---- actions ----------------------------------------------------------------------------------------------
@@ -397,11 +428,13 @@ class PourController:
 
     def _act_cfs(self, m: LiquidMeasurement) -> PlanarPose:
         cfs, geom, theta = self.config.cfs, self.config.vessel, self.pose.theta
+        tau = cfs.head_filter_fraction * cfs.time_constant
+        self._cfs_head += (1.0 - math.exp(-self.dt / tau) if tau > 0.0 else 1.0) * (m.h_q - self._cfs_head)
         step = cfs_increment(
             geom,
             theta,
             self._area(m),
-            m.h_q,
+            self._cfs_head,
             self._head_reference(self.phase),
             self.dt / cfs.time_constant,
             self._outflow_rate * self.dt,
@@ -411,8 +444,9 @@ class PourController:
         return self.pose.rotated_about(pivot, min(max(theta + step, 0.0), cfs.max_tilt))
 
     def _act_return(self, m: LiquidMeasurement) -> PlanarPose:
+        assert self._return is not None
         start = self._return_from
-        theta = self._return.step(0.0)
+        theta = self._return.at(self._elapsed(m) + self.dt)
         f = min(max(theta / start.theta, 0.0), 1.0) if start.theta > 0.0 else 0.0
         return PlanarPose(start.dx * f, start.dz * f, theta)
 

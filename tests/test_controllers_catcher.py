@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from controllers.catcher import CatcherFollower, fall_time, jet_path, landing_x, weir_velocity
-from controllers.motion import CriticallyDampedSmoother, RateLimitedTracker, fitted_delay, stop_time
+from controllers.motion import CriticallyDampedSmoother, JerkLimitedMove, RateLimitedTracker, fitted_delay, stop_time
 from controllers.slosh import GRAVITY
 
 EXACT = 1e-12  # m: closed-form identities in float64
@@ -69,6 +69,31 @@ def test_tracker_respects_rate_and_acceleration_and_arrives() -> None:
     assert pos[300] == pytest.approx(target, abs=1e-9)
     assert np.max(pos) <= target + 0.5 * DT * DT + 1e-12  # no overshoot beyond one step of acceleration
     assert stop_time(0.15, 0.2, 0.5) == pytest.approx(0.15 / 0.2 + 0.2 / (2 * 0.5))
+
+
+def test_jerk_limited_move_keeps_its_limits_and_stops_on_the_target() -> None:
+    """From 1.5 rad moving on at 0.05 rad/s, to rest at 0: within rate, acceleration and jerk (sampled finely),
+    continuous in acceleration from the start (which is at zero acceleration), at rest on the target at its end."""
+    move = JerkLimitedMove(1.5, 0.05, 0.0, max_rate=1.0, max_accel=1.5, max_jerk=10.0)
+    h = 1e-3
+    t = np.arange(0.0, move.duration + 0.2, h)
+    p = np.array([move.at(x) for x in t])
+    v, a, j = np.diff(p) / h, np.diff(p, 2) / h**2, np.diff(p, 3) / h**3
+    assert p[0] == 1.5 and p[-1] == 0.0 and move.at(move.duration) == 0.0
+    assert v[0] == pytest.approx(0.05, abs=1e-4) and abs(a[0]) <= 10.0 * h * (1 + 1e-3)
+    assert np.max(np.abs(v)) <= 1.0 + 1e-6
+    assert np.max(np.abs(a)) <= 1.5 + 1e-3
+    assert np.max(np.abs(j)) <= 10.0 * (1 + 1e-3)
+    assert np.min(p) >= -1e-9  # no overshoot
+    # a stop within the acceleration limit and a 10 rad/s^3 ramp takes longer than without the ramp
+    assert move.duration > stop_time(1.5, 1.0, 1.5)
+    # a gentler stop: the acceleration that slows the move (here upward, the move going down) within stop_accel
+    gentle = JerkLimitedMove(1.5, 0.05, 0.0, max_rate=1.0, max_accel=1.5, max_jerk=10.0, stop_accel=0.5)
+    a = np.diff([gentle.at(x) for x in np.arange(0.0, gentle.duration + 0.2, h)], 2) / h**2
+    assert np.min(a) == pytest.approx(-1.5, abs=1e-3) and np.max(a) == pytest.approx(0.5, abs=1e-3)
+    up = JerkLimitedMove(-1.0, 0.0, 0.0, max_rate=1.0, max_accel=1.5, max_jerk=10.0, stop_accel=0.5)
+    a = np.diff([up.at(x) for x in np.arange(0.0, up.duration + 0.2, h)], 2) / h**2
+    assert np.max(a) == pytest.approx(1.5, abs=1e-3) and np.min(a) == pytest.approx(-0.5, abs=1e-3)
 
 
 def test_follower_clips_travel_and_never_steps() -> None:

@@ -158,6 +158,30 @@ def test_discrete_pid_is_its_discrete_transfer_function() -> None:
     assert np.allclose(u, u_tf, rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.parametrize("y_rate, u_rate", [(0.0, 0.0), (0.4, 0.0), (-0.3, 0.05)])
+def test_discrete_pid_restarts_bumpless_in_value_and_rate(y_rate: float, u_rate: float) -> None:
+    """reset(u0, y0, r0, y_rate, u_rate): the first output is u0 and the second u0 + u_rate dt while the measurement
+    moves on at y_rate, with a tracking error at the start (where the start with the derivative at rest steps the
+    output's rate); afterwards it is the same PID: its outputs' differences follow its transfer function."""
+    gains = design_filtered_pid(SEED).gains
+    u0, y0, r0 = 0.2, 0.05, 0.12
+    pid = DiscretePid(gains, DT, -1e9, 1e9, 1e9)
+    pid.reset(u0=u0, y0=y0, r0=r0, y_rate=y_rate, u_rate=u_rate)
+    y = y0 + y_rate * DT * np.arange(200) + 0.01 * np.sin(np.arange(200) * DT * 12.0)
+    u = _run_pid(pid, np.full_like(y, r0), y)
+    assert u[0] == pytest.approx(u0, abs=1e-12)
+    # the sinusoid's own contribution to the second output is kp and kd/(tf+dt) times its first step
+    drift = (gains.kp + gains.kd / (gains.tf + DT)) * (y[1] - y0 - y_rate * DT)
+    assert u[1] - u[0] == pytest.approx(u_rate * DT - drift, abs=1e-12)
+    # the same controller from there on: a change of the measurement after the start changes the output as C(z) does
+    delta = np.concatenate([[0.0], np.random.default_rng(5).normal(0.0, 0.01, y.size - 1)])
+    other = DiscretePid(gains, DT, -1e9, 1e9, 1e9)
+    other.reset(u0=u0, y0=y0, r0=r0, y_rate=y_rate, u_rate=u_rate)
+    changed = _run_pid(other, np.full_like(y, r0), y + delta)
+    _, response = ct.forced_response(gains.discrete_tf(DT), T=np.arange(y.size) * DT, U=-delta)
+    assert np.allclose(changed - u, response, rtol=1e-9, atol=1e-12)
+
+
 def test_discrete_loop_on_the_sampled_plant_settles() -> None:
     """DiscretePid and the smoother in closed loop with the exact sampled plant (ZOH input, theta1 measured before
     each new command), stepped by hand: it settles to the reference; its poles are those of the design's check."""

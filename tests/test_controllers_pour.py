@@ -242,6 +242,68 @@ def test_commands_move_without_steps() -> None:
     assert all(c.catcher.dz == 0.0 and c.catcher.theta == 0.0 for c in trace.commands)
 
 
+def test_slosh_damping_starts_without_a_step_in_the_command_rate() -> None:
+    """The PID starts bumpless in rate: its first two commands continue the hold (at rest), though the surface
+    moves fast at the slosh's zero crossing and the reference is off the held tilt. (Started with its derivative at
+    rest, the second command moved by 0.4 mrad, an acceleration step of 4 rad/s^2 within one period.)"""
+    config = _config(target_volume=0.3 * _config().initial_volume)
+    _, _, trace = _run(config, duration=3.0, arm_delay_steps=8)
+    phases = _phases(trace)
+    k = int(np.argmax(phases == Phase.SIM_DAMP))
+    theta = np.array([c.pourer.theta for c in trace.commands])
+    assert np.all(np.diff(theta[k - 3:k + 1]) == 0.0)  # the hold
+    assert abs(np.diff(trace.series("theta1"))[k - 1]) / config.dt > 0.1  # rad/s: the surface is moving
+    assert abs(theta[k + 1] - theta[k]) <= 1e-3 * config.sim.max_tilt_rate * config.dt
+    acceleration = np.diff(theta[k - 1:k + 20], 2) / config.dt**2
+    assert np.max(np.abs(np.diff(acceleration[:3]))) < 2.5  # rad/s^2 per period
+
+
+def test_return_is_jerk_limited_and_ends_with_the_vessel_at_rest() -> None:
+    """The return's tilt command keeps the return's acceleration and jerk limits (a gentler stop than turn), so a
+    follower with finite jerk stays on it; the pour is done when the vessel (here an arm 8 periods late) has stopped, not when its command
+    has."""
+    config = _config(target_volume=0.3 * _config().initial_volume)
+    _, _, trace = _run(config, arm_delay_steps=8)
+    phases = _phases(trace)
+    ret, dt = config.returning, config.dt
+    back = np.flatnonzero(phases == Phase.RETURN)
+    theta = np.array([c.pourer.theta for c in trace.commands])[back[0] - 1:back[-1] + 2]
+    assert theta[-1] == 0.0
+    acceleration = np.diff(theta, 2) / dt**2
+    assert np.min(acceleration) >= -ret.max_accel * (1 + 1e-6)  # turning back
+    assert np.max(acceleration) <= ret.stop_accel * (1 + 1e-6)  # slowing down into upright
+    assert np.max(acceleration) >= 0.99 * ret.stop_accel  # ... which takes the whole of that limit
+    assert np.max(np.abs(np.diff(theta, 3)[1:])) / dt**3 <= ret.max_jerk * (1 + 1e-6)
+    assert trace.commands[-1].phase is Phase.DONE
+    tilt = trace.series("tilt")
+    assert abs(tilt[-1] - tilt[-2]) <= 1e-4  # the vessel at rest
+    assert abs(tilt[-1]) <= 1e-3  # rad: the last of a jerk-limited stop moves less than 1e-4 rad a period
+    upright = int(np.argmax(theta == 0.0)) + back[0] - 1  # the first step commanding upright
+    assert len(trace.commands) - 1 > upright  # done after the command arrived, once the vessel has
+
+
+def test_cfs_reads_the_head_through_its_filter() -> None:
+    """A head measurement with white noise (0.5 mm, as from particles at the crest): the CFS law turns less of it
+    into tilt increments with the head filter than without (a first-order low-pass with gain a = 1 - exp(-dt / tau)
+    passes a / (2 - a) of white noise's variance: 0.16 at tau = 0.03 s), and still holds h_q."""
+    rough = {}
+    for fraction in (0.0, 0.1):
+        base = _config(target_volume=0.5 * _config().initial_volume)
+        config = dataclasses.replace(base, cfs=dataclasses.replace(base.cfs, head_filter_fraction=fraction))
+        controller = PourController(config)
+        plant = ModelPlant(ModelPlantConfig(vessel=config.vessel, fill_depth=config.fill_depth), config.dt)
+        rng = np.random.default_rng(7)
+        measure = plant.measure
+        plant.measure = lambda: dataclasses.replace(m := measure(), h_q=m.h_q + rng.normal(0.0, 0.5e-3))
+        trace = run_closed_loop(controller, plant, 12.0)
+        cfs = _phases(trace) == Phase.CFS
+        theta = np.array([c.pourer.theta for c in trace.commands])[cfs][200:]  # 2 s into CFS
+        rough[fraction] = np.std(np.diff(theta, 2))
+        head = trace.series("h_q")[cfs][200:]  # as measured, with the noise (its mean is the plant's to 0.02 mm)
+        assert abs(np.mean(head) - config.cfs.h_q_ref) <= H_Q_TOL
+    assert rough[0.1] < 0.5 * rough[0.0]
+
+
 def test_catcher_sits_under_the_predicted_landing_point_in_cfs() -> None:
     config = _config(target_volume=0.3 * _config().initial_volume)
     _, _, trace = _run(config)
