@@ -81,7 +81,8 @@ def open_recorder(pour: CoupledPour, path: Path, settings, name: str, scene_toml
     frames = [scene.model.site(scene.arms[role].frame_site).name for role in ROLES]
     dim = fluid.config.dim
     note = (
-        f"2-D liquid: drawn is the pour-plane slice (y = 0) of a liquid {1e3 * fluid.config.depth_2d:g} mm deep."
+        "2-D liquid: drawn is the pour-plane slice (y = 0); the liquid is as deep as the vessel holding it "
+        f"({1e3 * fluid.config.depth_2d:g} mm in the pourer and in the stream; the catcher's depth once caught)."
         if dim == 2 else ""
     )
     return PourRecorder(
