@@ -6,12 +6,9 @@ Each control step the crest has to come down, relative to the liquid, by a heigh
 over the lip dropped this step"; here dh has two parts, which make it a feedback law that a sloshing liquid
 tolerates:
 
-* the level drop of this step, from the outflow: outflow rate * dt / (inner depth * free-surface chord)
+* the level drop of this step, from the measured outflow: outflow rate * dt / (inner depth * free-surface chord)
   (feed-forward: the draining vessel needs a steadily growing tilt; without it the integral law below lags
-  a ramp with a constant error). The rate is the weir law's at the measured head with the pourer's own discharge
-  coefficient (:mod:`controllers.discharge`), not the measured outflow: that counts the particles leaving, and
-  each one steps the measured rate by its volume over the step, where the head moves by fractions of a particle;
-  the coefficient, which changes only with the tilt, is estimated from that count over a second;
+  a ramp with a constant error);
 * a correction of the fraction dt / time_constant of the error h_ref - h_q (time_constant = dt would be the
   paper's one-step correction). Linearised, this is the integral law theta' = (theta1_ref - theta1) /
   time_constant on the slosh plant, because at the crest h_q depends, to first order, only on the free
@@ -74,7 +71,7 @@ def cfs_increment(
     """Tilt increment (rad) of one CFS step, clipped to +-max_step.
 
     theta: commanded tilt (rad); area: liquid area in the pour plane (m^2); h_q, h_ref: m; fraction: dt /
-    time_constant; outflow: m^3 expected to leave the pourer during this step (feed-forward rate * dt).
+    time_constant; outflow: m^3 that left the pourer during this step (filtered rate * dt).
     """
     dh = level_drop(geom, theta, area, outflow) + fraction * (h_ref - h_q)
     dtheta = vector_step(crest_lever(geom, theta, area), dh)

@@ -32,7 +32,6 @@ import numpy as np
 from controllers.catcher import CatcherFollower, landing_x, weir_velocity
 from controllers.cfs import after_flow_volume, cfs_increment, cfs_pivot, crest_lever
 from controllers.config import Damping, Handover, PourConfig, SimMode
-from controllers.discharge import DischargeEstimate
 from controllers.errors import ControllerInputError, MeasurementError
 from controllers.geometry import PlanarPose, static_tilt_for_h_q
 from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
@@ -43,11 +42,6 @@ from controllers.slosh_induction import excitation_duration, excitation_tilt, si
 # Time constant (s) of the first-order filter on the measured outflow rate d(poured)/dt: a fifth of the seed
 # vessel's slosh period, enough to smooth SPH particle-count steps while keeping the stop prediction current.
 OUTFLOW_FILTER_TIME = 0.1
-# Time constant (s) of the discharge coefficient's estimate (controllers.discharge), which scales CFS's feed-forward
-# outflow: long against the CFS law's time constant, so that a particle's step of the measured outflow moves the
-# feed-forward by only that particle's volume over (outflow rate * 1 s), and short against a pour, over which the
-# coefficient changes with the tilt.
-DISCHARGE_FILTER_TIME = 1.0
 # CFS has stalled when, over the last cfs.max_tilt_hold s, less than this fraction of the initial volume left and
 # the tilt rose by less than STALL_TILT: near 90 deg the crest's lever degenerates and the last wedge of liquid
 # only drips (default scene: 139 mL left, about 5 mL/s, for 26 s at 89 deg).
@@ -106,16 +100,8 @@ class PourController:
         self._first_t = math.nan
         self._initial_volume = math.nan
         self._outflow_rate = 0.0  # m^3/s, filtered
-        # the pourer's weir coefficient, from the catcher's (the same weir law) until the outflow has been measured
-        self._discharge = DischargeEstimate(
-            config.catcher.discharge_coefficient, geom.inner_depth, config.cfs.h_q_ref, DISCHARGE_FILTER_TIME,
-            config.gravity,
-        )
         # m, the head over the crest as the weir law sees it (max(h_q, 0): a negative head pours nothing), filtered like
-        # the outflow rate, for the after-flow prediction, which scales that rate by (head / this)^(3/2), and for CFS's
-        # feed-forward outflow, the weir flow at this head: through the same filter as the measured rate it replaces
-        # there, so the CFS loop keeps the dynamics it was designed with (the feed-forward's lagged response to the
-        # head is part of what damps the slosh with a slow arm, tests/test_controllers_pour.py)
+        # the outflow rate, for the after-flow prediction, which scales that rate by (head / this)^(3/2)
         self._h_q = math.nan
         self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
         self._cfs_head = 0.0  # m, the measured h_q through CFS's head filter (cfs.head_filter_fraction)
@@ -159,11 +145,6 @@ class PourController:
     def transitions(self) -> tuple[PhaseTransition, ...]:
         return tuple(self._transitions)
 
-    @property
-    def discharge_coefficient(self) -> float:
-        """The pourer's weir C_d as estimated so far (:mod:`controllers.discharge`)."""
-        return self._discharge.coefficient
-
     def phase_intervals(self, t_end: float) -> list[tuple[str, float, float]]:
         """(phase name, start s, end s) of every phase entered so far, IDLE from the first step, the current
         phase ending at ``t_end``. Empty before the first step."""
@@ -186,7 +167,6 @@ class PourController:
             gain = min((m.t - self._last_t) / OUTFLOW_FILTER_TIME, 1.0)
             self._outflow_rate += gain * (rate - self._outflow_rate)
             self._h_q += gain * (max(m.h_q, 0.0) - self._h_q)
-            self._discharge.update(rate, m.h_q, m.t - self._last_t)
             self._theta1_rate = (m.theta1 - self._last_theta1) / (m.t - self._last_t)
         self._last_theta1 = m.theta1
         self._last_t, self._last_poured = m.t, m.poured_volume
@@ -457,7 +437,7 @@ class PourController:
             self._cfs_head,
             self._head_reference(self.phase),
             self.dt / cfs.time_constant,
-            self._discharge.flow(self._h_q) * self.dt,
+            self._outflow_rate * self.dt,
             cfs.max_tilt_rate * self.dt,
         )
         pivot = cfs_pivot(geom, self.model, theta, cfs.pivot_margin)

@@ -27,7 +27,6 @@ from controllers import (
 )
 from controllers.geometry import VesselGeometry, static_tilt_for_h_q
 from controllers.model_plant import ModelPlant, ModelPlantConfig, Trace, run_closed_loop
-from controllers.pour import DISCHARGE_FILTER_TIME
 from controllers.slosh_induction import excitation_duration
 
 HOME_X = 0.25  # m, vessel B's home (arbitrary for the model plant)
@@ -411,54 +410,3 @@ def test_cfs_that_no_longer_pours_returns_as_stalled() -> None:
     # not before a whole hold of CFS has been seen
     cfs_entry = next(tr.t for tr in controller.transitions if tr.target is Phase.CFS)
     assert transition.t - cfs_entry >= config.cfs.max_tilt_hold
-
-
-def _quantised(plant: ModelPlant, particle: float) -> None:
-    """The plant's poured volume measured in whole particles of ``particle`` m^3, as an SPH liquid counts it."""
-    measure = plant.measure
-
-    def counted() -> LiquidMeasurement:
-        m = measure()
-        poured = particle * math.floor(m.poured_volume / particle)
-        return dataclasses.replace(m, poured_volume=poured, volume_in_pourer=m.volume_in_pourer + m.poured_volume - poured)
-
-    plant.measure = counted
-
-
-def test_cfs_feed_forward_does_not_step_with_each_particle_poured() -> None:
-    """The outflow measured in particles of 3.6 mL (the default 2-D scene's; here one leaves every 6 steps): the
-    feed-forward takes the weir flow of the head, and the particle count reaches it only through the discharge
-    coefficient's estimate, where a particle moves it by its volume over (outflow rate * DISCHARGE_FILTER_TIME).
-    A train of such steps in the tilt rate has second differences of at most that fraction of the mean increment
-    (a feed-forward from the measured rate through its 0.1 s filter would step ten times as much); h_q is held."""
-    particle = 3.6e-6
-    config = _config(target_volume=0.5 * _config().initial_volume)
-    controller = PourController(config)
-    plant = ModelPlant(ModelPlantConfig(vessel=config.vessel, fill_depth=config.fill_depth), config.dt)
-    _quantised(plant, particle)
-    trace = run_closed_loop(controller, plant, 12.0)
-    cfs = _phases(trace) == Phase.CFS
-    theta = np.array([c.pourer.theta for c in trace.commands])[cfs][200:]  # 2 s into CFS
-    poured = trace.series("poured_volume")[cfs][200:]
-    rate = (poured[-1] - poured[0]) / (config.dt * (len(poured) - 1))
-    assert particle > 5 * rate * config.dt  # the count does step
-    bound = particle / (rate * DISCHARGE_FILTER_TIME) * np.mean(np.diff(theta))
-    assert np.std(np.diff(theta, 2)) <= bound
-    assert abs(np.mean(trace.series("h_q")[cfs][200:]) - config.cfs.h_q_ref) <= H_Q_TOL
-
-
-def test_cfs_learns_the_pourers_discharge_coefficient() -> None:
-    """A liquid that pours with C_d = 0.95 where the catcher assumes 0.6: the estimate finds it, CFS holds h_q, and
-    the partial pour ends within its tolerance."""
-    config = _config(target_volume=0.5 * _config().initial_volume)
-    controller = PourController(config)
-    plant_config = ModelPlantConfig(vessel=config.vessel, fill_depth=config.fill_depth, discharge_coefficient=0.95)
-    plant = ModelPlant(plant_config, config.dt)
-    trace = run_closed_loop(controller, plant, 120.0)
-    assert trace.commands[-1].phase is Phase.DONE
-    assert controller.discharge_coefficient == pytest.approx(0.95, rel=0.05)
-    phases = _phases(trace)
-    t_cfs = next(tr.t for tr in controller.transitions if tr.target is Phase.CFS)
-    steady = (phases == Phase.CFS) & (trace.t > t_cfs + CFS_TRANSIENT)
-    assert np.all(np.abs(trace.series("h_q")[steady] - config.cfs.h_q_ref) <= H_Q_TOL)
-    assert plant.poured == pytest.approx(config.target_volume, rel=PARTIAL_POUR_RTOL)
