@@ -127,7 +127,7 @@ CFS_MAX_HEAD = 0.05  # m, the largest liquid height over the crest CFS accepts a
 class CfsConfig:
     """Constant-flow stage (Camporredondo et al. 2019, Sec. 3.2).
 
-    h_q_ref: m, liquid height over the crest to hold (seed: 5 mm, about one SPH smoothing radius). [0.001, 0.05]
+    h_q_ref: m, liquid height over the crest to hold (Camporredondo et al. 2019: 5 mm, about one SPH smoothing radius). [0.001, 0.05]
     time_constant: s, the error h_ref - h_q is corrected at the rate dt / time_constant per step. [0.01, 10]
     max_tilt_rate: rad/s. (0, 2]
     max_tilt: rad, largest tilt. (0, 2.5]
@@ -217,7 +217,7 @@ class CatcherConfig:
       travel_min < travel_max is).
     max_speed: m/s. (0, 2]   max_accel: m/s^2. (0, 20]
     discharge_coefficient: C_d of the weir estimate v_q = (2/3) C_d sqrt(2 g h_q) used to place vessel B before
-      the outflow starts (seed Sec. 2.2: about 0.6). (0, 1]
+      the outflow starts (Camporredondo et al. 2019, Sec. 2.2: about 0.6). (0, 1]
     filter_time: s, time constant of the low-pass on vessel B's target (the predicted landing point). [0, 5]
     """
 

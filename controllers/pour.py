@@ -39,7 +39,7 @@ from controllers.motion import CriticallyDampedSmoother, JerkLimitedMove, RateLi
 from controllers.pid import DiscretePid, PidDesign, design_filtered_pid
 from controllers.slosh_induction import excitation_duration, excitation_tilt, sim_needed
 
-# Time constant (s) of the first-order filter on the measured outflow rate d(poured)/dt: a fifth of the seed
+# Time constant (s) of the first-order filter on the measured outflow rate d(poured)/dt: a fifth of the paper's
 # vessel's slosh period, enough to smooth SPH particle-count steps while keeping the stop prediction current.
 OUTFLOW_FILTER_TIME = 0.1
 # CFS has stalled when, over the last cfs.max_tilt_hold s, less than this fraction of the initial volume left and

@@ -1,6 +1,6 @@
 """Smoothing of the controller's vessel targets in task space, before inverse kinematics: jerk-limited, then linear.
 
-The controller's planar targets can change faster than a jerk-limited arm can follow (the seed's SIM excitation
+The controller's planar targets can change faster than a jerk-limited arm can follow (the paper's SIM excitation
 theta = phi sin(alpha t) starts with a velocity step); fed straight to IK, the joint trajectory then cuts across
 the intended vessel path by centimetres. The targets (dx, dz, theta of the pourer; dx of the catcher) go through a
 ruckig generator in those coordinates first (the same :class:`TrajectoryGenerator`, one "joint" per coordinate),
@@ -60,7 +60,7 @@ class PoseFilterLimits:
     Defaults keep the UR10e-class joints within their limits on the pour paths, so that the joint generators stay
     on the smoothed path: with jerk limits of 40 rad/s^3 and 20 m/s^3 a CFS path (the coupled pour's own targets,
     ``tests/test_coupling_target_tracking.py``) left the generator behind and its catch-up overshot the tilt by
-    0.08 rad; with 20 and 10 it follows within 5 mrad (trajectory tests: 0.5 mm from the path for the seed's SIM
+    0.08 rad; with 20 and 10 it follows within 5 mrad (trajectory tests: 0.5 mm from the path for the paper's SIM
     excitation through 40 rad/s^3).
     """
 
