@@ -27,10 +27,8 @@ from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.json_file import FORMAT, UNITS, read_trajectory_json
 from cosim.trajectory.limits import JointLimitOverride, arm_limits
-from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
 from cosim.trajectory.scripted import generate_scripted, pour_poses
 
-POUR = PourMotionSpec(duration=10.0, max_tilt=math.radians(100.0), pivot=Pivot.LIP, catcher_dx=0.15)
 # Acceptance: `cosim replay trajectory.csv` tracks the vessel path within 2 mm.
 MAX_REPLAY_ERROR_M = 2e-3
 # Relative slack on the limits for round-off (the files hold ruckig's output exactly).
@@ -44,13 +42,8 @@ NAMES = {arm: tuple(f"{arm}_{j}_joint" for j in ("shoulder_pan", "shoulder_lift"
 
 
 @pytest.fixture(scope="module")
-def scene() -> RobotScene:
-    return RobotScene.load()
-
-
-@pytest.fixture(scope="module")
-def exported(scene, tmp_path_factory):
-    run = generate_scripted(scene, pour_poses(scene, POUR))
+def exported(scene, tmp_path_factory, scripted_pour):
+    run = scripted_pour
     folder = tmp_path_factory.mktemp("pour")
     write_trajectory_files(run.trajectory, run.limits, run.sample_rate_hz, driver_joint_names(scene, JointPrefix()),
                            folder / "trajectory.csv", folder / "trajectory.json", folder / "trajectory.mcap")
@@ -195,9 +188,9 @@ def test_a_scene_file_without_driver_names_exports_the_mjcf_names(tmp_path):
     assert names["pour_arm"][0] == "pour_arm_shoulder_pan" and names["catch_arm"][-1] == "catch_arm_wrist_3"
 
 
-def test_same_run_gives_byte_identical_files(scene, exported, tmp_path):
+def test_same_run_gives_byte_identical_files(scene, exported, tmp_path, scripted_pour_spec):
     _, folder = exported
-    again = generate_scripted(scene, pour_poses(scene, POUR))
+    again = generate_scripted(scene, pour_poses(scene, scripted_pour_spec))
     write_trajectory_files(again.trajectory, again.limits, again.sample_rate_hz, driver_joint_names(scene, JointPrefix()),
                            tmp_path / "t.csv", tmp_path / "t.json", tmp_path / "t.mcap")
     for suffix in ("csv", "json", "mcap"):

@@ -10,19 +10,15 @@ import ruckig
 
 from cosim.errors import InputError
 from cosim.robots.planar import PlanarPose, tilt_about_pivot
-from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
 from cosim.trajectory.deviation import path_deviation
 from cosim.trajectory.generator import STREAM_DELAY_PERIODS, TrajectoryGenerator
 from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits, JointLimitOverride, JointLimits, arm_limits
-from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
 from cosim.trajectory.recorder import TrajectoryRecorder
 from cosim.trajectory.scripted import generate_scripted, pour_path, pour_poses
 
-# The pour of the acceptance test: 10 s, tilt 0 -> 100 deg about the lip and back, catcher 0.15 m along x.
-POUR = PourMotionSpec(duration=10.0, max_tilt=math.radians(100.0), pivot=Pivot.LIP, catcher_dx=0.15)
 # m: how far the generated motion may take a vessel point from the scripted path: a hundredth of the robot scene's
 # 1 mm vessel-pose acceptance (measured: 0.001 mm).
 MAX_PATH_DEVIATION_M = 1e-5
@@ -42,28 +38,18 @@ CYCLES_PER_TARGET = 5  # 10 ms targets, 2 ms cycles
 ROUNDOFF = 1e-12
 
 
-@pytest.fixture(scope="module")
-def scene() -> RobotScene:
-    return RobotScene.load()
-
-
-@pytest.fixture(scope="module")
-def pour(scene):
-    return generate_scripted(scene, pour_poses(scene, POUR))
-
-
-def test_pour_follows_the_scripted_vessel_path(scene, pour):
-    paths = pour_path(scene, POUR)
+def test_pour_follows_the_scripted_vessel_path(scene, scripted_pour, scripted_pour_spec):
+    paths = pour_path(scene, scripted_pour_spec)
     for role in ArmRole:
-        lip = path_deviation(scene, role, pour.trajectory, paths[role])
-        origin = path_deviation(scene, role, pour.trajectory, paths[role], point_local=np.zeros(3))
+        lip = path_deviation(scene, role, scripted_pour.trajectory, paths[role])
+        origin = path_deviation(scene, role, scripted_pour.trajectory, paths[role], point_local=np.zeros(3))
         assert lip.max() <= MAX_PATH_DEVIATION_M, f"{role.value} lip strays {lip.max() * 1e3:.4f} mm"
         assert origin.max() <= MAX_PATH_DEVIATION_M, f"{role.value} vessel origin strays {origin.max() * 1e3:.4f} mm"
-    assert pour.trajectory.duration >= POUR.duration
-    assert sum(pour.clamped_targets.values()) == 0
+    assert scripted_pour.trajectory.duration >= scripted_pour_spec.duration
+    assert sum(scripted_pour.clamped_targets.values()) == 0
     for role in ArmRole:  # the arm is on every target when it arrives
-        assert pour.late_targets[role] == 0
-        assert pour.max_target_error[role] <= ON_TARGET_TOLERANCE
+        assert scripted_pour.late_targets[role] == 0
+        assert scripted_pour.max_target_error[role] <= ON_TARGET_TOLERANCE
 
 
 def _targets_at_rest_trajectory(role: ArmRole, pour, limits) -> JointTrajectory:
@@ -86,11 +72,11 @@ def _targets_at_rest_trajectory(role: ArmRole, pour, limits) -> JointTrajectory:
     return JointTrajectory(0.002 * np.arange(len(q)), limits.joint_names, q, zero, zero)
 
 
-def test_stopping_at_every_target_would_stray_from_the_path(scene, pour):
+def test_stopping_at_every_target_would_stray_from_the_path(scene, scripted_pour, scripted_pour_spec):
     role = ArmRole.POUR
     limits = arm_limits(scene, role)
-    naive = _targets_at_rest_trajectory(role, pour, limits)
-    deviation = path_deviation(scene, role, naive, pour_path(scene, POUR)[role])
+    naive = _targets_at_rest_trajectory(role, scripted_pour, limits)
+    deviation = path_deviation(scene, role, naive, pour_path(scene, scripted_pour_spec)[role])
     assert deviation.max() > NAIVE_DEVIATION_M
 
 
@@ -274,10 +260,10 @@ def test_any_sample_rate_is_sampled_exactly(scene):
         assert np.all(np.abs(central - trajectory.velocities[1:-1]) <= jerk * h * h / 6.0 + ROUNDOFF / h)
 
 
-def test_same_targets_give_identical_trajectories(scene, pour):
-    again = generate_scripted(scene, pour_poses(scene, POUR))
+def test_same_targets_give_identical_trajectories(scene, scripted_pour, scripted_pour_spec):
+    again = generate_scripted(scene, pour_poses(scene, scripted_pour_spec))
     for field in ("time", "positions", "velocities", "accelerations"):
-        np.testing.assert_array_equal(getattr(again.trajectory, field), getattr(pour.trajectory, field))
+        np.testing.assert_array_equal(getattr(again.trajectory, field), getattr(scripted_pour.trajectory, field))
 
 
 def test_bad_generator_input_is_one_line(scene):

@@ -8,36 +8,22 @@ target beyond it, naming arm, joint, time and limit (the arms' generators in scr
 
 from __future__ import annotations
 
-import math
 import re
 
 import numpy as np
 import pytest
 
-from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.checks import check_trajectory
 from cosim.trajectory.generator import STREAM_DELAY_PERIODS, GeneratorSettings, TrajectoryGenerator, UntrackablePathError, _peak_speed, _spline_state
 from cosim.trajectory.limits import ArmLimits, JointLimitOverride, JointLimits, arm_limits
-from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
 from cosim.trajectory.recorder import TrajectoryRecorder
 from cosim.trajectory.scripted import generate_scripted, pour_poses
 
-POUR = PourMotionSpec(duration=10.0, max_tilt=math.radians(100.0), pivot=Pivot.LIP, catcher_dx=0.15)
 CYCLES_PER_TARGET = 5  # 10 ms targets, 2 ms cycles
 CONTROL_PERIOD = 0.01  # s: targets, and so the path's velocity, come this often
 USER_LIMIT_FRACTION = 0.99  # the user's limit: 1 % below what the pour needs
 JOINT = "pour_arm/wrist_1"  # the pour arm's fastest joint on this pour
-
-
-@pytest.fixture(scope="module")
-def scene() -> RobotScene:
-    return RobotScene.load()
-
-
-@pytest.fixture(scope="module")
-def pour(scene):
-    return generate_scripted(scene, pour_poses(scene, POUR))
 
 
 def test_a_path_accelerating_through_the_velocity_limit_stays_within_it():
@@ -83,18 +69,18 @@ def _user_limits(scene, pour):
     return {ArmRole.CATCH: arm_limits(scene, ArmRole.CATCH), **override}, limit, first
 
 
-def test_a_user_limit_below_the_pours_need_is_respected_by_a_generator_that_catches_up(scene, pour):
-    limits, limit, _ = _user_limits(scene, pour)
-    trajectory = _replayed(scene, pour, limits, stop=False)
+def test_a_user_limit_below_the_pours_need_is_respected_by_a_generator_that_catches_up(scene, scripted_pour):
+    limits, limit, _ = _user_limits(scene, scripted_pour)
+    trajectory = _replayed(scene, scripted_pour, limits, stop=False)
     check_trajectory(trajectory, list(limits.values()))
     j = trajectory.joint_names.index(JOINT)
     assert np.abs(trajectory.velocities[:, j]).max() <= limit
 
 
-def test_a_user_limit_below_the_pours_need_stops_the_arm_generators_at_once(scene, pour):
-    limits, limit, first = _user_limits(scene, pour)
+def test_a_user_limit_below_the_pours_need_stops_the_arm_generators_at_once(scene, scripted_pour, scripted_pour_spec):
+    limits, limit, first = _user_limits(scene, scripted_pour)
     with pytest.raises(UntrackablePathError) as caught:
-        _replayed(scene, pour, limits, stop=True)
+        _replayed(scene, scripted_pour, limits, stop=True)
     message = str(caught.value)
     assert "\n" not in message
     found = re.fullmatch(
@@ -107,7 +93,7 @@ def test_a_user_limit_below_the_pours_need_stops_the_arm_generators_at_once(scen
     assert float(found.group(2)) > limit
     assert abs(float(found.group(1)) - first) <= CONTROL_PERIOD  # at the target where the arm first needed more
     with pytest.raises(UntrackablePathError, match="arm pour_arm, joint wrist_1"):  # the scripted runs stop alike
-        generate_scripted(scene, pour_poses(scene, POUR), limits=limits)
+        generate_scripted(scene, pour_poses(scene, scripted_pour_spec), limits=limits)
 
 
 def test_the_stop_uses_the_spline_segments_exact_peak_speed():
