@@ -41,8 +41,8 @@ if TYPE_CHECKING:
 
 # s of wall time per liquid particle per solver substep, the MuJoCo arms and the controller included (no recording):
 # the default pour's wall time over its particles times substeps (summary.json's wall_time / (particles x
-# sph_steps)) on a loaded 2-core CPU, rounded up (docs/scene_check.md). It includes the host's fixed share per step,
-# so scenes with more particles per step are overestimated, the safe side for a gate.
+# sph_steps)) on a busy CPU, rounded up; the calibration run is in docs/scene_check.md. It includes the host's fixed
+# share per step, so scenes with more particles per step are overestimated, the safe side for a gate.
 SECONDS_PER_PARTICLE_STEP = 6.5e-6
 LONG_RUN_S = 3600.0  # s: a longer estimate is refused unless the caller accepts it (`cosim pour --yes`)
 # The reach check's sweep: the pourer's tilt in steps of at most this (rad, 5 deg), the catcher's travel in this many
