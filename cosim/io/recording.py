@@ -123,6 +123,7 @@ class PourRecorder:
     properties: shown with the recording (``rr.send_property``): name -> text or number (e.g. the scene's TOML).
     frames: names of MuJoCo sites drawn as tool frames (axes, ``world/frames/<site>``) with the body poses.
     camera: the 3-D view's eye and look target (:class:`cosim.io.rerun_blueprint.Camera`); None: Rerun's default.
+        The attribute ``camera`` may be set until :meth:`close`, which writes it into the blueprint.
     liquid_note: a sentence on how the liquid is drawn, added to the colour scale's text (e.g. that a 2-D liquid
         is the pour-plane slice).
     """
