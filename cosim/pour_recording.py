@@ -30,7 +30,7 @@ import numpy as np
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour
 from cosim.frames import tilt_about_y
-from cosim.io.rerun_framing import frame_box, geom_box_corners
+from cosim.io.rerun_framing import frame_points, geom_box_corners
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 
@@ -57,14 +57,15 @@ def vessel_geoms(scene: RobotScene) -> np.ndarray:
     return np.flatnonzero(np.isin(scene.model.geom_bodyid, bodies))
 
 
-def pour_camera(scene: RobotScene, lo: np.ndarray, hi: np.ndarray):
-    """The default camera on the pour whose vessels and stream occupied the box [``lo``, ``hi``] ((3,) m, world
-    frame): looking at the box's middle from the side of the pour plane opposite the pour arm's shoulder (whose links
-    would hide the pourer), raised by :data:`VIEW_ELEVATION`, as near as the box allows when it is to fill most of
-    the view (:func:`cosim.io.rerun_framing.frame_box`)."""
+def pour_camera(scene: RobotScene, points: np.ndarray):
+    """The default camera on the pour whose vessels and stream occupied ``points`` ((n, 3) m, world frame: the
+    corners of the vessels' geoms, the lip's path, the landing points): looking at the middle of their bounding box
+    from the side of the pour plane opposite the pour arm's shoulder (whose links would hide the pourer), raised by
+    :data:`VIEW_ELEVATION`, as near as lets them fill most of the view (:func:`cosim.io.rerun_framing.frame_points`)."""
     shoulder = scene.data.xpos[scene.model.jnt_bodyid[scene.model.joint(scene.arms[ArmRole.POUR].joints[0]).id]]
-    side = -1.0 if shoulder[1] > 0.5 * (lo[1] + hi[1]) else 1.0
-    return frame_box(lo, hi, np.array([0.0, side * math.cos(VIEW_ELEVATION), math.sin(VIEW_ELEVATION)]))
+    middle_y = 0.5 * (points[:, 1].min() + points[:, 1].max())
+    side = -1.0 if shoulder[1] > middle_y else 1.0
+    return frame_points(points, np.array([0.0, side * math.cos(VIEW_ELEVATION), math.sin(VIEW_ELEVATION)]))
 
 
 def open_recorder(pour: CoupledPour, path: Path, settings, name: str, scene_toml: str):
@@ -90,9 +91,9 @@ def open_recorder(pour: CoupledPour, path: Path, settings, name: str, scene_toml
 
 class PourRecordingFeed:
     """Feeds the recorder from the pour (call it after every step, :meth:`finish` at the end): states at the
-    recording rate, signals and the controller's log at control steps; and keeps the box (``lo``, ``hi``, m, world
-    frame) around everything the vessels (their geoms' bounding boxes) and the stream (the lip's path and the landing
-    points) occupied, on which :meth:`finish` frames the camera."""
+    recording rate, signals and the controller's log at control steps; and keeps the points (``framed``, m, world
+    frame) of everything the vessels (their geoms' box corners at every logged state) and the stream (the lip's path
+    and the landing points) occupied, on which :meth:`finish` frames the camera."""
 
     def __init__(self, pour: CoupledPour, recorder):
         self.pour, self.rec = pour, recorder
@@ -102,13 +103,7 @@ class PourRecordingFeed:
         self.next_status = -math.inf
         self.lip_path: list[np.ndarray] = []
         self.vessel_geoms = vessel_geoms(pour.scene)
-        self.lo, self.hi = np.full(3, np.inf), np.full(3, -np.inf)
-
-    def include(self, points: np.ndarray) -> None:
-        """Grow the framed box (``lo``, ``hi``) to hold ``points`` ((k, 3) m, world frame)."""
-        if len(points):
-            self.lo = np.minimum(self.lo, points.min(axis=0))
-            self.hi = np.maximum(self.hi, points.max(axis=0))
+        self.framed: list[np.ndarray] = []
 
     def commanded_pose(self) -> tuple[float, np.ndarray]:
         """Pourer tilt (rad) and lip position (3,) m of the commanded joint trajectory at its current time (forward
@@ -130,7 +125,6 @@ class PourRecordingFeed:
         self.rows = len(rows["t"])
         theta, lip = self.commanded_pose()
         self.lip_path.append(lip)
-        self.include(lip[None])
         self.rec.log_scalars(pour.generators[ArmRole.POUR].time, step, self.signals(theta))
         phase = rows["phase"][-1]
         if phase != self.phase:
@@ -188,7 +182,7 @@ class PourRecordingFeed:
         if not self.rec.log_state(t, step, data, fluid.positions(), np.linalg.norm(fluid.velocities(), axis=1),
                                   active=fluid.active_mask(), force=force):
             return
-        self.include(geom_box_corners(pour.scene.model, data, self.vessel_geoms))
+        self.framed.append(geom_box_corners(pour.scene.model, data, self.vessel_geoms))
         origins = np.array([data.xipos[pour.scene.arms[role].vessel_body] for role in ROLES])
         forces = pour.wrench[:, :3]
         labels = [f"{np.linalg.norm(f):.1f} N on {pour.scene.arms[role].vessel.name}" for f, role in zip(forces, ROLES)]
@@ -201,7 +195,7 @@ class PourRecordingFeed:
         for name, x, color in (("predicted", rows["landing_x"][-1], PREDICTED_COLOR),
                                ("measured", rows["landing_measured_x"][-1], MEASURED_COLOR)):
             points = np.array([[x, catcher_y, rim_z]]) if np.isfinite(x) else np.zeros((0, 3))
-            self.include(points)
+            self.framed.append(points)
             self.rec.log_points(t, step, f"landing/{name}", points, LANDING_RADIUS, color, f"{name} landing")
 
     def finish(self) -> None:
@@ -210,4 +204,4 @@ class PourRecordingFeed:
         self.log_state(force=True)
         if len(self.lip_path) > 1:
             self.rec.log_path("lip_path/commanded", np.array(self.lip_path), PATH_COLOR, PATH_RADIUS, "commanded lip path")
-        self.rec.camera = pour_camera(self.pour.scene, self.lo, self.hi)
+        self.rec.camera = pour_camera(self.pour.scene, np.concatenate([*self.framed, np.reshape(self.lip_path, (-1, 3))]))

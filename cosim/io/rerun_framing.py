@@ -1,5 +1,6 @@
-"""The 3-D view's starting camera framed on a region of the scene: the nearest eye, looking from a given direction,
-from which the whole region fills a given share of Rerun's perspective view.
+"""The 3-D view's starting camera framed on a set of points of the scene: the nearest eye, looking from a given
+direction at the middle of their bounding box, from which all the points lie within a given share of Rerun's
+perspective view.
 
 Rerun's 3-D view is a pinhole camera of vertical field of view :data:`RERUN_FOV_Y` whose horizontal field follows
 the view's aspect ratio a (width / height): tan(fov_x / 2) = a tan(fov_y / 2). Seen from an eye at distance d from
@@ -10,8 +11,9 @@ both when
 
     d >= r . b + max(|x| / (fill tan(fov_x / 2)), |y| / (fill tan(fov_y / 2))),
 
-and the camera takes the smallest d for which every corner of the region's box holds it (the view is convex, so the
-whole box is then inside): the box fills ``fill`` of the view's width or height, whichever it reaches first.
+and the camera takes the smallest d for which every point holds it: the points fill ``fill`` of the view's width or
+height, whichever they reach first. The view is convex, so a solid whose corners are among the points (a box geom's
+eight, :func:`geom_box_corners`) is then inside too.
 """
 
 from __future__ import annotations
@@ -28,11 +30,11 @@ RERUN_FOV_Y = math.radians(55.0)
 # Width / height of the 3-D view the framing assumes: the default blueprint's left column in a 16:10 window (0.9 in a
 # 16:9 one); a wider view shows more beside the region, a narrower one would cut its sides.
 VIEW_ASPECT = 0.85
-# Share of the view's width or height (whichever binds) the region fills: the rest is a margin for the labels.
+# Share of the view's width or height (whichever binds) the points fill: the rest is a margin for the labels.
 VIEW_FILL = 0.9
 # World up (z), the view's up direction.
 _UP = np.array([0.0, 0.0, 1.0])
-# The eight corners of the unit cube [-1, 1]^3.
+# The eight corners of the cube [-1, 1]^3.
 _SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
 
 
@@ -57,17 +59,17 @@ def view_basis(toward_eye: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarr
     return right, np.cross(back, right), back
 
 
-def frame_box(lo: np.ndarray, hi: np.ndarray, toward_eye: np.ndarray, aspect: float = VIEW_ASPECT,
-              fill: float = VIEW_FILL, fov_y: float = RERUN_FOV_Y) -> Camera:
-    """The camera looking at the middle of the box [``lo``, ``hi``] ((3,) m each, world frame) from the direction
-    ``toward_eye`` (3,), at the nearest distance at which the box fills ``fill`` of a view of width / height
-    ``aspect`` and vertical field of view ``fov_y`` (rad) (module docstring)."""
-    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
-    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi)) and np.all(lo <= hi)):
-        raise ValueError(f"box [{lo.tolist()}, {hi.tolist()}]: must be finite with lo <= hi")
+def frame_points(points: np.ndarray, toward_eye: np.ndarray, aspect: float = VIEW_ASPECT, fill: float = VIEW_FILL,
+                 fov_y: float = RERUN_FOV_Y) -> Camera:
+    """The camera looking at the middle of the bounding box of ``points`` ((n, 3) m, world frame) from the direction
+    ``toward_eye`` (3,), at the nearest distance at which all the points lie within ``fill`` of a view of width /
+    height ``aspect`` and vertical field of view ``fov_y`` (rad) (module docstring)."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    if not (len(points) and np.all(np.isfinite(points))):
+        raise ValueError(f"points: need at least one, all finite (got {len(points)})")
     right, up, back = view_basis(toward_eye)
-    target = 0.5 * (lo + hi)
-    offsets = _SIGNS * (0.5 * (hi - lo))
+    target = 0.5 * (points.min(axis=0) + points.max(axis=0))
+    offsets = points - target
     half_y = fill * math.tan(0.5 * fov_y)
     half_x = aspect * half_y
     needed = offsets @ back + np.maximum(np.abs(offsets @ right) / half_x, np.abs(offsets @ up) / half_y)
