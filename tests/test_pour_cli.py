@@ -124,7 +124,7 @@ def test_recording_holds_what_a_robotics_user_reads(run):
     eye, target = blueprint_camera(rrd)
     frames = {v: np.concatenate(read_component(rrd, f"world/frames/{v}/frame", "Transform3D:translation").values)
               for v in ("pourer", "catcher")}
-    lip_path = read_component(rrd, "world/lip_path/commanded", "LineStrips3D:strips").values[0][0].reshape(-1, 3)
+    lip_path = np.stack(read_component(rrd, "world/lip_path/commanded", "LineStrips3D:strips").values[0][0])
     assert frames["pourer"][:, 0].max() < eye[0] < frames["catcher"][:, 0].min()  # between the vessels
     assert frames["catcher"][:, 2].min() < target[2] < lip_path[:, 2].max()
     assert eye[1] > 0  # the pour arm stands at y < 0: seen from the other side, its links do not hide the pour
