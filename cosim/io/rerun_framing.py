@@ -28,7 +28,7 @@ from cosim.io.rerun_blueprint import Camera
 # rad: the vertical field of view of Rerun's 3-D view (its eye's default, which a blueprint cannot change).
 RERUN_FOV_Y = math.radians(55.0)
 # Width / height of the 3-D view the framing assumes: the default blueprint's left column in a 16:10 window (0.9 in a
-# 16:9 one); a wider view shows more beside the region, a narrower one would cut its sides.
+# 16:9 one); a wider view shows more beside the points, a narrower one would cut off the outermost.
 VIEW_ASPECT = 0.85
 # Share of the view's width or height (whichever binds) the points fill: the rest is a margin for the labels.
 VIEW_FILL = 0.9
