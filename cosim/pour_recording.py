@@ -14,8 +14,9 @@ Signals (``signals/<name>``, one plot each, :mod:`cosim.io.rerun_blueprint`), ev
 
 In 3-D, with the body poses: each vessel's frame (the arm's tool frame) as axes, the liquid's force on each vessel as an
 arrow from its centre of mass (:data:`FORCE_SCALE` m per N), the predicted and measured landing points, and at the
-end the pourer lip's commanded path over the whole run. The controller's log has its phase changes and, while it
-pours (CFS), its state every :data:`STATUS_PERIOD` s.
+end the pourer lip's commanded path over the whole run. The 3-D view's camera is framed at the end on everything the
+vessels and the stream occupied over the run (:func:`pour_camera`). The controller's log has its phase changes and,
+while it pours (CFS), its state every :data:`STATUS_PERIOD` s.
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ import numpy as np
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour
 from cosim.frames import tilt_about_y
+from cosim.io.rerun_framing import frame_points, geom_box_corners
+from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 
 # m of arrow per N of the liquid's force (a litre of water weighs 9.8 N: a 10 cm arrow).
@@ -37,12 +40,8 @@ FORCE_SCALE = 0.01
 STATUS_PERIOD = 0.5
 # Phases in which the controller holds the flow (its state is logged every STATUS_PERIOD).
 POURING_PHASES = ("cfs", "cfs_final")
-# m: margin around the vessels in the default camera's view; rad: the camera's elevation above the pour plane's
-# normal; rad: the vertical field of view the framing assumes (narrower than Rerun's 3-D camera's, which leaves
-# room for the arms' wrists and a tilted pourer).
-VIEW_MARGIN = 0.08
+# rad: the default camera's elevation above the pour plane's normal (enough to see into the catcher).
 VIEW_ELEVATION = math.radians(20.0)
-VIEW_FOV = math.radians(48.0)
 # m: drawn radius of the landing points and of the lip path.
 LANDING_RADIUS = 0.008
 PATH_RADIUS = 0.002
@@ -52,29 +51,27 @@ PATH_COLOR = (255, 200, 0, 255)
 FORCE_COLOR = (230, 60, 40, 255)
 
 
-def pour_camera(pour: CoupledPour):
-    """The default camera on ``pour`` at its start: looking at the middle of both vessels' frames and lips from the
-    side of the pour plane opposite the pour arm's shoulder (whose links would hide the pourer), raised by
-    :data:`VIEW_ELEVATION`, far enough for the vessels and the stream between them (their bounding box plus
-    :data:`VIEW_MARGIN`) to fill a :data:`VIEW_FOV` view."""
-    from cosim.io.rerun_blueprint import Camera
+def vessel_geoms(scene: RobotScene) -> np.ndarray:
+    """Ids of the geoms of both vessels' bodies (their walls and floors)."""
+    bodies = [scene.arms[role].vessel_body for role in ROLES]
+    return np.flatnonzero(np.isin(scene.model.geom_bodyid, bodies))
 
-    scene, data = pour.scene, pour.scene.data
-    points = np.array([data.site_xpos[s] for role in ROLES for s in (scene.arms[role].frame_site, scene.arms[role].lip_site)])
-    lo, hi = points.min(axis=0) - VIEW_MARGIN, points.max(axis=0) + VIEW_MARGIN
-    target = 0.5 * (lo + hi)
-    span = max(hi[0] - lo[0], hi[2] - lo[2])
-    distance = 0.5 * span / math.tan(0.5 * VIEW_FOV)
-    shoulder = data.xpos[scene.model.jnt_bodyid[scene.model.joint(scene.arms[ArmRole.POUR].joints[0]).id]]
-    side = -1.0 if shoulder[1] > target[1] else 1.0
-    eye = target + distance * np.array([0.0, side * math.cos(VIEW_ELEVATION), math.sin(VIEW_ELEVATION)])
-    return Camera(tuple(float(v) for v in eye), tuple(float(v) for v in target))
+
+def pour_camera(scene: RobotScene, points: np.ndarray):
+    """The default camera on the pour whose vessels and stream occupied ``points`` ((n, 3) m, world frame: the
+    corners of the vessels' geoms, the lip's path, the landing points): looking at the middle of their bounding box
+    from the side of the pour plane opposite the pour arm's shoulder (whose links would hide the pourer), raised by
+    :data:`VIEW_ELEVATION`, as near as lets them fill most of the view (:func:`cosim.io.rerun_framing.frame_points`)."""
+    shoulder = scene.data.xpos[scene.model.jnt_bodyid[scene.model.joint(scene.arms[ArmRole.POUR].joints[0]).id]]
+    middle_y = 0.5 * (points[:, 1].min() + points[:, 1].max())
+    side = -1.0 if shoulder[1] > middle_y else 1.0
+    return frame_points(points, np.array([0.0, side * math.cos(VIEW_ELEVATION), math.sin(VIEW_ELEVATION)]))
 
 
 def open_recorder(pour: CoupledPour, path: Path, settings, name: str, scene_toml: str):
     """The :class:`~cosim.io.recording.PourRecorder` of ``pour`` at ``path``: named ``name``, the scene's TOML and
-    the liquid's dimension and particle count as properties, the vessel frames as tool frames, the
-    camera of :func:`pour_camera`; ``settings``: the scene's :class:`~cosim.io.recording_config.RecordingConfig`."""
+    the liquid's dimension and particle count as properties, the vessel frames as tool frames (its camera is set by
+    :meth:`PourRecordingFeed.finish`); ``settings``: the scene's :class:`~cosim.io.recording_config.RecordingConfig`."""
     from cosim.io.recording import PourRecorder
 
     scene, fluid = pour.scene, pour.fluid
@@ -88,13 +85,15 @@ def open_recorder(pour: CoupledPour, path: Path, settings, name: str, scene_toml
     return PourRecorder(
         path, scene.model, settings, particle_radius=0.5 * fluid.config.spacing, name=name,
         properties={"scene_name": name, "dim": dim, "particles": fluid.n_particles, "scene_toml": scene_toml},
-        frames=frames, camera=pour_camera(pour), liquid_note=note,
+        frames=frames, liquid_note=note,
     )
 
 
 class PourRecordingFeed:
     """Feeds the recorder from the pour (call it after every step, :meth:`finish` at the end): states at the
-    recording rate, signals and the controller's log at control steps."""
+    recording rate, signals and the controller's log at control steps; and keeps the points (``framed``, m, world
+    frame) of everything the vessels (their geoms' box corners at every logged state) and the stream (the lip's path
+    and the landing points) occupied, on which :meth:`finish` frames the camera."""
 
     def __init__(self, pour: CoupledPour, recorder):
         self.pour, self.rec = pour, recorder
@@ -103,6 +102,8 @@ class PourRecordingFeed:
         self.rows = 0
         self.next_status = -math.inf
         self.lip_path: list[np.ndarray] = []
+        self.vessel_geoms = vessel_geoms(pour.scene)
+        self.framed: list[np.ndarray] = []
 
     def commanded_pose(self) -> tuple[float, np.ndarray]:
         """Pourer tilt (rad) and lip position (3,) m of the commanded joint trajectory at its current time (forward
@@ -181,6 +182,7 @@ class PourRecordingFeed:
         if not self.rec.log_state(t, step, data, fluid.positions(), np.linalg.norm(fluid.velocities(), axis=1),
                                   active=fluid.active_mask(), force=force):
             return
+        self.framed.append(geom_box_corners(pour.scene.model, data, self.vessel_geoms))
         origins = np.array([data.xipos[pour.scene.arms[role].vessel_body] for role in ROLES])
         forces = pour.wrench[:, :3]
         labels = [f"{np.linalg.norm(f):.1f} N on {pour.scene.arms[role].vessel.name}" for f, role in zip(forces, ROLES)]
@@ -193,10 +195,13 @@ class PourRecordingFeed:
         for name, x, color in (("predicted", rows["landing_x"][-1], PREDICTED_COLOR),
                                ("measured", rows["landing_measured_x"][-1], MEASURED_COLOR)):
             points = np.array([[x, catcher_y, rim_z]]) if np.isfinite(x) else np.zeros((0, 3))
+            self.framed.append(points)
             self.rec.log_points(t, step, f"landing/{name}", points, LANDING_RADIUS, color, f"{name} landing")
 
     def finish(self) -> None:
-        """Log the final state and the lip's commanded path over the whole run."""
+        """Log the final state and the lip's commanded path over the whole run, and frame the 3-D view's camera on
+        the whole run (:func:`pour_camera`)."""
         self.log_state(force=True)
         if len(self.lip_path) > 1:
             self.rec.log_path("lip_path/commanded", np.array(self.lip_path), PATH_COLOR, PATH_RADIUS, "commanded lip path")
+        self.rec.camera = pour_camera(self.pour.scene, np.concatenate([*self.framed, np.reshape(self.lip_path, (-1, 3))]))

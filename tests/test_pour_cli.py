@@ -13,12 +13,16 @@ from controllers.config import CFS_MAX_HEAD
 from cosim.cli.main import main
 from cosim.frames import tilt_about_y
 from cosim.io.pour_series import read_series_csv
-from cosim.io.rerun_read import blueprint_camera, entity_paths, read_scalar_series, recording_properties, series_names
+from cosim.io.rerun_framing import VIEW_FILL
+from cosim.io.rerun_read import (
+    blueprint_camera, entity_paths, read_component, read_scalar_series, recording_properties, series_names,
+)
 from cosim.pour_scene import PourScene, load_scene
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.csv_file import read_trajectory_csv
 from cosim.trajectory.json_file import read_trajectory_json
+from tests.support.view_projection import image_coordinates
 
 COARSE = """
 name = "test-pour"
@@ -118,12 +122,14 @@ def test_recording_holds_what_a_robotics_user_reads(run):
     properties = recording_properties(rrd)
     assert properties["scene_name"] == "test-pour" and "particles_across = 10" in properties["scene_toml"]
     eye, target = blueprint_camera(rrd)
-    scene = RobotScene.load()
-    mujoco.mj_forward(scene.model, scene.data)
-    pourer, catcher = (scene.data.site_xpos[scene.arms[r].frame_site] for r in (ArmRole.POUR, ArmRole.CATCH))
-    lo, hi = np.minimum(pourer, catcher), np.maximum(pourer, catcher)
-    assert np.all(target[[0, 2]] >= lo[[0, 2]] - 0.1) and np.all(target[[0, 2]] <= hi[[0, 2]] + 0.1)
-    assert 0.3 < np.linalg.norm(eye - target) < 3.0
+    frames = {v: np.concatenate(read_component(rrd, f"world/frames/{v}/frame", "Transform3D:translation").values)
+              for v in ("pourer", "catcher")}
+    lip_path = np.stack(read_component(rrd, "world/lip_path/commanded", "LineStrips3D:strips").values[0][0])
+    assert frames["pourer"][:, 0].max() < eye[0] < frames["catcher"][:, 0].min()  # between the vessels
+    assert frames["catcher"][:, 2].min() < target[2] < lip_path[:, 2].max()
+    assert eye[1] > 0  # the pour arm stands at y < 0: seen from the other side, its links do not hide the pour
+    for points in (*frames.values(), lip_path):  # the vessels and the lip, all the run long, in the view
+        assert np.all(np.abs(image_coordinates(eye, target, points)) <= VIEW_FILL)
 
 
 def test_exported_trajectory_differentiates_consistently_and_holds_every_limit(run):

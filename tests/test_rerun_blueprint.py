@@ -1,12 +1,15 @@
-"""The default blueprint stored in the recording: the 3-D view of world framed by the camera given, the controller's
-log and the colour scale, one plot per signal titled with its unit in a tab per group, legends only where a plot
-has several series, and the sim_time timeline."""
+"""The default blueprint stored in the recording: the 3-D view of world framed by the camera given, the window's full
+height beside the plots, the controller's log and the colour scale, one plot per signal titled with its unit in a tab
+per group, legends only where a plot has several series, and the sim_time timeline."""
 
 from __future__ import annotations
+
+import uuid
 
 import mujoco
 import numpy as np
 import pytest
+import rerun.blueprint as rrb
 from rerun.chunk import RrdReader
 
 from cosim.io.recording import PourRecorder, RecordingConfig
@@ -85,6 +88,19 @@ def test_views_of_the_default_blueprint(recording):
     assert other["/time_panel"]["TimePanelBlueprint:timeline"] == ["sim_time"]
     tabs = {v["ContainerBlueprint:display_name"][0] for v in items.values() if "ContainerBlueprint:display_name" in v}
     assert {tab for tab, _ in PANELS.values()} <= tabs
+
+
+def test_the_3d_view_has_the_window_height_beside_the_plots_log_and_colour_scale(recording):
+    items, other = _blueprint(recording)
+    root = items[str(uuid.UUID(bytes=bytes(other["/viewport"]["ViewportBlueprint:root_container"][0])))]
+    assert root["ContainerBlueprint:container_kind"] == [rrb.components.ContainerKind.Horizontal.value]
+    left, right = (items[path.split("/")[1]] for path in root["ContainerBlueprint:contents"])
+    assert left["ViewBlueprint:class_identifier"] == ["3D"]
+    assert right["ContainerBlueprint:container_kind"] == [rrb.components.ContainerKind.Vertical.value]
+    tabs, notes = (items[path.split("/")[1]] for path in right["ContainerBlueprint:contents"])
+    assert tabs["ContainerBlueprint:container_kind"] == [rrb.components.ContainerKind.Tabs.value]
+    shown = {items[path.split("/")[1]]["ViewBlueprint:display_name"][0] for path in notes["ContainerBlueprint:contents"]}
+    assert shown == {"controller log", "colour scale"}
 
 
 def test_each_plot_shows_its_signal_and_a_legend_only_for_several_series(recording):

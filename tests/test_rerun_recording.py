@@ -156,6 +156,25 @@ def test_tool_frames_are_drawn_where_mujoco_has_the_sites(tmp_path):
     assert read_component(path, "world/frames/tool/tcp", "TransformAxes3D:axis_length").values[0].tolist() == [pytest.approx(0.08)]
 
 
+def test_each_state_keeps_the_poses_it_was_logged_with(tmp_path):
+    """A simulation updates one MjData in place: every logged row holds the poses of its own step, not the last."""
+    model = mujoco.MjModel.from_xml_string(MJCF.replace("<geom name=\"cup_floor\"", "<site name=\"tool/tcp\" pos=\"0.1 0 0.02\"/><geom name=\"cup_floor\""))
+    data = mujoco.MjData(model)
+    path = tmp_path / "pour.rrd"
+    cups, tools = [], []
+    with PourRecorder(path, model, RecordingConfig(particle_rate_hz=10.0), frames=["tool/tcp"]) as rec:
+        for k in range(4):
+            data.qpos[:] = [0.3 * k, -0.2 * k]
+            mujoco.mj_kinematics(model, data)
+            assert rec.log_state(0.1 * k, k, data)
+            cups.append(data.xpos[model.body("cup").id].copy())
+            tools.append(data.site_xpos[0].copy())
+    assert np.ptp(np.array(cups), axis=0).max() > 0.1  # the poses differ from row to row
+    for entity, expected in (("world/robot/cup", cups), ("world/frames/tool/tcp", tools)):
+        logged = np.concatenate(read_component(path, entity, "Transform3D:translation").values)
+        np.testing.assert_allclose(logged, np.array(expected), atol=1e-6)
+
+
 def test_name_and_properties_travel_with_the_recording(model, tmp_path):
     path = tmp_path / "pour.rrd"
     with PourRecorder(path, model, name="my-run", properties={"scene_toml": "[fluid]\ndim = 3\n", "particles": 12}):

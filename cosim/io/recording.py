@@ -61,7 +61,8 @@ _SLOT_TOLERANCE = 1e-6
 
 class _Columns:
     """Rows buffered for one entity of one archetype: times (ns), steps, and per row one batch of each component
-    (arrays of equal length k, the row's instance count)."""
+    (arrays of equal length k, the row's instance count). A row keeps copies of its batches: a caller's arrays may
+    change after it has logged them (a view into MuJoCo's ``data.xpos`` moves with the next step)."""
 
     __slots__ = ("archetype", "time_ns", "steps", "lengths", "components", "nbytes")
 
@@ -76,7 +77,7 @@ class _Columns:
     def append(self, time_ns: int, step: int, **batches) -> None:
         k = None
         for name, batch in batches.items():
-            batch = np.asarray(batch) if not isinstance(batch, list) else batch
+            batch = np.array(batch) if not isinstance(batch, list) else list(batch)
             k = len(batch) if k is None else k
             if len(batch) != k:
                 raise ValueError(f"{name}: expected {k} instances, got {len(batch)}")
@@ -123,6 +124,7 @@ class PourRecorder:
     properties: shown with the recording (``rr.send_property``): name -> text or number (e.g. the scene's TOML).
     frames: names of MuJoCo sites drawn as tool frames (axes, ``world/frames/<site>``) with the body poses.
     camera: the 3-D view's eye and look target (:class:`cosim.io.rerun_blueprint.Camera`); None: Rerun's default.
+        The attribute ``camera`` may be set until :meth:`close`, which writes it into the blueprint.
     liquid_note: a sentence on how the liquid is drawn, added to the colour scale's text (e.g. that a 2-D liquid
         is the pour-plane slice).
     """

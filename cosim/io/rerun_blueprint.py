@@ -1,5 +1,6 @@
-"""The default Rerun blueprint of a pour: the 3-D view framed on the pour, the controller's log, the liquid's colour
-scale, and one plot panel per scalar signal, in a tab per signal group.
+"""The default Rerun blueprint of a pour: the 3-D view framed on the pour, in a column of the window's full height;
+beside it one plot panel per scalar signal, in a tab per signal group, over the controller's log and the liquid's
+colour scale.
 
 A signal's name is ``<group>/<quantity>_<unit>`` (``pour_arm/joint_angle_deg``, ``pourer/liquid_force_N``); its
 panel is titled ``<group> <quantity> (<unit>)`` ("pour_arm joint angle (deg)") and sits in the tab ``<group>``.
@@ -21,10 +22,12 @@ from cosim.io import rerun_paths
 
 # Name suffix -> unit as shown, longest suffixes first (``_deg_s`` before ``_deg``, ``_N_m`` before ``_N``).
 UNITS = {"_deg_s": "deg/s", "_mm_s": "mm/s", "_m_s": "m/s", "_N_m": "N m", "_deg": "deg", "_mL": "mL", "_mm": "mm", "_N": "N"}
-# Share of the window width given to the 3-D view column and to the plot tabs.
-_COLUMN_SHARES = [3.0, 2.0]
-# Share of the left column's height given to the 3-D view and to the log + colour scale row.
-_LEFT_ROW_SHARES = [4.0, 1.0]
+# Share of the window width given to the 3-D view and to the column of plots, log and colour scale: the 3-D view,
+# the window's full height, comes out a little narrower than high (0.85 in a 16:10 window, 0.9 in a 16:9 one), as
+# the pour is, its vessels and stream seen from the side (:data:`cosim.io.rerun_framing.VIEW_ASPECT`).
+_COLUMN_SHARES = [5.0, 7.0]
+# Share of the right column's height given to the plot tabs and to the log + colour scale row.
+_RIGHT_ROW_SHARES = [3.0, 1.0]
 # Plot panels per row of a tab's grid.
 _GRID_COLUMNS = 1
 
@@ -86,17 +89,14 @@ def build_blueprint(signal_names: Iterable[str], camera: Camera | None = None, s
         origin=rerun_paths.WORLD, name="pour, world frame (m); liquid coloured by speed", eye_controls=eye,
         line_grid=rrb.LineGrid3D(visible=True, spacing=0.1),
     )
-    left = rrb.Vertical(
-        space,
-        rrb.Horizontal(
-            rrb.TextLogView(origin=rerun_paths.EVENTS, name="controller log"),
-            rrb.TextDocumentView(origin=rerun_paths.LEGEND, name="colour scale"),
-            column_shares=[2.0, 1.0],
-        ),
-        row_shares=_LEFT_ROW_SHARES,
+    notes = rrb.Horizontal(
+        rrb.TextLogView(origin=rerun_paths.EVENTS, name="controller log"),
+        rrb.TextDocumentView(origin=rerun_paths.LEGEND, name="colour scale"),
+        column_shares=[2.0, 1.0],
     )
     grids = [rrb.Grid(*plots, grid_columns=_GRID_COLUMNS, name=group) for group, plots in tabs.items()]
-    layout = rrb.Horizontal(left, rrb.Tabs(*grids), column_shares=_COLUMN_SHARES) if grids else left
+    right = rrb.Vertical(rrb.Tabs(*grids), notes, row_shares=_RIGHT_ROW_SHARES) if grids else notes
+    layout = rrb.Horizontal(space, right, column_shares=_COLUMN_SHARES)
     return rrb.Blueprint(
         layout, rrb.TimePanel(timeline=rerun_paths.TIMELINE_TIME), rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
