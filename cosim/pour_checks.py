@@ -183,7 +183,7 @@ def check_reach(robots: RobotScene, max_tilt: float, travel: float, fields: Mapp
     from cosim.robots.scene_config import ArmRole
 
     checker = MotionChecker(robots)
-    _check_contact(checker, {}, "the vessels at home")
+    _check_contact(checker, {}, "the vessels at home", "placement")
     pour = robots.arms[ArmRole.POUR]
     steps = max(1, math.ceil(max_tilt / REACH_TILT_STEP))
     tilts = [max_tilt * k / steps for k in range(1, steps + 1)]
@@ -199,29 +199,31 @@ def check_reach(robots: RobotScene, max_tilt: float, travel: float, fields: Mapp
     for role, poses in sweeps:
         arm = robots.arms[role]
         ik = robots.ik(role, IKSettings(position_tolerance=REACH_TOLERANCE, rotation_tolerance=REACH_TOLERANCE))
+        field = (fields or {}).get(role, "placement")
         q = arm.home_q
         for label, pose in poses:
             pos, quat = robots.vessel_target(role, pose)
             result = ik.solve(pos, quat, q)
             if not result.converged:
                 raise InputError(
-                    f"{(fields or {}).get(role, 'placement')}: {label} is out of {role.value}'s reach (the closest pose "
+                    f"{field}: {label} is out of {role.value}'s reach (the closest pose "
                     f"found is {result.position_error * 1e3:.1f} mm and {math.degrees(result.rotation_error):.2f} deg "
                     f"away); place the vessels nearer the arms (placement.*) or the arms nearer the vessels "
                     f"(arms.*.base_pos), or ask less of them"
                 )
             q = result.q
-            _check_contact(checker, {role: q}, label)
+            _check_contact(checker, {role: q}, label, field)
 
 
-def _check_contact(checker: MotionChecker, configuration: dict[ArmRole, np.ndarray], label: str) -> None:
-    """InputError naming ``label`` where the arms at ``configuration`` (role -> joint angles, rad; the other arm at
-    home) touch anything (:meth:`cosim.robots.collision.MotionChecker.contact_at`)."""
+def _check_contact(checker: MotionChecker, configuration: dict[ArmRole, np.ndarray], label: str, field: str) -> None:
+    """InputError naming ``field`` and ``label`` where the arms at ``configuration`` (role -> joint angles, rad; the
+    other arm at home) touch anything (:meth:`cosim.robots.collision.MotionChecker.contact_at`)."""
     hit = checker.contact_at(configuration)
     if hit is not None:
         raise InputError(
-            f"placement: {label}: {hit.geom1} ({hit.body1}) touches {hit.geom2} ({hit.body2}) ({hit.pair}, "
-            f"{-hit.distance * 1e3:.1f} mm deep); place the vessels elsewhere (placement.*) or ask less of the arms"
+            f"{field}: {label}: {hit.geom1} ({hit.body1}) touches {hit.geom2} ({hit.body2}) ({hit.pair}, "
+            f"{-hit.distance * 1e3:.1f} mm deep); place the vessels (placement.*) or the arms (arms.*.base_pos) "
+            f"elsewhere, or ask less of the arms"
         )
 
 

@@ -24,6 +24,7 @@ from cosim.robots.planar import tilt_about_pivot
 from cosim.robots.scene_config import ArmRole, default_scene_config
 from cosim.robots.ur10e import dh_forward_kinematics
 from cosim.trajectory.driver_names import driver_joint_names
+from tests.support.cli_refusal import refusal
 
 EXAMPLES = assets.models_dir().parent / "examples"
 EXAMPLE = EXAMPLES / "beaker_small_arm.toml"
@@ -149,21 +150,13 @@ REFUSED = {
 }
 
 
-def _refusal(capsys, argv: list[str], command: str) -> str:
-    assert main(argv) == 2
-    captured = capsys.readouterr()
-    lines = captured.err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"cosim {command}: error: "), captured.err
-    return lines[0].removeprefix(f"cosim {command}: error: ")
-
-
 @pytest.mark.parametrize("case", REFUSED)
 def test_scene_check_and_pour_refuse_a_bad_arm_with_the_same_line(case, tmp_path, capsys, monkeypatch):
     changes, expected = REFUSED[case]
     monkeypatch.chdir(tmp_path)  # a pour without --out would write under ./recordings
     (tmp_path / "scene.toml").write_text(_example_with(changes))
-    checked = _refusal(capsys, ["scene", "--check", "scene.toml"], "scene")
-    poured = _refusal(capsys, ["pour", "scene.toml", "--quiet"], "pour")
+    checked = refusal(capsys, ["scene", "--check", "scene.toml"], "scene")
+    poured = refusal(capsys, ["pour", "scene.toml", "--quiet"], "pour")
     assert checked == poured
     assert re.search(expected, checked.removeprefix("scene.toml: ")), checked
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml"]  # nothing written
