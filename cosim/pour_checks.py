@@ -3,7 +3,7 @@
 :func:`check_pour` refuses a scene (one :class:`InputError` line naming the field) or returns a :class:`PourPlan`:
 the robot scene, the joint limits, the liquid's configuration, its particle counts, its memory and an estimate of
 the run's wall time. Checked, in order: Rerun present when the recording is on; the device; the robot scene (the
-scene file, or the cell built around the scene's vessels with the arms' home postures solved); the fill below the
+scene file, or the cell of the scene's vessels and arms, their home postures solved); the fill below the
 pourer's rim; the catcher holding what is poured; the catcher above the table; each arm's load against its rated
 payload; the joint-limit overrides; the arms' reach over the pour's poses, free of collisions (:func:`check_reach`);
 the liquid's resolution (layers deep, particles across); the memory of its pair tables and cell grids

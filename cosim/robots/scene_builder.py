@@ -129,7 +129,6 @@ def _apply_joint_settings(arm: mujoco.MjSpec, alone: mujoco.MjModel, placement: 
     file must then have no actuator on those joints, and without them it must have its own."""
     model, field = placement.arm, _arm_field(placement)
     to_file_units = math.degrees if arm.compiler.degree else float  # the file's own angle unit
-    bodies = set()
     for i, name in enumerate(model.joints):
         jid = mujoco.mj_name2id(alone, mujoco.mjtObj.mjOBJ_JOINT, name)
         joint = arm.joint(name)
@@ -152,11 +151,10 @@ def _apply_joint_settings(arm: mujoco.MjSpec, alone: mujoco.MjModel, placement: 
             servo = arm.add_actuator(name=f"{name}_servo", target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
             servo.set_to_position(kp=model.servo_kp[i], kv=model.servo_kv[i])
             joint.actgravcomp = True
-            bodies.add(int(alone.jnt_bodyid[jid]))
         elif not existing:
             raise InputError(f"{field}.servo_kp: the arm file has no actuator on joint {name!r}; give each joint's "
                              f"servo gains (servo_kp in N m/rad, servo_kv in N m s/rad)")
-    if bodies:  # gravity compensation of every moving body of the arm (the servos' model-based compensation)
+    if model.servo_kp:  # gravity compensation of every moving body of the arm (the servos' model-based compensation)
         for body in range(1, alone.nbody):
             if alone.body_weldid[body] != 0:
                 arm.body(alone.body(body).name).gravcomp = 1.0
