@@ -183,7 +183,7 @@ def check_reach(robots: RobotScene, max_tilt: float, travel: float, fields: Mapp
     from cosim.robots.scene_config import ArmRole
 
     checker = MotionChecker(robots)
-    _check_contact(checker, {}, "the vessels at home", "placement")
+    _check_contact(checker, {}, "the vessels at home", fields)
     pour = robots.arms[ArmRole.POUR]
     steps = max(1, math.ceil(max_tilt / REACH_TILT_STEP))
     tilts = [max_tilt * k / steps for k in range(1, steps + 1)]
@@ -212,14 +212,20 @@ def check_reach(robots: RobotScene, max_tilt: float, travel: float, fields: Mapp
                     f"(arms.*.base_pos), or ask less of them"
                 )
             q = result.q
-            _check_contact(checker, {role: q}, label, field)
+            _check_contact(checker, {role: q}, label, fields)
 
 
-def _check_contact(checker: MotionChecker, configuration: dict[ArmRole, np.ndarray], label: str, field: str) -> None:
-    """InputError naming ``field`` and ``label`` where the arms at ``configuration`` (role -> joint angles, rad; the
-    other arm at home) touch anything (:meth:`cosim.robots.collision.MotionChecker.contact_at`)."""
+def _check_contact(
+    checker: MotionChecker, configuration: dict[ArmRole, np.ndarray], label: str, fields: Mapping[ArmRole, str] | None
+) -> None:
+    """InputError naming ``label`` where the arms at ``configuration`` (role -> joint angles, rad; the other arm at
+    home) touch anything (:meth:`cosim.robots.collision.MotionChecker.contact_at`), blamed on the ``fields`` entry of an
+    arm whose part touches, where it is not ``placement``, else on ``placement``."""
     hit = checker.contact_at(configuration)
     if hit is not None:
+        touching = [f for role, f in (fields or {}).items()
+                    if any(body.startswith(f"{role.value}/") for body in (hit.body1, hit.body2))]
+        field = next((f for f in touching if f != "placement"), "placement")
         raise InputError(
             f"{field}: {label}: {hit.geom1} ({hit.body1}) touches {hit.geom2} ({hit.body2}) ({hit.pair}, "
             f"{-hit.distance * 1e3:.1f} mm deep); place the vessels (placement.*) or the arms (arms.*.base_pos) "

@@ -123,6 +123,24 @@ def test_the_bundled_arm_takes_a_base_pose_and_a_grasp():
     assert data.ncon == 0
 
 
+def test_a_base_quaternion_and_a_grasp_orientation_pose_the_bundled_arms():
+    flip = np.empty(4)  # the default catch grasp (R_y(90 deg)) turned half a turn about the flange axis
+    mujoco.mju_mulQuat(flip, np.array([0.0, 0.0, 0.0, 1.0]), np.array([math.cos(math.pi / 4), 0.0, math.sin(math.pi / 4), 0.0]))
+    scene = PourScene(arms=ArmsSettings(pour=ArmSettings(base_quat=(0.0, 0.0, 0.0, 1.0)),  # the cell's yaw of pi
+                                        catch=ArmSettings(grasp_quat=tuple(flip))))
+    robots, default = robot_scene(scene), robot_scene(PourScene())
+    np.testing.assert_allclose(robots.arms[ArmRole.POUR].home_q, default.arms[ArmRole.POUR].home_q, atol=1e-5)
+    catch = robots.arms[ArmRole.CATCH]
+    site = robots.model.site("catch_arm/flange").id
+    in_flange = np.empty(4)
+    mujoco.mju_mat2Quat(in_flange, (robots.data.site_xmat[site].reshape(3, 3).T @ robots.data.xmat[catch.vessel_body].reshape(3, 3)).ravel())
+    assert abs(float(np.dot(in_flange, flip))) == pytest.approx(1.0, abs=1e-9)
+    np.testing.assert_allclose(catch.home_pos, default_scene_config().catch.vessel_home, atol=1e-7)  # the vessel stays
+    with pytest.raises(InputError, match=r"^arms\.catch\.base_pos: the vessels at home: .*\(catch_arm/wrist_1_link\) "
+                                         r"touches table \(world\) \(arm-table"):
+        check_pour(scene)  # the flipped wrist folds into the table
+
+
 ARM = "arms.pour"
 REFUSED = {
     "arm file missing": ('mjcf = "no_such_arm.xml"', rf"^{ARM}\.mjcf: file not found: .*no_such_arm\.xml$"),
