@@ -13,6 +13,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
 
 from cosim.cli.main import main
 from cosim.errors import InputError
@@ -101,6 +103,10 @@ def test_a_short_user_arm_pour_writes_the_users_joint_names(tmp_path):
     assert exported["catch_arm"]["arm_model"] == "small_arm"
     header = (tmp_path / "run" / "trajectory.csv").read_text().splitlines()[0]
     assert "pour_arm/joint_6.pos" in header and "shoulder_pan" not in header
+    with open(tmp_path / "run" / "trajectory.mcap", "rb") as stream:
+        topics = {channel.topic: list(message.joint_names)
+                  for _, channel, _, message in make_reader(stream, decoder_factories=[DecoderFactory()]).iter_decoded_messages()}
+    assert topics == {f"/{arm}/joint_trajectory": [f"{arm}_{j}" for j in JOINTS] for arm in ("pour_arm", "catch_arm")}
 
 
 def test_the_default_arms_are_the_project_cell():
