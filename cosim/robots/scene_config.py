@@ -112,7 +112,7 @@ class ArmModel:
         return self.driver_joints or self.joints
 
 
-# (field, lower bound (open; None: closed at 0), upper bound, unit) of ArmModel's optional per-joint values.
+# (field, lower bound, upper bound, unit) of ArmModel's optional per-joint values, as check_per_joint takes them.
 SERVO_AND_RANGE_BOUNDS = (
     ("servo_kp", 0.0, 1.0e7, "N m/rad"),
     ("servo_kv", None, 1.0e6, "N m s/rad"),
