@@ -3,7 +3,7 @@
 :func:`check_pour` refuses a scene (one :class:`InputError` line naming the field) or returns a :class:`PourPlan`:
 the robot scene, the joint limits, the liquid's configuration, its particle counts, its memory and an estimate of
 the run's wall time. Checked, in order: Rerun present when the recording is on; the device; the robot scene (the
-scene file, or the cell built around the scene's vessels with the arms' home postures solved); the fill below the
+scene file, or the cell of the scene's vessels and arms, their home postures solved); the fill below the
 pourer's rim; the catcher holding what is poured; the catcher above the table; each arm's load against its rated
 payload; the joint-limit overrides; the arms' reach over the pour's poses, free of collisions (:func:`check_reach`);
 the liquid's resolution (layers deep, particles across); the memory of its pair tables and cell grids
@@ -29,6 +29,8 @@ from typing import TYPE_CHECKING
 from cosim.errors import InputError
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     import numpy as np
 
     from cosim.fluid.config import FluidConfig
@@ -94,32 +96,35 @@ def estimate_wall_time(particles: int, substeps: int) -> float:
 
 
 def _joint_limits(scene: PourScene, robots: RobotScene) -> dict[ArmRole, ArmLimits]:
+    """Each arm's limits: its model's, the accelerations and jerks of its ``arms`` section, then the scene's
+    ``trajectory.limits`` joint by joint (a field set there wins)."""
+    from dataclasses import replace
+
     from cosim.robots.scene_config import ArmRole
-    from cosim.trajectory.limits import scene_limits
+    from cosim.trajectory.limits import LIMIT_FIELDS, scene_limits
 
     roles = {r.value: r for r in ArmRole}
-    overrides: dict = {}
+    overrides = {role: scene.arms.of(role).limit_overrides(role.value, robots.arms[role].joints) for role in ArmRole}
     for name, override in scene.trajectory.limits.items():
         arm = name.split("/", 1)[0]
         if arm not in roles or "/" not in name:
             raise InputError(f"trajectory.limits.{name}: must be '<arm>/<joint>' with <arm> one of {', '.join(roles)}")
-        overrides.setdefault(roles[arm], {})[name] = override
-    return scene_limits(robots, overrides)
+        by_joint = overrides[roles[arm]]
+        given = {f: getattr(override, f) for f in LIMIT_FIELDS if getattr(override, f) is not None}
+        by_joint[name] = replace(by_joint[name], **given) if name in by_joint else override
+    return scene_limits(robots, overrides, {role: scene.arms.of(role).arm_model for role in ArmRole})
 
 
 def robot_scene(scene: PourScene) -> RobotScene:
     """The robot scene of ``scene``: its ``robots.scene`` file, else the project's cell around its vessels at its
-    placement (the project's scene file where both are the defaults). A home posture out of reach is an InputError
-    naming the placement."""
+    placement with its arms (the project's scene file where all are the defaults). A home posture out of reach is an
+    InputError naming the setting to change (``placement``, or the arm's ``arms.*.base_pos``)."""
     from cosim.robots.scene import RobotScene
 
     config = scene.cell_config()
     if config is None:
         return RobotScene.load(scene.robots.scene or None)
-    try:
-        return RobotScene.from_config(config)
-    except InputError as exc:
-        raise InputError(f"placement: {exc}") from None
+    return RobotScene.from_config(config)
 
 
 def _liquid_volume(vessel: VesselSpec, depth: float, dim: int) -> float:
@@ -131,10 +136,9 @@ def _liquid_volume(vessel: VesselSpec, depth: float, dim: int) -> float:
 def check_vessels(scene: PourScene, robots: RobotScene) -> None:
     """The fill below the pourer's rim; the catcher holding all that is poured; in the project's cell, the catcher
     above the table and each arm's vessel, liquid and mount plate within the arm's rated payload
-    (:data:`cosim.robots.ur10e.UR10E_PAYLOAD_KG`)."""
+    (``arms.*.rated_payload``; the UR10e's :data:`cosim.robots.ur10e.UR10E_PAYLOAD_KG`)."""
     from cosim.robots.payload import LIQUID_DENSITY
     from cosim.robots.scene_config import ArmRole, MountSpec
-    from cosim.robots.ur10e import UR10E_PAYLOAD_KG
 
     pourer, catcher = robots.arms[ArmRole.POUR].vessel, robots.arms[ArmRole.CATCH].vessel
     fill, dim = scene.liquid.fill_depth, scene.fluid.dim
@@ -155,28 +159,31 @@ def check_vessels(scene: PourScene, robots: RobotScene) -> None:
                          f"placement.pourer_height)")
     mount = MountSpec()
     plate = mount.density * (2.0 * mount.half_width) ** 2 * mount.thickness
-    for name, vessel, liquid in (("pourer", pourer, _liquid_volume(pourer, fill, dim)), ("catcher", catcher, poured)):
+    held = ((ArmRole.POUR, "pourer", pourer, _liquid_volume(pourer, fill, dim)), (ArmRole.CATCH, "catcher", catcher, poured))
+    for role, name, vessel, liquid in held:
         load = vessel.mass + LIQUID_DENSITY * liquid + plate
-        if load > UR10E_PAYLOAD_KG:
-            raise InputError(f"vessels.{name}: {load:.1f} kg with its liquid and mount, more than the arm's rated payload "
-                             f"of {UR10E_PAYLOAD_KG:g} kg (a smaller or lighter vessel, or a smaller liquid.fill_depth)")
+        rated = scene.arms.of(role).payload_kg
+        if load > rated:
+            raise InputError(f"vessels.{name}: {load:.1f} kg with its liquid and mount, more than the arm's rated "
+                             f"payload of {rated:g} kg (a smaller or lighter vessel, or a smaller liquid.fill_depth)")
 
 
-def check_reach(robots: RobotScene, max_tilt: float, travel: float) -> None:
+def check_reach(robots: RobotScene, max_tilt: float, travel: float, fields: Mapping[ArmRole, str] | None = None) -> None:
     """Every pose the pour will ask of the arms reachable and free of collisions, before any simulation: the pourer
     tilted from upright to ``max_tilt`` (rad) about its bottom middle (slosh induction's pivot) and about its lip (the
     constant-flow stage's pivots lie between the two), the other vessel at home; the catcher moved ``travel`` (m) each
     way along the pour direction, the pourer upright at home. Each sweep is solved by inverse kinematics from the
     arm's home posture on, each solve starting from the last; each pose reached, and home, is posed for MuJoCo's
     collision detection (:class:`cosim.robots.collision.MotionChecker`: vessel-vessel, arm-table, arm-arm, ...). The
-    first pose out of reach or in collision is an InputError naming it."""
+    first pose out of reach or in collision is an InputError naming it, and the setting it is blamed on: per arm,
+    ``fields`` (default ``placement``: where the vessels stand)."""
     from cosim.robots.collision import MotionChecker
     from cosim.robots.ik import IKSettings
     from cosim.robots.planar import PlanarPose, tilt_about_pivot
     from cosim.robots.scene_config import ArmRole
 
     checker = MotionChecker(robots)
-    _check_contact(checker, {}, "the vessels at home")
+    _check_contact(checker, {}, "the vessels at home", fields)
     pour = robots.arms[ArmRole.POUR]
     steps = max(1, math.ceil(max_tilt / REACH_TILT_STEP))
     tilts = [max_tilt * k / steps for k in range(1, steps + 1)]
@@ -192,28 +199,37 @@ def check_reach(robots: RobotScene, max_tilt: float, travel: float) -> None:
     for role, poses in sweeps:
         arm = robots.arms[role]
         ik = robots.ik(role, IKSettings(position_tolerance=REACH_TOLERANCE, rotation_tolerance=REACH_TOLERANCE))
+        field = (fields or {}).get(role, "placement")
         q = arm.home_q
         for label, pose in poses:
             pos, quat = robots.vessel_target(role, pose)
             result = ik.solve(pos, quat, q)
             if not result.converged:
                 raise InputError(
-                    f"placement: {label} is out of {role.value}'s reach (the closest pose found is "
-                    f"{result.position_error * 1e3:.1f} mm and {math.degrees(result.rotation_error):.2f} deg away); place "
-                    f"the vessels nearer the arms (placement.*) or ask less of them"
+                    f"{field}: {label} is out of {role.value}'s reach (the closest pose "
+                    f"found is {result.position_error * 1e3:.1f} mm and {math.degrees(result.rotation_error):.2f} deg "
+                    f"away); place the vessels nearer the arms (placement.*) or the arms nearer the vessels "
+                    f"(arms.*.base_pos), or ask less of them"
                 )
             q = result.q
-            _check_contact(checker, {role: q}, label)
+            _check_contact(checker, {role: q}, label, fields)
 
 
-def _check_contact(checker: MotionChecker, configuration: dict[ArmRole, np.ndarray], label: str) -> None:
+def _check_contact(
+    checker: MotionChecker, configuration: dict[ArmRole, np.ndarray], label: str, fields: Mapping[ArmRole, str] | None
+) -> None:
     """InputError naming ``label`` where the arms at ``configuration`` (role -> joint angles, rad; the other arm at
-    home) touch anything (:meth:`cosim.robots.collision.MotionChecker.contact_at`)."""
+    home) touch anything (:meth:`cosim.robots.collision.MotionChecker.contact_at`), blamed on the ``fields`` entry of an
+    arm whose part touches, where it is not ``placement``, else on ``placement``."""
     hit = checker.contact_at(configuration)
     if hit is not None:
+        touching = [f for role, f in (fields or {}).items()
+                    if any(body.startswith(f"{role.value}/") for body in (hit.body1, hit.body2))]
+        field = next((f for f in touching if f != "placement"), "placement")
         raise InputError(
-            f"placement: {label}: {hit.geom1} ({hit.body1}) touches {hit.geom2} ({hit.body2}) ({hit.pair}, "
-            f"{-hit.distance * 1e3:.1f} mm deep); place the vessels elsewhere (placement.*) or ask less of the arms"
+            f"{field}: {label}: {hit.geom1} ({hit.body1}) touches {hit.geom2} ({hit.body2}) ({hit.pair}, "
+            f"{-hit.distance * 1e3:.1f} mm deep); place the vessels (placement.*) or the arms (arms.*.base_pos) "
+            f"elsewhere, or ask less of the arms"
         )
 
 
@@ -236,7 +252,7 @@ def check_pour(scene: PourScene, long_run_ok: bool = False) -> PourPlan:
     fill = scene.liquid.fill_depth
     check_vessels(scene, robots)
     limits = _joint_limits(scene, robots)
-    check_reach(robots, scene.controller.cfs.max_tilt, scene.controller.catcher.travel)
+    check_reach(robots, scene.controller.cfs.max_tilt, scene.controller.catcher.travel, scene.arms.reach_fields())
     base = scene.fluid.fluid_config(pourer.inner_width)
     cfg = pour_fluid_config(robots, base, fill)
     check_resolution(pourer, fill, cfg)

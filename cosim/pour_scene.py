@@ -5,7 +5,8 @@ commented with its unit and range; a user's file only needs the keys it changes.
 much to pour), ``fluid`` (SPH resolution and numerics), ``controller`` (the paper's SIM, PID, CFS and catcher, from
 ``controllers.config``), ``coupling``, ``trajectory`` (sampling and joint-limit overrides), ``logging`` (Rerun),
 ``vessels`` (the pourer's and the catcher's shape, size and walls), ``placement`` (the table, the pourer's height,
-where vessel B waits, the pour height), ``robots`` (a MuJoCo scene file instead of the project's cell).
+where vessel B waits, the pour height), ``arms`` (the arm holding each vessel: the bundled UR10e or a user's MJCF, its
+base pose, its grasp; :mod:`cosim.pour_arms`), ``robots`` (a MuJoCo scene file instead of the project's cell).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
 from cosim.fluid.config import DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
 from cosim.io.recording_config import RecordingConfig
+from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
 from cosim.robots.scene_config import (
     CATCHER_HOME_X, POUR_HEIGHT, POURER_FLOOR_ABOVE_TABLE, TABLE_TOP, SceneConfig, pour_cell_config,
@@ -328,6 +330,7 @@ class PourScene:
     logging: the Rerun recording.
     vessels: the pourer and the catcher.
     placement: where the table, the pourer and the catcher stand.
+    arms: the arm holding each vessel, where it stands and how it grasps.
     robots: the MuJoCo scene.
     """
 
@@ -341,6 +344,7 @@ class PourScene:
     logging: LoggingSettings = field(default_factory=LoggingSettings)
     vessels: VesselsSettings = field(default_factory=VesselsSettings)
     placement: PlacementSettings = field(default_factory=PlacementSettings)
+    arms: ArmsSettings = field(default_factory=ArmsSettings)
     robots: RobotSettings = field(default_factory=RobotSettings)
 
     def __post_init__(self) -> None:
@@ -348,17 +352,18 @@ class PourScene:
             raise InputError(f"scene.name: must be letters, digits, '-' or '_' (or '': the scene file's name), got {self.name!r}")
         check_device("scene.device", self.device)
         if self.robots.scene and self.cell_config() is not None:
-            raise InputError("robots.scene: a scene file brings its own vessels and placement; leave [vessels] and "
-                             "[placement] at their defaults with it, or leave robots.scene out")
+            raise InputError("robots.scene: a scene file brings its own vessels and placement, and its arms; leave [vessels], "
+                             "[placement] and [arms] at their defaults with it, or leave robots.scene out")
 
     def cell_config(self) -> SceneConfig | None:
-        """The robot cell of :attr:`vessels` and :attr:`placement` (:func:`cosim.robots.scene_config.pour_cell_config`);
-        None where both are the defaults: the project's scene file (``models/scene.xml``) is that cell, ready built."""
-        if self.vessels == VesselsSettings() and self.placement == PlacementSettings():
+        """The robot cell of :attr:`vessels`, :attr:`placement` and :attr:`arms`
+        (:func:`cosim.robots.scene_config.pour_cell_config` with :meth:`cosim.pour_arms.ArmsSettings.apply`); None
+        where all three are the defaults: the project's scene file (``models/scene.xml``) is that cell, ready built."""
+        if self.vessels == VesselsSettings() and self.placement == PlacementSettings() and self.arms == ArmsSettings():
             return None
         p = self.placement
-        return pour_cell_config(self.vessels.pourer.spec("pourer"), self.vessels.catcher.spec("catcher"),
-                                p.table_height, p.pourer_height, p.catcher_home_x, p.pour_height)
+        return self.arms.apply(pour_cell_config(self.vessels.pourer.spec("pourer"), self.vessels.catcher.spec("catcher"),
+                                                p.table_height, p.pourer_height, p.catcher_home_x, p.pour_height))
 
     @property
     def run_name(self) -> str:
@@ -372,13 +377,15 @@ class PourScene:
 
 
 def load_scene(path: str | Path) -> PourScene:
-    """Read a scene TOML file; any problem is one InputError line naming the file and the field."""
+    """Read a scene TOML file; any problem is one InputError line naming the file and the field. Arm files
+    (``arms.*.mjcf``) given by a relative path are taken from the scene file's folder."""
     path = Path(path)
     table = read_toml_file(path, "scene file")
     try:
-        return from_mapping(PourScene, table, "scene")
+        scene = from_mapping(PourScene, table, "scene")
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
+    return replace(scene, arms=scene.arms.with_folder(path.parent))
 
 
 def dump_scene(scene: PourScene) -> str:

@@ -151,8 +151,8 @@ def test_bad_driver_joint_names_are_refused(driver):
 
 
 def test_bad_mapping_is_reported(config):
-    wrong_site = dataclasses.replace(config.pour, arm=dataclasses.replace(config.pour.arm, attachment_site="flange9"))
-    with pytest.raises(InputError, match="pour_arm.attachment_site: no site 'flange9'"):
+    wrong_site = dataclasses.replace(config.pour, arm=dataclasses.replace(config.pour.arm, flange_site="flange9"))
+    with pytest.raises(InputError, match="pour_arm.arm.flange_site: no site 'flange9'"):
         build_scene_spec(dataclasses.replace(config, pour=wrong_site))
     wrong_joint = dataclasses.replace(
         config.pour, arm=dataclasses.replace(config.pour.arm, joints=("j1", "j2", "j3", "j4", "j5", "j7"))

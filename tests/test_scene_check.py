@@ -13,6 +13,7 @@ import cosim.fluid.memory
 from cosim.cli.main import main
 from cosim.pour_checks import LONG_RUN_S, SECONDS_PER_PARTICLE_STEP, check_pour, estimate_wall_time
 from cosim.pour_scene import PourScene
+from tests.support.cli_refusal import refusal
 
 REFUSED = {
     "fill above the rim": ("[liquid]\nfill_depth = 0.5\n", "liquid.fill_depth: must be in (0, 0.191) m (below the pourer's rim)"),
@@ -48,14 +49,6 @@ REFUSED = {
 }
 
 
-def _refusal(capsys, argv: list[str], command: str) -> str:
-    assert main(argv) == 2
-    captured = capsys.readouterr()
-    lines = captured.err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"cosim {command}: error: "), captured.err
-    return lines[0].removeprefix(f"cosim {command}: error: ")
-
-
 @pytest.mark.parametrize("case", REFUSED)
 def test_scene_check_and_pour_refuse_the_same_scene_with_the_same_line(case, tmp_path, capsys, monkeypatch):
     toml, expected = REFUSED[case]
@@ -63,9 +56,9 @@ def test_scene_check_and_pour_refuse_the_same_scene_with_the_same_line(case, tmp
     monkeypatch.setattr(cosim.fluid.memory, "available_bytes", lambda device: 64_000_000_000)  # not the live, moving value
     (tmp_path / "scene.toml").write_text(toml)
     start = time.perf_counter()
-    checked = _refusal(capsys, ["scene", "--check", "scene.toml"], "scene")
+    checked = refusal(capsys, ["scene", "--check", "scene.toml"], "scene")
     assert time.perf_counter() - start < 60.0  # seconds, not the minutes a fine 3-D liquid takes to seed
-    poured = _refusal(capsys, ["pour", "scene.toml", "--quiet"], "pour")
+    poured = refusal(capsys, ["pour", "scene.toml", "--quiet"], "pour")
     assert checked == poured and expected in checked
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml"]  # nothing written
 

@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass, field
 from enum import Enum
 
-from cosim.checks import check_choice, check_number, check_positive, check_vector
+from cosim.checks import check_choice, check_number, check_positive, check_range, check_vector
 from cosim.errors import InputError
 from cosim.robots.ur10e import UR10E_DRIVER_JOINTS, UR10E_JOINTS, UR10E_MAX_JOINT_SPEED
 from cosim.vessel import VesselSpec, default_catching_vessel, seed_pouring_vessel
@@ -42,47 +42,102 @@ class ArmModel:
     """An arm MJCF and how it maps onto the project's conventions.
 
     mjcf: path of the arm's MJCF; a relative path is resolved against the project's models directory.
-    joints: the arm's joint names in that file, base to tip (n >= 6); each needs a position servo (an actuator
-        with ``biastype="affine"`` and bias -kp on the joint).
-    attachment_site: a site on the last link whose z axis points out of the tool flange; the vessel mount is built
-        on it.
-    max_joint_speed: rad/s per joint (n,), for trajectory generation (MuJoCo models have no speed limits).
+    joints: the arm's joint names in that file, base to tip (n >= 6); each driven by a position servo: the file's own
+        (an actuator with ``biastype="affine"`` and bias -kp on the joint) or the one :attr:`servo_kp` asks for.
+    flange_site: a site on the last link whose z axis points out of the tool flange; the vessel mount is built on it.
+    max_velocity: rad/s per joint (n,), the joint speed limit, for trajectory generation (MuJoCo models have no speed
+        limits). (0, 50]
     driver_joints: the same joints as the arm's ROS 2 driver names them (n, without its tf prefix), for the exported
         trajectories; empty: the MJCF's names.
+    servo_kp, servo_kv: N m/rad and N m s/rad per joint (n,), for a file without actuators on its joints: the scene
+        adds a position servo ``tau = kp (u - q) - kv qdot`` on each, with gravity compensation through the actuators
+        (body ``gravcomp``, joint ``actuatorgravcomp``), as an arm's controller compensates gravity from its dynamic
+        model; empty: the file's own servos.
+    min_position, max_position: rad per joint (n,), the joints' range, within the file's; empty: the file's range.
+    rated_torque: N m per joint (n,), the most each joint's drive delivers (the joint's actuator force range);
+        empty: the file's.
+    label: how messages name this arm's settings (a scene file's ``arms.pour``); empty: ``arm``.
     """
 
     mjcf: str
     joints: tuple[str, ...]
-    attachment_site: str
-    max_joint_speed: tuple[float, ...]
+    flange_site: str
+    max_velocity: tuple[float, ...]
     driver_joints: tuple[str, ...] = ()
+    servo_kp: tuple[float, ...] = ()
+    servo_kv: tuple[float, ...] = ()
+    min_position: tuple[float, ...] = ()
+    max_position: tuple[float, ...] = ()
+    rated_torque: tuple[float, ...] = ()
+    label: str = ""
 
     def __post_init__(self) -> None:
+        p = self.field_prefix
         if not isinstance(self.mjcf, str) or not self.mjcf:
-            raise InputError(f"arm.mjcf: must be a path, got {self.mjcf!r}")
+            raise InputError(f"{p}.mjcf: must be a path, got {self.mjcf!r}")
         if len(self.joints) < 6 or not all(isinstance(j, str) and j for j in self.joints):
-            raise InputError(f"arm.joints: must name at least 6 joints, got {list(self.joints)}")
+            raise InputError(f"{p}.joints: must name at least 6 joints, got {list(self.joints)}")
         if len(set(self.joints)) != len(self.joints):
-            raise InputError(f"arm.joints: names must be unique, got {list(self.joints)}")
-        if not isinstance(self.attachment_site, str) or not self.attachment_site:
-            raise InputError(f"arm.attachment_site: must be a site name, got {self.attachment_site!r}")
-        speeds = check_vector("arm.max_joint_speed", self.max_joint_speed, len(self.joints))
-        for i, v in enumerate(speeds):
-            check_positive(f"arm.max_joint_speed[{i}]", v, "rad/s", 50.0)
+            raise InputError(f"{p}.joints: names must be unique, got {list(self.joints)}")
+        if not isinstance(self.flange_site, str) or not self.flange_site:
+            raise InputError(f"{p}.flange_site: must be a site name, got {self.flange_site!r}")
+        n = len(self.joints)
         object.__setattr__(self, "joints", tuple(self.joints))
-        object.__setattr__(self, "max_joint_speed", speeds)
+        object.__setattr__(self, "max_velocity", check_per_joint(f"{p}.max_velocity", self.max_velocity, n, 0.0, 50.0, "rad/s"))
         driver = tuple(self.driver_joints)
         named = all(isinstance(j, str) and j and not any(c.isspace() for c in j) for j in driver)
-        if driver and (not named or len(driver) != len(self.joints) or len(set(driver)) != len(driver)):
-            raise InputError(
-                f"arm.driver_joints: must name the arm's {len(self.joints)} joints once each, without spaces, got {list(driver)}"
-            )
+        if driver and (not named or len(driver) != n or len(set(driver)) != len(driver)):
+            raise InputError(f"{p}.driver_joints: must name the arm's {n} joints once each, without spaces, got {list(driver)}")
         object.__setattr__(self, "driver_joints", driver)
+        if len(self.servo_kp) != len(self.servo_kv):
+            raise InputError(f"{p}.servo_kv: give servo_kp and servo_kv together, one of each per joint ({n})")
+        for name, lo, hi, unit in SERVO_AND_RANGE_BOUNDS:
+            value = getattr(self, name)
+            if value:
+                object.__setattr__(self, name, check_per_joint(f"{p}.{name}", value, n, lo, hi, unit))
+        if bool(self.min_position) != bool(self.max_position):
+            raise InputError(f"{p}.max_position: give min_position and max_position together, one of each per joint ({n})")
+        for i, (lo, hi) in enumerate(zip(self.min_position, self.max_position)):
+            if not lo < hi:
+                raise InputError(f"{p}.max_position[{i}]: must be above min_position[{i}] = {lo:g} rad, got {hi:g}")
+
+    @property
+    def field_prefix(self) -> str:
+        """How messages name these settings: :attr:`label`, else ``arm``."""
+        return self.label or "arm"
 
     @property
     def exported_joints(self) -> tuple[str, ...]:
         """The joint names the exported trajectories use (before the prefix): :attr:`driver_joints`, else the MJCF's."""
         return self.driver_joints or self.joints
+
+
+# (field, lower bound, upper bound, unit) of ArmModel's optional per-joint values, as check_per_joint takes them.
+SERVO_AND_RANGE_BOUNDS = (
+    ("servo_kp", 0.0, 1.0e7, "N m/rad"),
+    ("servo_kv", None, 1.0e6, "N m s/rad"),
+    ("min_position", -100.0, 100.0, "rad"),
+    ("max_position", -100.0, 100.0, "rad"),
+    ("rated_torque", 0.0, 1.0e5, "N m"),
+)
+
+
+def check_per_joint(field: str, values: object, n: int, lo: float | None, hi: float, unit: str) -> tuple[float, ...]:
+    """``n`` numbers, each at most ``hi`` and above ``lo`` (a positive quantity: ``lo`` = 0, open), or at least ``lo``
+    where it is negative (a position), or at least 0 where ``lo`` is None (a damping)."""
+    vector = check_vector(field, values, n)
+    for i, v in enumerate(vector):
+        check_range(f"{field}[{i}]", v, 0.0 if lo is None else lo, hi, unit, lo_open=lo is not None and lo >= 0.0)
+    return vector
+
+
+def check_quat(field: str, values: object) -> tuple[float, ...]:
+    """A rotation as a quaternion [w, x, y, z], normalised; InputError for a zero one."""
+    quat = check_vector(field, values, 4)
+    norm = math.sqrt(sum(v * v for v in quat))
+    if norm < 1e-9:
+        raise InputError(f"{field}: must be a rotation [w, x, y, z] (not all zero), got {list(quat)}")
+    return tuple(v / norm for v in quat)
 
 
 def ur10e_arm() -> ArmModel:
@@ -102,6 +157,13 @@ class ArmPlacement:
     vessel_home: (3,) m, world position of the vessel frame origin at home (y must be 0: the pour plane).
     mount_side: :class:`MountSide`, the wall the flange holds.
     home_seed: (n,) rad, the joint configuration the home posture is solved from (picks the IK branch).
+    base_quat: (4,) [w, x, y, z], the base frame's orientation in the world, instead of ``base_yaw``; None: the yaw.
+    grasp_pos: (3,) m, the vessel frame's origin in the flange site's frame; None: the held wall's outer face on the
+        mount plate, the flange at half the wall height (:func:`cosim.robots.scene_builder.vessel_in_site`).
+    grasp_quat: (4,) [w, x, y, z], the vessel frame's orientation in the flange site's frame; None: the mount side's
+        (the flange's z axis into the held wall, the vessel's z along the site's x).
+    home_field: the setting a home posture out of reach is blamed on in the message (a scene file's
+        ``arms.pour.base_pos``).
     """
 
     role: ArmRole
@@ -112,9 +174,13 @@ class ArmPlacement:
     vessel_home: tuple[float, float, float]
     mount_side: MountSide
     home_seed: tuple[float, ...]
+    base_quat: tuple[float, float, float, float] | None = None
+    grasp_pos: tuple[float, float, float] | None = None
+    grasp_quat: tuple[float, float, float, float] | None = None
+    home_field: str = "placement"
 
     def __post_init__(self) -> None:
-        p = f"{getattr(self.role, 'value', self.role)}"
+        p = self.arm.label if isinstance(self.arm, ArmModel) and self.arm.label else f"{getattr(self.role, 'value', self.role)}"
         object.__setattr__(self, "role", check_choice(f"{p}.role", self.role, ArmRole))
         object.__setattr__(self, "mount_side", check_choice(f"{p}.mount_side", self.mount_side, MountSide))
         object.__setattr__(self, "base_pos", check_vector(f"{p}.base_pos", self.base_pos, 3))
@@ -129,6 +195,12 @@ class ArmPlacement:
         object.__setattr__(self, "home_seed", check_vector(f"{p}.home_seed", self.home_seed, len(self.arm.joints)))
         if not isinstance(self.vessel, VesselSpec):
             raise InputError(f"{p}.vessel: must be a VesselSpec, got {type(self.vessel).__name__}")
+        if self.base_quat is not None:
+            object.__setattr__(self, "base_quat", check_quat(f"{p}.base_quat", self.base_quat))
+        if self.grasp_pos is not None:
+            object.__setattr__(self, "grasp_pos", check_vector(f"{p}.grasp_pos", self.grasp_pos, 3))
+        if self.grasp_quat is not None:
+            object.__setattr__(self, "grasp_quat", check_quat(f"{p}.grasp_quat", self.grasp_quat))
 
 
 @dataclass(frozen=True)

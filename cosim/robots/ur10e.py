@@ -43,8 +43,14 @@ UR10E_RATED_TORQUE: tuple[float, ...] = (330.0, 330.0, 150.0, 56.0, 56.0, 56.0)
 UR10E_PAYLOAD_KG = 12.5
 
 
-def dh_forward_kinematics(q: np.ndarray) -> np.ndarray:
-    """Flange pose (4x4 homogeneous transform, m) in the arm's base frame for joint angles ``q`` (6,), rad.
+def dh_forward_kinematics(
+    q: np.ndarray,
+    dh_d: tuple[float, ...] = UR10E_DH_D,
+    dh_a: tuple[float, ...] = UR10E_DH_A,
+    dh_alpha: tuple[float, ...] = UR10E_DH_ALPHA,
+) -> np.ndarray:
+    """Flange pose (4x4 homogeneous transform, m) in the arm's base frame for joint angles ``q`` (6,), rad, of the
+    arm with standard DH parameters ``dh_d``, ``dh_a`` (m) and ``dh_alpha`` (rad) (default: the UR10e's).
 
     Standard DH: ``T = prod_i Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``; the result is DH frame 6 (tool flange, z out of
     the flange).
@@ -53,7 +59,7 @@ def dh_forward_kinematics(q: np.ndarray) -> np.ndarray:
     if q.shape != (6,):
         raise ValueError(f"q must have shape (6,), got {q.shape}")
     transform = np.eye(4)
-    for theta, d, a, alpha in zip(q, UR10E_DH_D, UR10E_DH_A, UR10E_DH_ALPHA):
+    for theta, d, a, alpha in zip(q, dh_d, dh_a, dh_alpha):
         ct, st, ca, sa = math.cos(theta), math.sin(theta), math.cos(alpha), math.sin(alpha)
         link = np.array(
             [

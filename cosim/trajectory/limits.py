@@ -202,10 +202,11 @@ def arm_limits(
         values.update({f: getattr(override, f) for f in LIMIT_FIELDS if getattr(override, f) is not None})
         for f in ("min_position", "max_position"):
             if not math.isfinite(values[f]) and getattr(override, f) is None:
-                raise InputError(f"limits.{name}.{f}: the model's joint has no range; give one in the overrides")
+                raise InputError(f"limits.{name}.{f}: the model's joint has no range; give one (arms.*.{f} or trajectory.limits)")
             check_range(f"limits.{name}.{f}", values[f], lo, hi, "rad (the model's joint range)")
         if not math.isfinite(values["rated_torque"]):
-            raise InputError(f"limits.{name}.rated_torque: the model's joint has no actuator force range; give one in the overrides")
+            raise InputError(f"limits.{name}.rated_torque: the model's joint has no actuator force range; give one "
+                             f"(arms.*.rated_torque or trajectory.limits)")
         joints.append(JointLimits(name=name, **values))
     return ArmLimits(arm=role.value, arm_model=arm_model, joints=tuple(joints))
 
@@ -213,8 +214,9 @@ def arm_limits(
 def scene_limits(
     scene: RobotScene,
     overrides: Mapping[ArmRole, Mapping[str, JointLimitOverride]] | None = None,
-    arm_model: str = DEFAULT_ARM_MODEL,
+    arm_models: Mapping[ArmRole, str] | None = None,
 ) -> dict[ArmRole, ArmLimits]:
-    """:func:`arm_limits` of both arms, in :class:`ArmRole` order (the trajectory files' column order)."""
-    overrides = overrides or {}
-    return {role: arm_limits(scene, role, overrides.get(role), arm_model) for role in ArmRole}
+    """:func:`arm_limits` of both arms, in :class:`ArmRole` order (the trajectory files' column order); ``arm_models``
+    names each arm's model (default :data:`DEFAULT_ARM_MODEL`)."""
+    overrides, arm_models = overrides or {}, arm_models or {}
+    return {role: arm_limits(scene, role, overrides.get(role), arm_models.get(role, DEFAULT_ARM_MODEL)) for role in ArmRole}
