@@ -99,19 +99,20 @@ def test_the_head_of_a_lattice_is_its_top_layer_plus_half_a_spacing(level_spacin
 def test_the_head_is_continuous_when_another_particle_becomes_the_highest():
     # One particle passes over the liquid's top layer from upstream, through the head's window and past the crest,
     # as the highest particle there: the head read from the highest particle over the crest jumped by about a spacing
-    # where it entered that band. Here the head follows it within the B-spline's slope (max |B'| = 2/3 per spacing
-    # moved; the level's inverse gain 1/C(v) is 1 at levels over two spacings).
+    # where it entered that band. Here the head follows it at most at the window's slope: max |B'| = 2/3 per width
+    # of two spacings, times a particle's weight dx / 2 in a window that wide, 1/6 of the distance moved (the level's
+    # inverse gain 1/C(v) is 1 at levels over two spacings).
     level, step = 2.3 * DX, 1e-4
     liquid = _liquid_over_the_crest(level, 0.0)
     crest = np.array([0.5 * SPEC.inner_width, 0.0, SPEC.inner_height])
-    path_x = np.arange(crest[0] - 5.0 * DX, crest[0] + 3.0 * DX, step)
+    path_x = np.arange(crest[0] - 8.0 * DX, crest[0] + 3.0 * DX, step)
     heads = []
     for px in path_x:
         x = np.vstack([liquid, [px, 0.0, crest[2] + level + 0.2 * DX]])
         heads.append(measure(0.0, GEO, Pose(), Pose(), x, np.zeros_like(x), np.ones(len(x), bool), 0.002).h_q)
     heads = np.array(heads)
     assert heads.max() - heads[0] > 0.1 * DX  # it does add to the head while in the window
-    assert np.abs(np.diff(heads)).max() <= 2.0 / 3.0 * step + 1e-6  # float32 positions: 1e-6 m
+    assert np.abs(np.diff(heads)).max() <= step / 6.0 + 1e-6  # float32 positions: 1e-6 m
 
 
 def test_free_surface_fit_recovers_a_slope():

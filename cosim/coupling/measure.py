@@ -25,7 +25,7 @@ import warp as wp
 
 from controllers.geometry import height_above
 from controllers.measurement import LiquidMeasurement
-from cosim.coupling.crest_head import head_from_volume, head_window, sum_crest_head
+from cosim.coupling.crest_head import WINDOW_WIDTH, head_from_volume, head_window, sum_crest_head, volume_over_crest
 from cosim.coupling.landing import BAND_SPACINGS, MIN_FALL_SPEED_FRACTION
 from cosim.frames import Pose, tilt_about_y
 from cosim.vessel import VesselSpec
@@ -297,15 +297,15 @@ class LiquidProbe:
             self._launch(find_column_tops, self.n, [frame, x, active], [self._column_top])
             self._launch(find_column_top_x, self.n, [frame, x, active, self._column_top], [self._column_top_x])
         window = wp.vec3(*head_window(crest, dx))
-        self._launch(sum_crest_head, CHUNKS, [window, dx, geo.dim, self.n, chunk, x, active], [self._head_sums])
+        self._launch(sum_crest_head, CHUNKS, [window, dx, WINDOW_WIDTH * dx, geo.dim, self.n, chunk, x, active], [self._head_sums])
         top_z = self._column_top.numpy().astype(np.float64)[: geo.columns]
         top_x = self._column_top_x.numpy().astype(np.float64)[: geo.columns]
         c, slope, columns = free_surface_line(top_x, top_z)
         theta1 = math.atan(slope) if columns >= MIN_FIT_COLUMNS else tilt
 
-        volume_over_crest = dx * float(self._head_sums.numpy().astype(np.float64).sum())
-        if volume_over_crest > 0.0:
-            h_q = head_from_volume(volume_over_crest, dx)
+        volume = volume_over_crest(self._head_sums.numpy(), dx, geo.dim)
+        if volume > 0.0:
+            h_q = head_from_volume(volume, dx)
         elif columns >= MIN_FIT_COLUMNS:
             h_q = min(height_above((geo.crest_local[0], geo.crest_local[2]), c, theta1, tilt), 0.0)
         else:

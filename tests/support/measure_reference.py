@@ -40,10 +40,11 @@ def reference_measure(geo: MeasurementGeometry, pourer: Pose, catcher: Pose, x: 
     else:
         c, theta1 = 0.0, tilt
     crest = pourer.transform(geo.crest_local[None, :])[0]
-    d = (x - np.array([crest[0] - dx, crest[1], crest[2]])) / dx
-    weight = _bspline(d[:, 0]) * _bspline_integral(d[:, 2]) * (_bspline(d[:, 1]) if geo.dim == 3 else 1.0)
+    w = 2.0 * dx  # the window's width, its centre one width upstream of the crest
+    d = x - np.array([crest[0] - w, crest[1], crest[2]])
+    weight = _bspline(d[:, 0] / w) * _bspline_integral(d[:, 2] / dx) * (_bspline(d[:, 1] / w) if geo.dim == 3 else 1.0)
     if weight.sum() > 0.0:
-        h_q = dx * _level_for_volume(float(weight.sum()))
+        h_q = dx * _level_for_volume(float(weight.sum()) * (dx / w) ** (geo.dim - 1))
     elif used.sum() >= MIN_FIT_COLUMNS:
         h_q = min(height_above((geo.crest_local[0], geo.crest_local[2]), c, theta1, tilt), 0.0)
     else:
