@@ -30,7 +30,7 @@ from collections.abc import Callable
 import numpy as np
 
 from controllers.catcher import CatcherFollower, landing_x, weir_velocity
-from controllers.cfs import after_flow_volume, cfs_increment, cfs_pivot, crest_lever
+from controllers.cfs import after_flow_volume, cfs_increment, cfs_pivot, crest_lever, deepest_crest_tilt
 from controllers.config import Damping, Handover, PourConfig, SimMode
 from controllers.errors import ControllerInputError, MeasurementError
 from controllers.geometry import PlanarPose, static_tilt_for_h_q
@@ -456,7 +456,10 @@ class PourController:
             cfs.max_tilt_rate * self.dt,
         )
         pivot = cfs_pivot(geom, self.model, theta, cfs.pivot_margin)
-        return self.pose.rotated_about(pivot, min(max(theta + step, 0.0), cfs.max_tilt))
+        # no further than the crest's deepest tilt (controllers.cfs.deepest_crest_tilt), approached or, should it sink
+        # below the tilt, returned to at the rate limit
+        limit = min(cfs.max_tilt, max(deepest_crest_tilt(geom, self._area(m)), theta - cfs.max_tilt_rate * self.dt))
+        return self.pose.rotated_about(pivot, min(max(theta + step, 0.0), limit))
 
     def _act_return(self, m: LiquidMeasurement) -> PlanarPose:
         assert self._return is not None
