@@ -2,33 +2,33 @@
 
 The height of the top particle over the crest jumps by a large part of a particle spacing whenever another particle
 becomes the highest one there, and the constant-flow law turns every jump into a tilt increment. Instead the head is
-read from the liquid's volume over the crest level, through the cubic B-spline colour field of the particles, averaged
-over a horizontal window of width w = WINDOW_WIDTH dx: each particle i of spacing dx is spread over
+read from the liquid's volume over the crest level, through a cubic B-spline colour field of the particles: particle
+i (spacing dx, volume dx^dim) stands for the liquid fraction
 
-    phi_i(x, y, z) = B(sx) [B(sy)] B(sz) dx^(dim - 1) / (w^(dim - 1) dx^dim),   sx, sy = (x, y - particle's) / w,
-    sz = (z - particle's) / dx,
+    phi_i(x, y, z) = (dx / w)^(dim - 1) B((x - x_i) / w) [B((y - y_i) / w)] B((z - z_i) / dx),
 
-B the cubic B-spline (support [-2, 2], unit integral; dim = 2: the pour plane x-z, dim = 3 adds y). Its volume
-over the crest level z_c, per unit width and depth, at the window's centre (x_w, y_w) is
+B the cubic B-spline (support [-2, 2], unit integral), w = WINDOW_WIDTH dx its width across (dim = 2: the pour
+plane x-z; dim = 3 adds y). The volume over the crest level z_c per unit width and depth, at the window's centre
+(x_w, y_w), is the integral of sum_i phi_i over z > z_c:
 
     m = dx (dx / w)^(dim - 1) sum_i B((x_i - x_w) / w) [B((y_i - y_w) / w)] C((z_i - z_c) / dx),
 
 C the B-spline's integral (the particle's share above z_c, from 0 at 2 dx below it to 1 at 2 dx above). m is twice
 continuously differentiable in every particle position: a particle entering, leaving or overtaking another changes
-it gradually. Liquid flows through the window at about sqrt(g h_q) (0.4 m/s at 15 mm): a particle crosses a
-spacing every 12 ms, and that passage is noise in the head at tens of Hz. A window of two spacings (support
-+-4 dx) averages over twice the particles of one and passes less of their passage (the B-spline's spectrum falls as
-sinc^4 of its width). It is centred
-WINDOW_OFFSET windows upstream of the crest, x_w = x_c - w, where the liquid still stands at the level that drives
-the flow over the crest (weir heads are read upstream of the crest); the liquid falling past the crest lies below
-the crest level and does not count.
+it gradually. Liquid flows over the crest at about sqrt(g h_q) (0.4 m/s at 15 mm), across a spacing every 12 ms,
+and that passage is noise in the head at tens of Hz. A window two spacings wide (support +-4 dx) averages over
+twice the particles of one a spacing wide and passes less of their passage (the B-spline's spectrum falls as sinc^4
+of its width). Its centre lies WINDOW_OFFSET widths upstream of the crest, x_w = x_c - w, where the liquid still
+stands at the level that drives the flow over the crest (weir heads are read upstream of the crest); the liquid
+falling past the crest lies below the crest level and does not count.
 
 Calibration: a continuous liquid at rest whose level stands u (m) over the crest gives m = dx G(u / dx), G the
 second integral of B (G(v) = 0 for v <= -2, G(v) = v for v >= 2, G'' = B). So h_q = dx G^-1(m / dx) reads the
 level itself: negative while it is below the crest, positive once liquid stands over it. A particle lattice (dx
-apart, top layer u - dx/2 over the crest, any phase in x) gives m = u exactly from u = 1.5 dx on, since the
-B-spline's translates by its width, and so by its half width (w = 2 dx), sum to one: from u = 2 dx on h_q = u, the top particle plus half a spacing, as the
-top-particle reading of a lattice (between 1.5 and 2 dx h_q lies below u by G(-u / dx) dx, at most 3e-4 dx).
+apart, top layer u - dx/2 over the crest, any phase in x) gives m = u exactly from u = 1.5 dx on, because the
+B-spline translated by its knot spacing sums to one (B(s / 2) / 2 by half its width too); from u = 2 dx on h_q = u,
+the top particle plus half a spacing, as the top-particle reading of a lattice (from 1.5 to 2 dx h_q lies below u by
+at most 3e-4 dx).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ import warp as wp
 
 REACH = wp.constant(2.0)  # spacings: the B-spline's support half-width, how far below the crest level a particle still counts
 WINDOW_WIDTH = 2.0  # spacings: the horizontal B-spline's width w (its support is +-2 w)
-WINDOW_OFFSET = 1.0  # windows: the window's centre lies this far upstream of the crest (toward -x in the world)
+WINDOW_OFFSET = 1.0  # widths: the window's centre lies this far upstream of the crest (toward -x in the world)
 NEWTON_ITERATIONS = 30  # G is convex and increasing: Newton from above converges monotonically
 NEWTON_TOLERANCE = 1e-12  # spacings
 LOWEST_PIECE = 1.0 / 120.0  # G(-1): below it G(v) = (v + 2)^5 / 120, inverted in closed form
