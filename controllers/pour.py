@@ -46,6 +46,11 @@ from controllers.slosh_induction import excitation_duration, excitation_tilt, si
 # (the level drop it feeds forward), through two a ramp.
 OUTFLOW_FILTER_TIME = 0.1
 OUTFLOW_FILTER_STAGES = 2
+# Delay (s) of the two-stage filter on the volume left that sets CFS's deepest tilt (controllers.cfs.deepest_crest_tilt):
+# the volume changes in whole particles, and near 89 deg one particle of the default scene moves that tilt by 3e-4
+# rad, a step in a command that rides the limit. Filtered, the limit rises smoothly; it lags the draining, which
+# keeps it below the instantaneous one.
+DEEPEST_TILT_FILTER_TIME = 0.5
 # CFS has stalled when, over the last cfs.max_tilt_hold s, less than this fraction of the initial volume left and
 # the tilt rose by less than STALL_TILT: near 90 deg the crest's lever degenerates and the last wedge of liquid
 # only drips (default scene: 139 mL left, about 5 mL/s, for 26 s at 89 deg).
@@ -117,6 +122,7 @@ class PourController:
         # the outflow rate, for the after-flow prediction, which scales that rate by (head / this)^(3/2)
         self._head_stages = [math.nan] * OUTFLOW_FILTER_STAGES
         self._h_q = math.nan
+        self._volume_stages = [math.nan] * OUTFLOW_FILTER_STAGES  # m^3, the volume left for the deepest tilt
         self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
         self._cfs_head = 0.0  # m, the measured h_q through CFS's head filter (cfs.head_filter_fraction)
         self._theta1_rate = 0.0  # rad/s, of the measured free-surface angle over the last step
@@ -181,6 +187,8 @@ class PourController:
             gain = min(OUTFLOW_FILTER_STAGES * (m.t - self._last_t) / OUTFLOW_FILTER_TIME, 1.0)
             self._outflow_rate = _low_pass(self._outflow_stages, rate, gain)
             self._h_q = _low_pass(self._head_stages, max(m.h_q, 0.0), gain)
+            gain = min(OUTFLOW_FILTER_STAGES * (m.t - self._last_t) / DEEPEST_TILT_FILTER_TIME, 1.0)
+            _low_pass(self._volume_stages, m.volume_in_pourer, gain)
             self._theta1_rate = (m.theta1 - self._last_theta1) / (m.t - self._last_t)
         self._last_theta1 = m.theta1
         self._last_t, self._last_poured = m.t, m.poured_volume
@@ -213,6 +221,7 @@ class PourController:
         self._first_t = m.t
         self._h_q = max(m.h_q, 0.0)
         self._head_stages = [self._h_q] * OUTFLOW_FILTER_STAGES
+        self._volume_stages = [m.volume_in_pourer] * OUTFLOW_FILTER_STAGES
         self._initial_volume = m.volume_in_pourer + m.poured_volume
         if not self._initial_volume > 0.0:
             raise MeasurementError("measurement.volume_in_pourer: the pourer is empty at the first step")
@@ -456,9 +465,10 @@ class PourController:
             cfs.max_tilt_rate * self.dt,
         )
         pivot = cfs_pivot(geom, self.model, theta, cfs.pivot_margin)
-        # no further than the crest's deepest tilt (controllers.cfs.deepest_crest_tilt), approached or, should it sink
-        # below the tilt, returned to at the rate limit
-        limit = min(cfs.max_tilt, max(deepest_crest_tilt(geom, self._area(m)), theta - cfs.max_tilt_rate * self.dt))
+        # no further than the crest's deepest tilt (controllers.cfs.deepest_crest_tilt) for the filtered volume left,
+        # approached or, should it sink below the tilt, returned to at the rate limit
+        deepest = deepest_crest_tilt(geom, geom.area(self._volume_stages[-1]))
+        limit = min(cfs.max_tilt, max(deepest, theta - cfs.max_tilt_rate * self.dt))
         return self.pose.rotated_about(pivot, min(max(theta + step, 0.0), limit))
 
     def _act_return(self, m: LiquidMeasurement) -> PlanarPose:
