@@ -46,10 +46,10 @@ from controllers.slosh_induction import excitation_duration, excitation_tilt, si
 # (the level drop it feeds forward), through two a ramp.
 OUTFLOW_FILTER_TIME = 0.1
 OUTFLOW_FILTER_STAGES = 2
-# Delay (s) of the two-stage filter on the volume left that sets CFS's deepest tilt (controllers.cfs.deepest_crest_tilt):
-# the volume changes in whole particles, and near 89 deg one particle of the default scene moves that tilt by 3e-4
-# rad, a step in a command that rides the limit. Filtered, the limit rises smoothly; it lags the draining, which
-# keeps it below the instantaneous one.
+# Delay (s) of the filter (OUTFLOW_FILTER_STAGES stages) on the volume left that sets CFS's deepest tilt
+# (controllers.cfs.deepest_crest_tilt): the volume changes in whole particles, and near 89 deg one particle of the
+# default scene moves that tilt by 3e-4 rad, a step in a command that rides the limit. Filtered, the limit rises
+# smoothly; it lags the draining, which keeps it below the instantaneous one.
 DEEPEST_TILT_FILTER_TIME = 0.5
 # CFS has stalled when, over the last cfs.max_tilt_hold s, less than this fraction of the initial volume left and
 # the tilt rose by less than STALL_TILT: near 90 deg the crest's lever degenerates and the last wedge of liquid

@@ -38,7 +38,7 @@ import math
 import numpy as np
 import warp as wp
 
-REACH = wp.constant(2.0)  # spacings: the B-spline's support half-width, how far below the crest level a particle still counts
+REACH = wp.constant(2.0)  # spacings: the B-spline's half support, how far below the crest level a particle counts
 WINDOW_WIDTH = 2.0  # spacings: the horizontal B-spline's width w (its support is +-2 w)
 WINDOW_OFFSET = 1.0  # widths: the window's centre lies this far upstream of the crest (toward -x in the world)
 NEWTON_ITERATIONS = 30  # G is convex and increasing: Newton from above converges monotonically

@@ -3,10 +3,10 @@
 Implements the measurement contract written in :class:`controllers.measurement.LiquidMeasurement` exactly
 (free-surface angle theta1 from a least-squares line through the top particle of each column of width h in the
 pourer's frame; h_q from the liquid's volume over the crest, :mod:`cosim.coupling.crest_head`; v_q through the
-lip plane; volumes; lip and catcher-rim positions). The pour
-lip used here is where the simulated liquid leaves the vessel: the outer top edge of the wall as the liquid sees
-it (``FluidModel.wall_thickness``, at least the dummy-particle layers), which is also the wall thickness given to
-the controller, so that its jet launch point is the simulated one.
+lip plane; volumes; lip and catcher-rim positions). The pour lip used here is where the simulated liquid leaves the
+vessel: the outer top edge of the wall as the liquid sees it (``FluidModel.wall_thickness``, at least the
+dummy-particle layers), which is also the wall thickness given to the controller, so that its jet launch point is
+the simulated one.
 
 Computed on the fluid's device, from its particle arrays as they are (any order): warp kernels reduce the
 particles to per-column maxima, fixed-order chunk sums of the liquid over the crest and of the stream leaving the
