@@ -37,6 +37,7 @@ from controllers.geometry import MAX_STATIC_TILT, VesselGeometry, rotate, surfac
 from controllers.slosh import SloshModel
 
 AFTER_FLOW_SAMPLES = 257  # quadrature points for the after-flow integral (trapezoid; smooth integrand)
+DEEPEST_TILT_HALVINGS = 40  # bisection of [0, 90 deg) for deepest_crest_tilt: 1.4e-12 rad
 
 
 def _static_chord(geom: VesselGeometry, theta: float, area: float) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -50,6 +51,29 @@ def crest_lever(geom: VesselGeometry, theta: float, area: float) -> tuple[float,
     (x0, z0), (x1, z1) = _static_chord(geom, theta, area)
     cx, cz = geom.crest
     return rotate(theta, (cx - 0.5 * (x0 + x1), cz - 0.5 * (z0 + z1)))
+
+
+def deepest_crest_tilt(geom: VesselGeometry, area: float) -> float:
+    """Tilt (rad) beyond which tilting on raises the crest over the level surface of ``area`` (m^2): where the crest
+    lever (:func:`crest_lever`) turns vertical, a_x = 0, and the liquid at rest stands highest over the crest.
+
+    Turning by dtheta lowers the crest by a_x dtheta relative to the surface's midpoint; as the liquid left becomes a
+    wedge against the lip wall (past about 84 deg in a pour), a_x falls through zero within a degree (the wedge's
+    midpoint moves along the wall as the vessel turns). Past that tilt the vector step answers a head below its
+    reference with a turn back, short of it with a turn forward: at the rate limit, of either sign from one step to
+    the next. CFS stops at this tilt instead (:class:`controllers.pour.PourController`), which rises as the vessel
+    drains. Bisection of a_x over [0, 90 deg) (a_x > 0 upright: the crest lies toward the lip from the midpoint);
+    ``math.inf`` where a_x stays positive up to 90 deg."""
+    if crest_lever(geom, MAX_STATIC_TILT, area)[0] > 0.0 or crest_lever(geom, 0.0, area)[0] <= 0.0:
+        return math.inf
+    lo, hi = 0.0, MAX_STATIC_TILT
+    for _ in range(DEEPEST_TILT_HALVINGS):
+        mid = 0.5 * (lo + hi)
+        if crest_lever(geom, mid, area)[0] > 0.0:
+            lo = mid
+        else:
+            hi = mid
+    return lo
 
 
 def level_drop(geom: VesselGeometry, theta: float, area: float, outflow: float) -> float:

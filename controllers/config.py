@@ -143,11 +143,11 @@ class CfsConfig:
     final_stage_time: s, the final stage starts when the volume still to pour before the predicted after-flow
       would leave in this time at the current outflow rate. [0, 10]
     head_filter_fraction: the law reads the measured h_q through a first-order low-pass whose time constant is
-      this fraction of time_constant (0: unfiltered). [0, 1] The SPH head is quantised by the particles at the
-      crest, and the law would turn each sample's noise into a tilt increment. Linearised, the integral law with
-      a lag tau in its loop is tau T s^2 + T s + 1 (T = time_constant), damped at zeta = sqrt(T / tau) / 2; the
-      loop's lag is this filter's plus the arm's (its task-space filter and servos: 0.08-0.1 s in the coupled
-      pour). zeta >= 0.7 needs their sum <= T / 2 = 0.15 s, which leaves at most 0.05 s for the filter; the
+      this fraction of time_constant (0: unfiltered). [0, 1] The SPH head carries the particles' passage over the
+      crest as noise, and the law would turn each sample's noise into a tilt increment. Linearised, the integral
+      law with a lag tau in its loop is tau T s^2 + T s + 1 (T = time_constant), damped at zeta = sqrt(T / tau) /
+      2; the loop's lag is this filter's plus the arm's (its task-space filter and servos: 0.08-0.1 s in the
+      coupled pour). zeta >= 0.7 needs their sum <= T / 2 = 0.15 s, which leaves at most 0.05 s for the filter; the
       default, 0.1 T = 0.03 s, keeps a margin for the slosh mode the law also acts on. (At 0.25 T a partial pour
       with an arm 90 ms late on the pendulum plant stopped 12 % short.)
     """

@@ -31,10 +31,18 @@ class LiquidMeasurement:
       vessel x); fit z = c + m x to those by least squares;
       theta1 = atan(m). Fewer than three columns: theta1 = tilt (nothing to fit). A liquid at rest gives
       theta1 = tilt; equivalently theta1 = tilt + atan(dz/dx) of the same surface fitted in world x-z.
-    h_q: m, height of the free surface over the crest point, along world z. Where liquid lies over the crest
-      (particles within one particle spacing dx of the crest's world x, above it): z of the highest such particle
-      centre + dx/2 - z of the crest. Otherwise: the height of the theta1 fit line above the crest along world z,
-      clipped to <= 0 (:func:`controllers.geometry.height_above`). h_q > 0 means outflow.
+    h_q: m, height of the free surface over the crest point, along world z, read from the liquid's volume over the
+      crest level: each particle spread as the cubic B-spline B (support +-2 in its argument) over x (and y in 3-D)
+      with width w = 2 dx (dx = particle spacing) and over z with width dx, the volume over the crest's z per unit
+      width (and depth) at the window centred w upstream of the crest's world x (and at its y) is m = dx (dx /
+      w)^(dim - 1) * sum_i B(sx_i) [B(sy_i)] C(sz_i), sx, sy = (particle - window) / w, sz = (particle z - crest
+      z) / dx, C the integral of B; h_q = dx * G^-1(m / dx), G the second integral of B (G(v) = v for v >= 2),
+      which makes it the level of a liquid at rest, and of a particle lattice at least 2 dx over the crest its top
+      particle centre + dx/2 - z of the crest (:mod:`cosim.coupling.crest_head`). Smooth in the particle positions:
+      no jump when another particle becomes the highest.
+      Where m = 0 (no particle within 2 dx below the crest level in the window): the height of the theta1 fit line
+      above the crest along world z, clipped to <= 0 (:func:`controllers.geometry.height_above`). h_q > 0 means
+      outflow.
     v_q: m/s, mean world-x velocity of the liquid particles that have just left over the lip: those outside the
       inner box with world x in [x_lip + dx, x_lip + 4 dx] and z in [z_lip - 6 dx, z_lip + dx + max(h_q, 0)] (the
       stream one to four spacings past the lip, where it already falls freely: nearer the lip the liquid behind

@@ -30,7 +30,7 @@ from collections.abc import Callable
 import numpy as np
 
 from controllers.catcher import CatcherFollower, landing_x, weir_velocity
-from controllers.cfs import after_flow_volume, cfs_increment, cfs_pivot, crest_lever
+from controllers.cfs import after_flow_volume, cfs_increment, cfs_pivot, crest_lever, deepest_crest_tilt
 from controllers.config import Damping, Handover, PourConfig, SimMode
 from controllers.errors import ControllerInputError, MeasurementError
 from controllers.geometry import PlanarPose, static_tilt_for_h_q
@@ -39,9 +39,18 @@ from controllers.motion import CriticallyDampedSmoother, JerkLimitedMove, RateLi
 from controllers.pid import DiscretePid, PidDesign, design_filtered_pid
 from controllers.slosh_induction import excitation_duration, excitation_tilt, sim_needed
 
-# Time constant (s) of the first-order filter on the measured outflow rate d(poured)/dt: a fifth of the paper's
-# vessel's slosh period, enough to smooth SPH particle-count steps while keeping the stop prediction current.
+# Delay (s) of the filter on the measured outflow rate d(poured)/dt: a fifth of the paper's vessel's slosh period,
+# enough to smooth SPH particle-count steps while keeping the stop prediction current. OUTFLOW_FILTER_STAGES
+# first-order stages of OUTFLOW_FILTER_TIME / OUTFLOW_FILTER_STAGES each: the volume leaves in whole particles, each an
+# impulse in d(poured)/dt; through one stage it is a step in the filtered rate and so in the CFS law's tilt rate
+# (the level drop it feeds forward), through two a ramp.
 OUTFLOW_FILTER_TIME = 0.1
+OUTFLOW_FILTER_STAGES = 2
+# Delay (s) of the filter (OUTFLOW_FILTER_STAGES stages) on the volume left that sets CFS's deepest tilt
+# (controllers.cfs.deepest_crest_tilt): the volume changes in whole particles, and near 89 deg one particle of the
+# default scene moves that tilt by 3e-4 rad, a step in a command that rides the limit. Filtered, the limit rises
+# smoothly; it lags the draining, which keeps it below the instantaneous one.
+DEEPEST_TILT_FILTER_TIME = 0.5
 # CFS has stalled when, over the last cfs.max_tilt_hold s, less than this fraction of the initial volume left and
 # the tilt rose by less than STALL_TILT: near 90 deg the crest's lever degenerates and the last wedge of liquid
 # only drips (default scene: 139 mL left, about 5 mL/s, for 26 s at 89 deg).
@@ -56,6 +65,14 @@ LAG_WINDOW = 0.5  # s, about one slosh period of the vessel of Camporredondo et 
 MAX_FOLLOWER_LAG = 0.3  # s
 
 Transition = tuple[Phase, str] | None
+
+
+def _low_pass(stages: list[float], x: float, gain: float) -> float:
+    """One sample ``x`` through first-order stages in series (each y += gain (input - y), updated in place); returns
+    the last stage's output."""
+    for k, y in enumerate(stages):
+        x = stages[k] = y + gain * (x - y)
+    return x
 
 
 class PourController:
@@ -99,10 +116,13 @@ class PourController:
         self._last_t: float | None = None
         self._first_t = math.nan
         self._initial_volume = math.nan
+        self._outflow_stages = [0.0] * OUTFLOW_FILTER_STAGES  # the outflow rate's filter
         self._outflow_rate = 0.0  # m^3/s, filtered
         # m, the head over the crest as the weir law sees it (max(h_q, 0): a negative head pours nothing), filtered like
         # the outflow rate, for the after-flow prediction, which scales that rate by (head / this)^(3/2)
+        self._head_stages = [math.nan] * OUTFLOW_FILTER_STAGES
         self._h_q = math.nan
+        self._volume_stages = [math.nan] * OUTFLOW_FILTER_STAGES  # m^3, the volume left for the deepest tilt
         self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
         self._cfs_head = 0.0  # m, the measured h_q through CFS's head filter (cfs.head_filter_fraction)
         self._theta1_rate = 0.0  # rad/s, of the measured free-surface angle over the last step
@@ -164,9 +184,11 @@ class PourController:
             raise MeasurementError(f"measurement.t: must increase, got {m.t:g} s after {self._last_t:g} s")
         else:
             rate = (m.poured_volume - self._last_poured) / (m.t - self._last_t)
-            gain = min((m.t - self._last_t) / OUTFLOW_FILTER_TIME, 1.0)
-            self._outflow_rate += gain * (rate - self._outflow_rate)
-            self._h_q += gain * (max(m.h_q, 0.0) - self._h_q)
+            gain = min(OUTFLOW_FILTER_STAGES * (m.t - self._last_t) / OUTFLOW_FILTER_TIME, 1.0)
+            self._outflow_rate = _low_pass(self._outflow_stages, rate, gain)
+            self._h_q = _low_pass(self._head_stages, max(m.h_q, 0.0), gain)
+            gain = min(OUTFLOW_FILTER_STAGES * (m.t - self._last_t) / DEEPEST_TILT_FILTER_TIME, 1.0)
+            _low_pass(self._volume_stages, m.volume_in_pourer, gain)
             self._theta1_rate = (m.theta1 - self._last_theta1) / (m.t - self._last_t)
         self._last_theta1 = m.theta1
         self._last_t, self._last_poured = m.t, m.poured_volume
@@ -198,6 +220,8 @@ class PourController:
     def _begin(self, m: LiquidMeasurement) -> None:
         self._first_t = m.t
         self._h_q = max(m.h_q, 0.0)
+        self._head_stages = [self._h_q] * OUTFLOW_FILTER_STAGES
+        self._volume_stages = [m.volume_in_pourer] * OUTFLOW_FILTER_STAGES
         self._initial_volume = m.volume_in_pourer + m.poured_volume
         if not self._initial_volume > 0.0:
             raise MeasurementError("measurement.volume_in_pourer: the pourer is empty at the first step")
@@ -441,7 +465,11 @@ class PourController:
             cfs.max_tilt_rate * self.dt,
         )
         pivot = cfs_pivot(geom, self.model, theta, cfs.pivot_margin)
-        return self.pose.rotated_about(pivot, min(max(theta + step, 0.0), cfs.max_tilt))
+        # no further than the crest's deepest tilt (controllers.cfs.deepest_crest_tilt) for the filtered volume left,
+        # approached or, should it sink below the tilt, returned to at the rate limit
+        deepest = deepest_crest_tilt(geom, geom.area(self._volume_stages[-1]))
+        limit = min(cfs.max_tilt, max(deepest, theta - cfs.max_tilt_rate * self.dt))
+        return self.pose.rotated_about(pivot, min(max(theta + step, 0.0), limit))
 
     def _act_return(self, m: LiquidMeasurement) -> PlanarPose:
         assert self._return is not None

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from controllers.cfs import after_flow_volume, cfs_pivot, crest_lever, level_drop
-from controllers.geometry import VesselGeometry, rotate, vector_step
+from controllers.cfs import after_flow_volume, cfs_pivot, crest_lever, deepest_crest_tilt, level_drop
+from controllers.geometry import VesselGeometry, rotate, static_h_q, vector_step
 from controllers.slosh import potential_flow_model
 
 SEED_VESSEL = VesselGeometry()
@@ -64,6 +64,17 @@ def test_cfs_pivot_is_the_lip_until_it_sinks_toward_the_hinge() -> None:
             piv_w = rotate(float(theta), pivot)
             assert piv_w[0] == pytest.approx(lip_w[0], abs=1e-12)  # straight above the lip in the world
     assert SEED.pivot_above_hinge(SEED_VESSEL.lip, math.radians(50.0)) < margin  # the switch does happen
+
+
+@pytest.mark.parametrize("area", [0.006, 0.003, 0.0015])  # m^2: 600, 300 and 150 mL in the 0.1 m deep vessel
+def test_deepest_crest_tilt_is_where_the_liquid_at_rest_stands_highest_over_the_crest(area) -> None:
+    geom = VesselGeometry(wall_thickness=0.191 / 40 * 3)
+    tilt = deepest_crest_tilt(geom, area)
+    assert math.radians(80.0) < tilt < math.radians(90.0)
+    assert abs(crest_lever(geom, tilt, area)[0]) < 1e-9
+    tilts = np.linspace(tilt - 0.05, min(tilt + 0.05, math.radians(89.99)), 101)
+    heads = [static_h_q(geom, float(t), area) for t in tilts]
+    assert static_h_q(geom, tilt, area) >= max(heads) - 1e-6  # within a micrometre of the largest head nearby
 
 
 def test_level_drop_of_a_level_surface_spanning_the_vessel() -> None:

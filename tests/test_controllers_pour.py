@@ -25,6 +25,7 @@ from controllers import (
     SimConfig,
     SimMode,
 )
+from controllers.cfs import deepest_crest_tilt
 from controllers.geometry import VesselGeometry, static_tilt_for_h_q
 from controllers.model_plant import ModelPlant, ModelPlantConfig, Trace, run_closed_loop
 from controllers.slosh_induction import excitation_duration
@@ -392,6 +393,29 @@ def test_controllers_import_no_warp_mujoco_or_cosim() -> None:
     root = Path(__file__).resolve().parents[1]
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=root)
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_cfs_stops_at_the_crest_deepest_tilt_without_turning_back_and_forth() -> None:
+    """The last liquid, a wedge against the lip wall: the head stays below its reference, and past the tilt where the
+    crest is lowest relative to the liquid (controllers.cfs.deepest_crest_tilt) the vector step turns back at the
+    rate limit, then forward again. CFS tilts up to that tilt and holds it."""
+    config = _config(sim=SimConfig(mode=SimMode.NEVER), cfs=CfsConfig(max_tilt=2.4))
+    controller = PourController(config)
+    left = 0.0002  # m^3
+    poured = config.initial_volume - left
+    tilts = []
+    for k in range(3000):  # 30 s
+        m = _measurement(t=0.2 + k * config.dt, h_q=0.0004, tilt=controller.pose.theta, volume_in_pourer=left,
+                         poured_volume=poured)
+        command = controller.step(m)
+        if command.phase is not Phase.CFS:
+            continue
+        tilts.append(command.pourer.theta)
+    deepest = deepest_crest_tilt(config.vessel, config.vessel.area(left))
+    assert np.all(np.diff(tilts) >= 0.0)  # never turns back
+    # holds that tilt until the stall rule ends CFS (nothing pours; the rule's window began while it still rose)
+    assert np.count_nonzero(np.array(tilts) == deepest) >= 0.9 * config.cfs.max_tilt_hold / config.dt
+    assert controller.phase is not Phase.CFS
 
 
 def test_cfs_that_no_longer_pours_returns_as_stalled() -> None:

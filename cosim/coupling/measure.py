@@ -2,14 +2,15 @@
 
 Implements the measurement contract written in :class:`controllers.measurement.LiquidMeasurement` exactly
 (free-surface angle theta1 from a least-squares line through the top particle of each column of width h in the
-pourer's frame; h_q over the crest; v_q through the lip plane; volumes; lip and catcher-rim positions). The pour
-lip used here is where the simulated liquid leaves the vessel: the outer top edge of the wall as the liquid sees
-it (``FluidModel.wall_thickness``, at least the dummy-particle layers), which is also the wall thickness given to
-the controller, so that its jet launch point is the simulated one.
+pourer's frame; h_q from the liquid's volume over the crest, :mod:`cosim.coupling.crest_head`; v_q through the
+lip plane; volumes; lip and catcher-rim positions). The pour lip used here is where the simulated liquid leaves the
+vessel: the outer top edge of the wall as the liquid sees it (``FluidModel.wall_thickness``, at least the
+dummy-particle layers), which is also the wall thickness given to the controller, so that its jet launch point is
+the simulated one.
 
 Computed on the fluid's device, from its particle arrays as they are (any order): warp kernels reduce the
-particles to per-column maxima, the crest's highest particle, fixed-order chunk sums of the stream leaving the lip
-and the few particles crossing vessel B's rim plane; the host reads back only those, so its work per control
+particles to per-column maxima, fixed-order chunk sums of the liquid over the crest and of the stream leaving the
+lip and the few particles crossing vessel B's rim plane; the host reads back only those, so its work per control
 step does not grow with the particle count. Every reduction is order-independent (maxima, a median of a set) or
 summed in a fixed order (chunks), so the measurement is deterministic on any device.
 """
@@ -24,6 +25,7 @@ import warp as wp
 
 from controllers.geometry import height_above
 from controllers.measurement import LiquidMeasurement
+from cosim.coupling.crest_head import WINDOW_WIDTH, head_from_volume, head_window, sum_crest_head, volume_over_crest
 from cosim.coupling.landing import BAND_SPACINGS, MIN_FALL_SPEED_FRACTION
 from cosim.frames import Pose, tilt_about_y
 from cosim.vessel import VesselSpec
@@ -108,27 +110,21 @@ def column_of(f: PourerFrame, qx: float) -> int:
 def find_column_tops(
     # Model
     f: PourerFrame,
-    crest: wp.vec3,
-    dx: float,
     # State in
     x: wp.array(dtype=wp.vec3),
     active: wp.array(dtype=wp.int32),
     # Out
     column_top: wp.array(dtype=float),
-    crest_top: wp.array(dtype=float),
 ):
-    """The highest vessel z of each surface column (inner particles) and the highest world z over the crest."""
+    """The highest vessel z of each surface column (inner particles)."""
     i = wp.tid()
     if active[i] == 0:
         return
-    xi = x[i]
-    q = inner_local(f, xi)
+    q = inner_local(f, x[i])
     if q[3] > 0.0:
         c = column_of(f, q[0])
         if c >= 0:
             wp.atomic_max(column_top, c, q[2])
-    if wp.abs(xi[0] - crest[0]) <= dx and xi[2] > crest[2]:
-        wp.atomic_max(crest_top, 0, xi[2])
 
 
 @wp.kernel
@@ -247,7 +243,7 @@ class LiquidProbe:
         cols = max(geo.columns, 1)
         self._column_top = wp.zeros(cols, dtype=float, device=device)
         self._column_top_x = wp.zeros(cols, dtype=float, device=device)
-        self._crest_top = wp.zeros(1, dtype=float, device=device)
+        self._head_sums = wp.zeros(CHUNKS, dtype=float, device=device)
         self._sums = wp.zeros((CHUNKS, STREAM_SUM_COLUMNS), dtype=float, device=device)
         self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
         self._crossing_x = wp.zeros(max(n_particles, 1), dtype=float, device=device)
@@ -296,18 +292,20 @@ class LiquidProbe:
         crest = pourer_pose.transform(geo.crest_local[None, :])[0]
         self._column_top.fill_(LOWEST)
         self._column_top_x.fill_(LOWEST)
-        self._crest_top.fill_(LOWEST)
+        chunk = max(math.ceil(self.n / CHUNKS), 1)
         if self.n:
-            self._launch(find_column_tops, self.n, [frame, wp.vec3(*crest), dx, x, active], [self._column_top, self._crest_top])
+            self._launch(find_column_tops, self.n, [frame, x, active], [self._column_top])
             self._launch(find_column_top_x, self.n, [frame, x, active, self._column_top], [self._column_top_x])
+        window = wp.vec3(*head_window(crest, dx))
+        self._launch(sum_crest_head, CHUNKS, [window, dx, WINDOW_WIDTH * dx, geo.dim, self.n, chunk, x, active], [self._head_sums])
         top_z = self._column_top.numpy().astype(np.float64)[: geo.columns]
         top_x = self._column_top_x.numpy().astype(np.float64)[: geo.columns]
         c, slope, columns = free_surface_line(top_x, top_z)
         theta1 = math.atan(slope) if columns >= MIN_FIT_COLUMNS else tilt
 
-        crest_top = float(self._crest_top.numpy()[0])
-        if crest_top > 0.5 * LOWEST:
-            h_q = crest_top + 0.5 * dx - crest[2]
+        volume = volume_over_crest(self._head_sums.numpy(), dx, geo.dim)
+        if volume > 0.0:
+            h_q = head_from_volume(volume, dx)
         elif columns >= MIN_FIT_COLUMNS:
             h_q = min(height_above((geo.crest_local[0], geo.crest_local[2]), c, theta1, tilt), 0.0)
         else:
@@ -315,7 +313,6 @@ class LiquidProbe:
 
         lip = pourer_pose.transform(geo.lip_local[None, :])[0]
         top = lip[2] + dx + max(h_q, 0.0)
-        chunk = max(math.ceil(self.n / CHUNKS), 1)
         self._launch(sum_leaving_stream, CHUNKS, [frame, wp.vec3(*lip), dx, top, self.n, chunk, x, v, active], [self._sums])
         count, svx, svz, sx, sz = self._sums.numpy().astype(np.float64).sum(axis=0)
         if count > 0:

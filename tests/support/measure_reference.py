@@ -40,9 +40,11 @@ def reference_measure(geo: MeasurementGeometry, pourer: Pose, catcher: Pose, x: 
     else:
         c, theta1 = 0.0, tilt
     crest = pourer.transform(geo.crest_local[None, :])[0]
-    over = (np.abs(x[:, 0] - crest[0]) <= dx) & (x[:, 2] > crest[2])
-    if over.any():
-        h_q = float(x[over, 2].max() + 0.5 * dx - crest[2])
+    w = 2.0 * dx  # the window's width, its centre one width upstream of the crest
+    d = x - np.array([crest[0] - w, crest[1], crest[2]])
+    weight = _bspline(d[:, 0] / w) * _bspline_integral(d[:, 2] / dx) * (_bspline(d[:, 1] / w) if geo.dim == 3 else 1.0)
+    if weight.sum() > 0.0:
+        h_q = dx * _level_for_volume(float(weight.sum()) * (dx / w) ** (geo.dim - 1))
     elif used.sum() >= MIN_FIT_COLUMNS:
         h_q = min(height_above((geo.crest_local[0], geo.crest_local[2]), c, theta1, tilt), 0.0)
     else:
@@ -58,6 +60,33 @@ def reference_measure(geo: MeasurementGeometry, pourer: Pose, catcher: Pose, x: 
     rim = catcher.transform(np.array([[0.0, 0.0, geo.catcher_height]]))[0]
     return dict(theta1=theta1, h_q=h_q, v_q=v_q, v_q_z=v_q_z, jet_dx=jet_dx, jet_dz=jet_dz, lip_x=lip[0], lip_z=lip[2],
                 catcher_rim_z=rim[2], leaving=int(leaving.sum()))
+
+
+def _bspline(s: np.ndarray) -> np.ndarray:
+    """Cubic B-spline of unit spacing (support [-2, 2], unit integral)."""
+    a = np.abs(s)
+    return np.where(a < 1.0, 2.0 / 3.0 - a**2 + 0.5 * a**3, np.where(a < 2.0, (2.0 - np.minimum(a, 2.0)) ** 3 / 6.0, 0.0))
+
+
+def _bspline_integral(s: np.ndarray) -> np.ndarray:
+    """Integral of the cubic B-spline from -inf to s, by Simpson's rule on its pieces (exact for cubics)."""
+    s = np.clip(np.asarray(s, dtype=float), -2.0, 2.0)
+    total = np.zeros_like(s)
+    for k in np.arange(-2.0, 2.0):  # each piece [k, k + 1] is one cubic
+        b = np.clip(s, k, k + 1.0)
+        total += (b - k) / 6.0 * (_bspline(np.full_like(b, k)) + 4.0 * _bspline(0.5 * (k + b)) + _bspline(b))
+    return total
+
+
+def _level_for_volume(volume: float) -> float:
+    """v (spacings) whose resting level has this volume over the crest: bisection of G(v) = integral of the
+    B-spline's integral from -inf to v (trapezoid on a fine grid), G(v) = v from v = 2 on."""
+    if volume >= 2.0:
+        return volume
+    grid = np.linspace(-2.0, 2.0, 40001)
+    share = _bspline_integral(grid)
+    second = np.concatenate([[0.0], np.cumsum(0.5 * (share[1:] + share[:-1]) * np.diff(grid))])
+    return float(np.interp(volume, second, grid))
 
 
 def reference_crossing_x(x: np.ndarray, v: np.ndarray, rim_z: float, lip_z: float, spacing: float, gravity: float) -> float:
