@@ -49,6 +49,47 @@ def grid_index(g: GridSpec, cx: int, cy: int, cz: int) -> int:
     return (cz * g.ny + cy) * g.nx + cx
 
 
+@wp.struct
+class CellBlock:
+    """The cells a neighbour loop visits around a point: the 3 x 3 x 3 block of cells centred on the point's cell
+    (one cell thick in y in 2-D), cut at the grid's faces. ``first``: the lowest cell's coordinates; ``size``: cells
+    along each axis; ``count``: their product."""
+
+    first: wp.vec3i
+    size: wp.vec3i
+    count: int
+
+
+@wp.func
+def neighbor_cells(g: GridSpec, x: wp.vec3) -> CellBlock:
+    """The block of cells that holds every neighbour within one support of x (cells are one support wide)."""
+    c = grid_cell(g, x)
+    lo = wp.vec3i(wp.max(c[0] - 1, 0), wp.max(c[1] - 1, 0), wp.max(c[2] - 1, 0))
+    hi = wp.vec3i(wp.min(c[0] + 1, g.nx - 1), wp.min(c[1] + 1, g.ny - 1), wp.min(c[2] + 1, g.nz - 1))
+    block = CellBlock()
+    block.first = lo
+    block.size = hi - lo + wp.vec3i(1, 1, 1)
+    block.count = block.size[0] * block.size[1] * block.size[2]
+    return block
+
+
+@wp.func
+def block_cell(g: GridSpec, block: CellBlock, k: int) -> int:
+    """Grid index of the k-th cell of ``block`` (0 <= k < ``block.count``), x fastest, then y, then z: every
+    neighbour loop visits the cells, and so sums its neighbours, in this one order. The neighbour loop reads
+
+        cells = neighbor_cells(g, x)
+        for k in range(cells.count):
+            cell = block_cell(g, cells, k)
+            for j in range(cell_start[cell], cell_end[cell]): ..."""
+    sx = block.size[0]
+    sy = block.size[1]
+    cx = block.first[0] + k % sx
+    cy = block.first[1] + (k // sx) % sy
+    cz = block.first[2] + k // (sx * sy)
+    return grid_index(g, cx, cy, cz)
+
+
 @wp.kernel
 def compute_cell_keys(
     # Model
