@@ -26,6 +26,8 @@ from typing import Callable, Sequence, Union
 
 import warp as wp
 
+from cosim.fluid.launch import record_launch
+
 # Fewest particles per lane the automatic thread count gives a lane. Measured on the 2-core CPU (a resting 2-D tank,
 # `python -m cosim.bench.fluid_throughput --counts2d 400 800 1600 --solvers dfsph wcsph --threads 1 2`): 2 lanes run 1.57,
 # 1.52 and 1.79 x the particle-steps of one under DFSPH at 400, 784 and 1600 particles, 1.58, 1.74 and 1.84 x under
@@ -250,10 +252,10 @@ class Lanes:
 
     def _wait(self) -> None:
         if self._barrier is None:
-            self._barrier = wp.launch(
-                lane_barrier, dim=1, inputs=[self._barrier_state, self.count, SPINS_BEFORE_YIELD, wp.uint64(_yield_function())],
-                device=self.device, record_cmd=True,
-            ).launch
+            self._barrier = record_launch(
+                lane_barrier, 1, self.device,
+                dict(state=self._barrier_state, parties=self.count, spins_before_yield=SPINS_BEFORE_YIELD, yield_fn=wp.uint64(_yield_function())),
+            )
         self._barrier()
 
     def run_lane(self, program: Program, lane: int) -> None:

@@ -22,6 +22,7 @@ import numpy as np
 import warp as wp
 
 from cosim.fluid.config import GridReset
+from cosim.fluid.launch import record_launch
 
 
 @wp.struct
@@ -196,9 +197,9 @@ class CellGrid:
         arguments bound once (recorded launches), to be run in order every build."""
         if n == 0:
             return [self.cell_start.zero_, self.cell_end.zero_]
-        keys = wp.launch(compute_cell_keys, dim=n, inputs=[self.spec, x, active], outputs=[self.keys, self.order], device=self.device, record_cmd=True)
-        ranges = wp.launch(
-            find_cell_ranges, dim=n, inputs=[n, self.n_cells, self.keys], outputs=[self.cell_start, self.cell_end], device=self.device, record_cmd=True
+        keys = record_launch(compute_cell_keys, n, self.device, dict(g=self.spec, x=x, active=active, keys=self.keys, order=self.order))
+        ranges = record_launch(
+            find_cell_ranges, n, self.device, dict(n=n, n_cells=self.n_cells, keys=self.keys, cell_start=self.cell_start, cell_end=self.cell_end)
         )
         bits = self.key_bits
 
@@ -206,11 +207,9 @@ class CellGrid:
             wp.utils.radix_sort_pairs(self.keys, self.order, n, 0, bits)
 
         if self.reset is GridReset.WHOLE:
-            return [keys.launch, sort, self.cell_start.zero_, self.cell_end.zero_, ranges.launch]
-        clear = wp.launch(
-            clear_occupied_cells, dim=n, inputs=[self.n_cells, self.keys], outputs=[self.cell_start, self.cell_end], device=self.device, record_cmd=True
-        )
-        return [clear.launch, keys.launch, sort, ranges.launch]
+            return [keys, sort, self.cell_start.zero_, self.cell_end.zero_, ranges]
+        clear = record_launch(clear_occupied_cells, n, self.device, dict(n_cells=self.n_cells, keys=self.keys, cell_start=self.cell_start, cell_end=self.cell_end))
+        return [clear, keys, sort, ranges]
 
     def build(self, x: wp.array, active: wp.array, n: int) -> None:
         """Sort the first ``n`` points by cell and record the cell ranges (one-off; loops use build_commands)."""
