@@ -50,7 +50,7 @@ def _shaken_tank(dim: int, solver: str, layout):
 def test_the_cuda_layouts_give_the_cpu_layouts_state(dim, solver, layout):
     ref = _shaken_tank(dim, solver, CPU_LAYOUT)
     cuda = _shaken_tank(dim, solver, layout)
-    assert (cuda._pair_index.strides != ref._pair_index.strides) == layout.pairs_by_column  # the layouts differ in memory...
+    assert (cuda.step.scratch.pairs.index.strides != ref.step.scratch.pairs.index.strides) == layout.pairs_by_column  # the layouts differ in memory...
     assert np.array_equal(ref.positions(), cuda.positions())  # ...not in the particles
     assert np.array_equal(ref.state.v.numpy(), cuda.state.v.numpy())
     wrench_scale = np.abs(ref.vessel_wrenches()).max()

@@ -181,9 +181,9 @@ def test_each_occupied_cell_is_in_one_sweep_list_with_its_colour(threads):
     n_cells = grid.spec.nx * grid.spec.ny * grid.spec.nz
     keys = np.concatenate([grid.keys.numpy(), walls.keys.numpy()])
     occupied = np.unique(keys[keys < n_cells])
-    counts = fluid._sweep_count.numpy()
-    listed = np.concatenate([fluid._sweep_cell.numpy()[t, :c] for t, c in enumerate(counts)])
-    colors = np.concatenate([fluid._sweep_color.numpy()[t, :c] for t, c in enumerate(counts)])
+    counts = fluid.step.scratch.sweep_count.numpy()
+    listed = np.concatenate([fluid.step.scratch.sweep_cell.numpy()[t, :c] for t, c in enumerate(counts)])
+    colors = np.concatenate([fluid.step.scratch.sweep_color.numpy()[t, :c] for t, c in enumerate(counts)])
     assert len(listed) == len(occupied) and np.array_equal(np.sort(listed), occupied)
     cx, cy, cz = listed % grid.spec.nx, (listed // grid.spec.nx) % grid.spec.ny, listed // (grid.spec.nx * grid.spec.ny)
     np.testing.assert_array_equal(colors, cx % 3 + 3 * (cz % 3) + 9 * (cy % 3))

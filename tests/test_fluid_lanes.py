@@ -49,7 +49,7 @@ def test_lanes_give_the_single_thread_run_to_the_bit(solver, iteration):
         fluid = tank(solver, ACROSS, graphs, threads, iteration)
         shake(fluid, **SHAKE)
         assert fluid.lanes.count == threads
-        assert (fluid._graphs is not None) == graphs and fluid.graph_capture_error is None  # it replayed the lanes' graphs
+        assert fluid.runner.replays_graphs == graphs and fluid.graph_capture_error is None  # it replayed the lanes' graphs
         _assert_same_run(fluid, one)
     assert one.history()["density_iterations" if solver is PressureSolver.DFSPH else "active"].max() > 0  # the solves ran
 
@@ -115,7 +115,7 @@ from tests.support.shaken_tank import tank
 fluid = tank(PressureSolver.DFSPH, 16, threads=2)
 fluid.advance(0.01)
 fluid.advance(0.01)  # captured and replayed by both lanes
-assert fluid._graphs is not None
+assert fluid.runner.replays_graphs
 """
 CHILD_CHECK = """
 assert fluid.lanes.aborted

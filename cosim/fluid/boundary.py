@@ -20,7 +20,7 @@ from __future__ import annotations
 import warp as wp
 
 from cosim.fluid.lanes import lane_item
-from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
+from cosim.fluid.neighbors import GridSpec, block_cell, neighbor_cells
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -149,21 +149,19 @@ def extrapolate_wall_state(
     sum_pw = float(0.0)
     sum_rho_r = wp.vec3(0.0)
     sum_v = wp.vec3(0.0)
-    c = grid_cell(g, xb)
-    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
-        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
-            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
-                cell = grid_index(g, cx, cy, cz)
-                for f in range(cell_start[cell], cell_end[cell]):
-                    r = xb - x[f]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2:
-                        continue
-                    w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                    sum_w += w
-                    sum_pw += p[f] * w
-                    sum_rho_r += (rho[f] * w) * r
-                    sum_v += w * v[f]
+    cells = neighbor_cells(g, xb)
+    for k_cell in range(cells.count):
+        cell = block_cell(g, cells, k_cell)
+        for f in range(cell_start[cell], cell_end[cell]):
+            r = xb - x[f]
+            r2 = wp.dot(r, r)
+            if r2 >= support2:
+                continue
+            w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+            sum_w += w
+            sum_pw += p[f] * w
+            sum_rho_r += (rho[f] * w) * r
+            sum_v += w * v[f]
     pw = float(0.0)
     v_noslip = bv[b]
     if sum_w > 0.0:

@@ -87,7 +87,7 @@ from cosim.fluid.diagnostics import (
     DIAG_PAIR_OVERFLOW,
 )
 from cosim.fluid.lanes import lane_item
-from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
+from cosim.fluid.neighbors import GridSpec, block_cell, neighbor_cells
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
     add_wall_density,
@@ -266,43 +266,41 @@ def compute_density_factor(
     grad_sum = wp.vec3(0.0)
     grad_sq = float(0.0)
     count = int(0)
-    c = grid_cell(g, xi)
-    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
-        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
-            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
-                cell = grid_index(g, cx, cy, cz)
-                for j in range(cell_start[cell], cell_end[cell]):
-                    r = xi - x[j]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    mj = mass[j]
-                    density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                    gw = kernel_gradient(prm, r, r2)
-                    gm = mj * gw
-                    grad_sum += gm
-                    grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
-                    if count < capacity:
-                        pair_index[i, count] = j
-                        pair_grad[i, count] = gw
-                        pair_mass_grad[i, count] = gm
-                    count += 1
-                for kk in range(b_cell_start[cell], b_cell_end[cell]):
-                    b = b_order[kk]
-                    r = xi - bx[b]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    mw = prm.rest_density * b_volume[b]
-                    density += mw * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                    gw = kernel_gradient(prm, r, r2)
-                    gm = mw * gw
-                    grad_sum += gm
-                    if count < capacity:
-                        pair_index[i, count] = wall_pair(b)
-                        pair_grad[i, count] = gw
-                        pair_mass_grad[i, count] = gm
-                    count += 1
+    cells = neighbor_cells(g, xi)
+    for k_cell in range(cells.count):
+        cell = block_cell(g, cells, k_cell)
+        for j in range(cell_start[cell], cell_end[cell]):
+            r = xi - x[j]
+            r2 = wp.dot(r, r)
+            if r2 >= support2 or r2 < 1.0e-24:
+                continue
+            mj = mass[j]
+            density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+            gw = kernel_gradient(prm, r, r2)
+            gm = mj * gw
+            grad_sum += gm
+            grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
+            if count < capacity:
+                pair_index[i, count] = j
+                pair_grad[i, count] = gw
+                pair_mass_grad[i, count] = gm
+            count += 1
+        for kk in range(b_cell_start[cell], b_cell_end[cell]):
+            b = b_order[kk]
+            r = xi - bx[b]
+            r2 = wp.dot(r, r)
+            if r2 >= support2 or r2 < 1.0e-24:
+                continue
+            mw = prm.rest_density * b_volume[b]
+            density += mw * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+            gw = kernel_gradient(prm, r, r2)
+            gm = mw * gw
+            grad_sum += gm
+            if count < capacity:
+                pair_index[i, count] = wall_pair(b)
+                pair_grad[i, count] = gw
+                pair_mass_grad[i, count] = gm
+            count += 1
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
@@ -533,25 +531,23 @@ def compute_wall_density_factor(
     density = mb * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     grad_sq = float(0.0)
     count = int(0)
-    c = grid_cell(g, xb)
-    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
-        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
-            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
-                cell = grid_index(g, cx, cy, cz)
-                for j in range(cell_start[cell], cell_end[cell]):
-                    r = xb - x[j]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    mj = mass[j]
-                    density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                    gw = kernel_gradient(prm, r, r2)
-                    grad_sq += mj * mb * wp.dot(gw, gw)
-                    if count < capacity:
-                        b_pair_index[b, count] = j
-                        b_pair_mass_grad[b, count] = mj * gw
-                    count += 1
-                density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xb, density)
+    cells = neighbor_cells(g, xb)
+    for k_cell in range(cells.count):
+        cell = block_cell(g, cells, k_cell)
+        for j in range(cell_start[cell], cell_end[cell]):
+            r = xb - x[j]
+            r2 = wp.dot(r, r)
+            if r2 >= support2 or r2 < 1.0e-24:
+                continue
+            mj = mass[j]
+            density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+            gw = kernel_gradient(prm, r, r2)
+            grad_sq += mj * mb * wp.dot(gw, gw)
+            if count < capacity:
+                b_pair_index[b, count] = j
+                b_pair_mass_grad[b, count] = mj * gw
+            count += 1
+        density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xb, density)
     if count == 0:
         return
     if count > capacity:

@@ -12,6 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
+from cosim.fluid.lanes import PerLane
+
 # float row
 DIAG_MAX_SPEED = wp.constant(0)  # m/s
 DIAG_MAX_ACCEL = wp.constant(1)  # m/s^2 (total, gravity included)
@@ -85,30 +87,104 @@ class StepDiagnostics:
     spilled_volume: float  # m^3 deactivated (fell below the floor or left the domain)
 
 
-def rows_to_records(
-    first_step: int, t0: float, dt: float, rows_f: np.ndarray, rows_i: np.ndarray, n_total: int, particle_volume: float
-) -> list[StepDiagnostics]:
-    """Host records of ``len(rows_f)`` consecutive substeps."""
-    out = []
-    for s in range(rows_f.shape[0]):
-        f, i = rows_f[s], rows_i[s]
-        out.append(
-            StepDiagnostics(
-                step=first_step + s,
-                time=t0 + (s + 1) * dt,
-                dt=dt,
-                max_speed=float(f[0]),
-                max_acceleration=float(f[1]),
-                max_density_error=float(f[2]),
-                max_compression=float(f[4]),
-                kinetic_energy=float(f[3]),
-                nonfinite=int(i[0]),
-                wall_breaches=int(i[1]),
-                wall_corrections=int(i[2]),
-                active=int(i[3]),
-                solver_iterations=(int(i[4]), int(i[5])),
-                volume_in_vessel=tuple(float(c) * particle_volume for c in i[N_DIAG_INT_BASE:]),
-                spilled_volume=(n_total - int(i[3])) * particle_volume,
-            )
+def _float_field(column: int, doc: str) -> property:
+    return property(lambda rows: rows.f[:, column], doc=doc)
+
+
+def _int_field(column: int, doc: str) -> property:
+    return property(lambda rows: rows.i[:, column], doc=doc)
+
+
+@dataclass(frozen=True)
+class SubstepRows:
+    """Consecutive substeps' diagnostics, the lanes combined: ``f`` (substeps, N_DIAG_FLOAT) and ``i`` (substeps,
+    N_DIAG_INT_BASE + vessels), read by field name (each a column, one value per substep)."""
+
+    f: np.ndarray
+    i: np.ndarray
+
+    max_speed = _float_field(DIAG_MAX_SPEED, "m/s")
+    max_acceleration = _float_field(DIAG_MAX_ACCEL, "m/s^2 (DFSPH: of the non-pressure forces)")
+    max_density_error = _float_field(DIAG_MAX_DENSITY_ERROR, "max |rho - rho0| / rho0")
+    max_compression = _float_field(DIAG_MAX_COMPRESSION, "max (rho - rho0) / rho0")
+    kinetic_energy = _float_field(DIAG_KINETIC_ENERGY, "J")
+    potential_energy = _float_field(DIAG_POTENTIAL_ENERGY, "J")
+    removed_energy = _float_field(DIAG_REMOVED_ENERGY, "J")
+    internal_energy = _float_field(DIAG_INTERNAL_ENERGY, "J")
+    divergence_error = _float_field(DIAG_DIVERGENCE_ERROR, "relative error the divergence solve left (DFSPH)")
+    density_solve_error = _float_field(DIAG_DENSITY_SOLVE_ERROR, "relative error the density solve left (DFSPH)")
+    nonfinite = _int_field(DIAG_NONFINITE, "particles")
+    wall_breaches = _int_field(DIAG_BREACHES, "particles")
+    wall_corrections = _int_field(DIAG_CORRECTIONS, "particles")
+    active = _int_field(DIAG_ACTIVE, "particles")
+    divergence_iterations = _int_field(DIAG_DIVERGENCE_ITERATIONS, "iterations (DFSPH)")
+    density_iterations = _int_field(DIAG_DENSITY_ITERATIONS, "iterations (DFSPH)")
+    pair_overflows = _int_field(DIAG_PAIR_OVERFLOW, "particles")
+
+    @property
+    def inside(self) -> np.ndarray:
+        """(substeps, vessels): particles inside each vessel."""
+        return self.i[:, N_DIAG_INT_BASE:]
+
+    def __len__(self) -> int:
+        return self.f.shape[0]
+
+    @staticmethod
+    def concatenate(parts: "list[SubstepRows]") -> "SubstepRows":
+        return SubstepRows(np.concatenate([p.f for p in parts]), np.concatenate([p.i for p in parts]))
+
+    def record(self, s: int, step: int, time: float, dt: float, n_total: int, particle_volume: float) -> StepDiagnostics:
+        """Substep ``s`` of these rows as a host record (``step``: its number, ``time``: s at its end)."""
+        return StepDiagnostics(
+            step=step,
+            time=time,
+            dt=dt,
+            max_speed=float(self.max_speed[s]),
+            max_acceleration=float(self.max_acceleration[s]),
+            max_density_error=float(self.max_density_error[s]),
+            max_compression=float(self.max_compression[s]),
+            kinetic_energy=float(self.kinetic_energy[s]),
+            nonfinite=int(self.nonfinite[s]),
+            wall_breaches=int(self.wall_breaches[s]),
+            wall_corrections=int(self.wall_corrections[s]),
+            active=int(self.active[s]),
+            solver_iterations=(int(self.divergence_iterations[s]), int(self.density_iterations[s])),
+            volume_in_vessel=tuple(float(c) * particle_volume for c in self.inside[s]),
+            spilled_volume=(n_total - int(self.active[s])) * particle_volume,
         )
-    return out
+
+
+class DiagnosticBuffers:
+    """Each lane's device rows of the substeps' diagnostics: ``f`` (lanes, rows x replicas, N_DIAG_FLOAT) and ``i``
+    (lanes, rows x replicas, N_DIAG_INT_BASE + vessels), room for :attr:`capacity` substeps; the particle kernels
+    write their lane's rows (:attr:`lane_f`, :attr:`lane_i`)."""
+
+    def __init__(self, lanes: int, replicas: int, n_vessels: int, device, substeps: int = 64):
+        self.lanes, self.replicas, self.n_vessels, self.device = lanes, replicas, n_vessels, device
+        self.capacity = 0
+        self.ensure(substeps)
+
+    def ensure(self, substeps: int) -> bool:
+        """Room for ``substeps`` rows; True when the arrays were replaced (at least doubled), which programs that
+        hold the old ones must be recorded again for."""
+        if substeps <= self.capacity:
+            return False
+        self.capacity = max(substeps, 2 * self.capacity)
+        slots = self.capacity * self.replicas
+        self.f = wp.zeros((self.lanes, slots, N_DIAG_FLOAT), dtype=float, device=self.device)
+        self.i = wp.zeros((self.lanes, slots, N_DIAG_INT_BASE + self.n_vessels), dtype=wp.int32, device=self.device)
+        self.lane_f = PerLane(self.f[k] for k in range(self.lanes))
+        self.lane_i = PerLane(self.i[k] for k in range(self.lanes))
+        self._views = (self.f.numpy(), self.i.numpy()) if self.device.is_cpu else None  # shared memory
+        return True
+
+    def zero(self) -> None:
+        self.f.zero_()
+        self.i.zero_()
+
+    def read(self, substeps: int) -> SubstepRows:
+        """The first ``substeps`` rows, the lanes and replicas combined (from the device's copy only the rows
+        written)."""
+        used = substeps * self.replicas
+        diag_f, diag_i = self._views or (read_lane_rows(self.f, used), read_lane_rows(self.i, used))
+        return SubstepRows(*combine_lanes(*(replicas_as_lanes(a, substeps, self.replicas) for a in (diag_f, diag_i))))

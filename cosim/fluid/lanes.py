@@ -10,7 +10,8 @@ maxima) is kept per lane and combined in a fixed order, as integers or maxima wh
 graphs (the first interval, ``graphs=False``) the lanes' shares run one after the other on the calling thread.
 
 A stage is the unit between two barriers: :class:`Stage` (the operations each lane runs) or :class:`Loop` (a
-``wp.capture_while`` loop of stages on a device flag).
+``wp.capture_while`` loop of stages on a device flag); the stage functions of the physics record them without
+knowing of lanes (``cosim.fluid.program``).
 """
 
 from __future__ import annotations
@@ -25,6 +26,8 @@ from dataclasses import dataclass
 from typing import Callable, Sequence, Union
 
 import warp as wp
+
+from cosim.fluid.launch import record_launch
 
 # Fewest particles per lane the automatic thread count gives a lane. Measured on the 2-core CPU (a resting 2-D tank,
 # `python -m cosim.bench.fluid_throughput --counts2d 400 800 1600 --solvers dfsph wcsph --threads 1 2`): 2 lanes run 1.57,
@@ -149,8 +152,8 @@ Program = Sequence[Union[Stage, Loop]]
 
 
 class PerLane(tuple):
-    """An argument with one value per lane (e.g. each lane's row of a diagnostics array); :meth:`Lanes.launch`
-    passes lane L its L-th value."""
+    """An argument with one value per lane (e.g. each lane's row of a diagnostics array); a split launch
+    (``cosim.fluid.program.Recorder.launch``) passes lane L its L-th value."""
 
 
 def run_serial(program: Program, call: Callable[[Callable[[], None]], None] | None = None) -> None:
@@ -218,7 +221,7 @@ def _stop_threads(threads: list[_LaneThread]) -> None:
 
 
 class Lanes:
-    """The lanes of one solver: launches split over them, their per-lane graphs, and the threads that replay them."""
+    """The lanes of one solver: their per-lane graphs of a program and the threads that replay them."""
 
     def __init__(self, count: int, device):
         self.count = count
@@ -228,21 +231,6 @@ class Lanes:
         self._threads: list[_LaneThread] | None = None  # lanes 1.. (lane 0 runs on the caller's thread)
         self._aborted = False
 
-    def launch(self, kernel, items: int, inputs: Sequence, outputs: Sequence = ()) -> Stage:
-        """``kernel`` over ``items`` items, each lane its share (:func:`lane_item`; the kernel's first argument is
-        (lane, lane count), :class:`PerLane` arguments are resolved per lane); a lane with no share launches
-        nothing."""
-        parts = []
-        for lane, size in enumerate(lane_sizes(items, self.count)):
-            if size == 0:
-                parts.append(())
-                continue
-            pick = [a[lane] if isinstance(a, PerLane) else a for a in inputs]
-            out = [a[lane] if isinstance(a, PerLane) else a for a in outputs]
-            args = [wp.vec2i(lane, self.count), *pick]
-            parts.append((wp.launch(kernel, dim=size, inputs=args, outputs=out, device=self.device, record_cmd=True).launch,))
-        return Stage(tuple(parts))
-
     def on_lane(self, lane: int, *ops: Callable[[], None]) -> Stage:
         """``ops`` on one lane (``lane`` taken modulo the lane count); the others only wait."""
         lane %= self.count
@@ -250,10 +238,10 @@ class Lanes:
 
     def _wait(self) -> None:
         if self._barrier is None:
-            self._barrier = wp.launch(
-                lane_barrier, dim=1, inputs=[self._barrier_state, self.count, SPINS_BEFORE_YIELD, wp.uint64(_yield_function())],
-                device=self.device, record_cmd=True,
-            ).launch
+            self._barrier = record_launch(
+                lane_barrier, 1, self.device,
+                dict(state=self._barrier_state, parties=self.count, spins_before_yield=SPINS_BEFORE_YIELD, yield_fn=wp.uint64(_yield_function())),
+            )
         self._barrier()
 
     def run_lane(self, program: Program, lane: int) -> None:

@@ -69,6 +69,11 @@ class FluidModel:
     def n_boundary(self) -> int:
         return self.b_local.shape[0]
 
+    @property
+    def n_particles(self) -> int:
+        """N: the liquid grid holds every liquid particle."""
+        return self.grid.capacity
+
 
 def caught_liquid_mass(cfg: FluidConfig, spec: VesselSpec) -> float:
     """In-plane SPH mass (kg/m) of a particle inside ``spec`` in 2-D: m = M / d = rho0 dx^2 d0 / d, with d0 =
@@ -177,6 +182,3 @@ class FluidState:
             rest_offset=wp.zeros(n, dtype=float, device=device),
             mass=wp.zeros(n, dtype=float, device=device),
         )
-
-    def arrays(self) -> list[wp.array]:
-        return [self.x, self.v, self.rho, self.p, self.active, self.pid, self.kappa_density, self.kappa_divergence, self.free, self.rest_offset, self.mass]

@@ -22,6 +22,7 @@ import numpy as np
 import warp as wp
 
 from cosim.fluid.config import GridReset
+from cosim.fluid.launch import record_launch
 
 
 @wp.struct
@@ -47,6 +48,47 @@ def grid_cell(g: GridSpec, x: wp.vec3) -> wp.vec3i:
 @wp.func
 def grid_index(g: GridSpec, cx: int, cy: int, cz: int) -> int:
     return (cz * g.ny + cy) * g.nx + cx
+
+
+@wp.struct
+class CellBlock:
+    """The cells a neighbour loop visits around a point: the 3 x 3 x 3 block of cells centred on the point's cell
+    (one cell thick in y in 2-D), cut at the grid's faces. ``first``: the lowest cell's coordinates; ``size``: cells
+    along each axis; ``count``: their product."""
+
+    first: wp.vec3i
+    size: wp.vec3i
+    count: int
+
+
+@wp.func
+def neighbor_cells(g: GridSpec, x: wp.vec3) -> CellBlock:
+    """The block of cells that holds every neighbour within one support of x (cells are one support wide)."""
+    c = grid_cell(g, x)
+    lo = wp.vec3i(wp.max(c[0] - 1, 0), wp.max(c[1] - 1, 0), wp.max(c[2] - 1, 0))
+    hi = wp.vec3i(wp.min(c[0] + 1, g.nx - 1), wp.min(c[1] + 1, g.ny - 1), wp.min(c[2] + 1, g.nz - 1))
+    block = CellBlock()
+    block.first = lo
+    block.size = hi - lo + wp.vec3i(1, 1, 1)
+    block.count = block.size[0] * block.size[1] * block.size[2]
+    return block
+
+
+@wp.func
+def block_cell(g: GridSpec, block: CellBlock, k: int) -> int:
+    """Grid index of the k-th cell of ``block`` (0 <= k < ``block.count``), x fastest, then y, then z: every
+    neighbour loop visits the cells, and so sums its neighbours, in this one order. The neighbour loop reads
+
+        cells = neighbor_cells(g, x)
+        for k in range(cells.count):
+            cell = block_cell(g, cells, k)
+            for j in range(cell_start[cell], cell_end[cell]): ..."""
+    sx = block.size[0]
+    sy = block.size[1]
+    cx = block.first[0] + k % sx
+    cy = block.first[1] + (k // sx) % sy
+    cz = block.first[2] + k // (sx * sy)
+    return grid_index(g, cx, cy, cz)
 
 
 @wp.kernel
@@ -155,9 +197,9 @@ class CellGrid:
         arguments bound once (recorded launches), to be run in order every build."""
         if n == 0:
             return [self.cell_start.zero_, self.cell_end.zero_]
-        keys = wp.launch(compute_cell_keys, dim=n, inputs=[self.spec, x, active], outputs=[self.keys, self.order], device=self.device, record_cmd=True)
-        ranges = wp.launch(
-            find_cell_ranges, dim=n, inputs=[n, self.n_cells, self.keys], outputs=[self.cell_start, self.cell_end], device=self.device, record_cmd=True
+        keys = record_launch(compute_cell_keys, n, self.device, dict(g=self.spec, x=x, active=active, keys=self.keys, order=self.order))
+        ranges = record_launch(
+            find_cell_ranges, n, self.device, dict(n=n, n_cells=self.n_cells, keys=self.keys, cell_start=self.cell_start, cell_end=self.cell_end)
         )
         bits = self.key_bits
 
@@ -165,11 +207,9 @@ class CellGrid:
             wp.utils.radix_sort_pairs(self.keys, self.order, n, 0, bits)
 
         if self.reset is GridReset.WHOLE:
-            return [keys.launch, sort, self.cell_start.zero_, self.cell_end.zero_, ranges.launch]
-        clear = wp.launch(
-            clear_occupied_cells, dim=n, inputs=[self.n_cells, self.keys], outputs=[self.cell_start, self.cell_end], device=self.device, record_cmd=True
-        )
-        return [clear.launch, keys.launch, sort, ranges.launch]
+            return [keys, sort, self.cell_start.zero_, self.cell_end.zero_, ranges]
+        clear = record_launch(clear_occupied_cells, n, self.device, dict(n_cells=self.n_cells, keys=self.keys, cell_start=self.cell_start, cell_end=self.cell_end))
+        return [clear, keys, sort, ranges]
 
     def build(self, x: wp.array, active: wp.array, n: int) -> None:
         """Sort the first ``n`` points by cell and record the cell ranges (one-off; loops use build_commands)."""

@@ -33,7 +33,7 @@ import warp as wp
 from cosim.fluid.boundary import VesselGeometry, VesselMotion
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
 from cosim.fluid.lanes import lane_item
-from cosim.fluid.neighbors import GridSpec, grid_cell, grid_index
+from cosim.fluid.neighbors import GridSpec, block_cell, neighbor_cells
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
     add_wall_density,
@@ -125,18 +125,16 @@ def update_free_liquid(
         return
     support2 = prm.support * prm.support
     density = mass[i] * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
-    c = grid_cell(g, xi)
-    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
-        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
-            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
-                cell = grid_index(g, cx, cy, cz)
-                for j in range(cell_start[cell], cell_end[cell]):
-                    r = xi - x[j]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    density += mass[j] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xi, density)
+    cells = neighbor_cells(g, xi)
+    for k_cell in range(cells.count):
+        cell = block_cell(g, cells, k_cell)
+        for j in range(cell_start[cell], cell_end[cell]):
+            r = xi - x[j]
+            r2 = wp.dot(r, r)
+            if r2 >= support2 or r2 < 1.0e-24:
+                continue
+            density += mass[j] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+        density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xi, density)
     density = density / prm.lattice_density
     state = next_free_state(free[i], inside, density, prm.rest_density)
     if free[i] == 0 and state == 0:
@@ -219,48 +217,46 @@ def compute_forces(
     a = wp.vec3(0.0)
     moment = wp.mat33(0.0)
     gsum = wp.vec3(0.0)
-    c = grid_cell(g, xi)
-    for cz in range(wp.max(c[2] - 1, 0), wp.min(c[2] + 1, g.nz - 1) + 1):
-        for cy in range(wp.max(c[1] - 1, 0), wp.min(c[1] + 1, g.ny - 1) + 1):
-            for cx in range(wp.max(c[0] - 1, 0), wp.min(c[0] + 1, g.nx - 1) + 1):
-                cell = grid_index(g, cx, cy, cz)
-                for j in range(cell_start[cell], cell_end[cell]):
-                    r = xi - x[j]
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    gw = kernel_gradient(prm, r, r2)
-                    if count < capacity:
-                        pair_index[i, count] = j
-                        pair_grad[i, count] = gw
-                    count += 1
-                    vij = vi - v[j]
-                    rhoj = rho[j]
-                    mj = mass[j]
-                    vol = mj / rhoj
-                    moment += vol * wp.outer(-r, gw)
-                    gsum += (vol * (rhoj - rhoi)) * gw
-                    a -= mj * (pi_term + p[j] / (rhoj * rhoj)) * gw
-                    alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
-                    a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
-                for kk in range(b_cell_start[cell], b_cell_end[cell]):
-                    b = b_order[kk]
-                    xb = bx[b]
-                    r = xi - xb
-                    r2 = wp.dot(r, r)
-                    if r2 >= support2 or r2 < 1.0e-24:
-                        continue
-                    gw = kernel_gradient(prm, r, r2)
-                    if count < capacity:
-                        pair_index[i, count] = wall_pair(b)
-                        pair_grad[i, count] = gw
-                    count += 1
-                    mw = prm.rest_density * b_volume[b]
-                    rhob = b_rho[b]
-                    ab = -(mw * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
-                    ab += viscous_pair(prm, alpha_wall, mw, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
-                    a += ab
-                    add_wall_reaction(prm, vessels, motions, b_vessel[b], i, xb, ab, wall_force, wall_torque)
+    cells = neighbor_cells(g, xi)
+    for k_cell in range(cells.count):
+        cell = block_cell(g, cells, k_cell)
+        for j in range(cell_start[cell], cell_end[cell]):
+            r = xi - x[j]
+            r2 = wp.dot(r, r)
+            if r2 >= support2 or r2 < 1.0e-24:
+                continue
+            gw = kernel_gradient(prm, r, r2)
+            if count < capacity:
+                pair_index[i, count] = j
+                pair_grad[i, count] = gw
+            count += 1
+            vij = vi - v[j]
+            rhoj = rho[j]
+            mj = mass[j]
+            vol = mj / rhoj
+            moment += vol * wp.outer(-r, gw)
+            gsum += (vol * (rhoj - rhoi)) * gw
+            a -= mj * (pi_term + p[j] / (rhoj * rhoj)) * gw
+            alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
+            a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
+        for kk in range(b_cell_start[cell], b_cell_end[cell]):
+            b = b_order[kk]
+            xb = bx[b]
+            r = xi - xb
+            r2 = wp.dot(r, r)
+            if r2 >= support2 or r2 < 1.0e-24:
+                continue
+            gw = kernel_gradient(prm, r, r2)
+            if count < capacity:
+                pair_index[i, count] = wall_pair(b)
+                pair_grad[i, count] = gw
+            count += 1
+            mw = prm.rest_density * b_volume[b]
+            rhob = b_rho[b]
+            ab = -(mw * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
+            ab += viscous_pair(prm, alpha_wall, mw, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
+            a += ab
+            add_wall_reaction(prm, vessels, motions, b_vessel[b], i, xb, ab, wall_force, wall_torque)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)

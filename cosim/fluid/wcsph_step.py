@@ -1,0 +1,128 @@
+"""The weakly compressible SPH substep (the kernels and their physics: ``cosim.fluid.wcsph``).
+
+    start_substep: move_vessels; place_wall_particles; find_neighbors; reorder_particles (``cosim.fluid.substep``)
+    update_free_liquid      free liquid takes its summation density (``FluidConfig.free_liquid``)
+    extrapolate_wall_state  the wall particles' pressure, density and no-slip velocity from the liquid around them
+    compute_forces          pressure, viscous and wall forces; the substep's pair list; the density gradient
+    compute_density_rate    continuity with delta-SPH diffusion, over the pair list
+    integrate               symplectic Euler, the equation of state, the wall guard, diagnostics
+    end_substep: reduce_wrenches; next_row (``cosim.fluid.substep``)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import warp as wp
+
+from cosim.fluid import boundary as bd
+from cosim.fluid import wcsph
+from cosim.fluid.device_layout import pair_table
+from cosim.fluid.launch import launch_now
+from cosim.fluid.model import FluidModel, FluidState
+from cosim.fluid.program import Recorder
+from cosim.fluid.substep import PairList, SubstepScratch, end_substep, start_substep
+
+
+class WCSPHScratch:
+    """WCSPH's per-substep arrays: acc (N,) m/s^2; rho_grad (N,) the renormalised density gradient (kg/m^4); drho
+    (N,) kg/m^3/s; pairs: the pair list; b_p (Pa), b_rho (kg/m^3), b_v_noslip (m/s): (Nb,) the wall particles'
+    extrapolated state."""
+
+    def __init__(self, m: FluidModel, sh: SubstepScratch):
+        d, n, nb, by_column = m.device, m.n_particles, m.n_boundary, sh.layout.pairs_by_column
+        self.acc = wp.zeros(n, dtype=wp.vec3, device=d)
+        self.rho_grad = wp.zeros(n, dtype=wp.vec3, device=d)
+        self.drho = wp.zeros(n, dtype=float, device=d)
+        self.pairs = PairList(
+            wp.zeros(n, dtype=wp.int32, device=d), pair_table(n, sh.pair_capacity, wp.int32, d, by_column), pair_table(n, sh.pair_capacity, wp.vec3, d, by_column),
+        )
+        self.b_p = wp.zeros(nb, dtype=float, device=d)
+        self.b_rho = wp.zeros(nb, dtype=float, device=d)
+        self.b_v_noslip = wp.zeros(nb, dtype=wp.vec3, device=d)
+
+
+def update_free_liquid(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch) -> None:
+    """Free liquid (outside every vessel and separated, or back inside but not yet packed) takes the tension-free
+    summation density (``cosim.fluid.wcsph.update_free_liquid``)."""
+    if not m.config.free_liquid:
+        return
+    rec.launch(
+        wcsph.update_free_liquid, m.n_particles, prm=m.params, g=m.grid.spec, vessels=m.vessels, b_volume=m.b_volume, motions=sh.motions,
+        x=st.x, active=st.active, mass=st.mass, cell_start=m.grid.cell_start, cell_end=m.grid.cell_end,
+        bx=sh.bx, b_order=m.b_grid.order, b_cell_start=m.b_grid.cell_start, b_cell_end=m.b_grid.cell_end, free=st.free, rho=st.rho, p=st.p,
+    )
+
+
+def extrapolate_wall_state(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: WCSPHScratch) -> None:
+    """Each wall particle's pressure, density and no-slip velocity from the liquid around it
+    (``cosim.fluid.boundary.extrapolate_wall_state``)."""
+    if not m.n_boundary:
+        return
+    rec.launch(
+        bd.extrapolate_wall_state, m.n_boundary, prm=m.params, g=m.grid.spec, b_vessel=m.b_vessel, motions=sh.motions, bx=sh.bx, bv=sh.bv,
+        x=st.x, v=st.v, rho=st.rho, p=st.p, cell_start=m.grid.cell_start, cell_end=m.grid.cell_end, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip,
+    )
+
+
+def compute_forces(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: WCSPHScratch) -> None:
+    """Each particle's acceleration, its reaction on the vessels, its density gradient and the substep's pair list."""
+    rec.launch(
+        wcsph.compute_forces, m.n_particles, prm=m.params, g=m.grid.spec, vessels=m.vessels, b_volume=m.b_volume, b_vessel=m.b_vessel,
+        motions=sh.motions, x=st.x, v=st.v, rho=st.rho, p=st.p, active=st.active, free=st.free, mass=st.mass,
+        cell_start=m.grid.cell_start, cell_end=m.grid.cell_end, bx=sh.bx, bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip,
+        b_order=m.b_grid.order, b_cell_start=m.b_grid.cell_start, b_cell_end=m.b_grid.cell_end, row=sh.row, capacity=sh.pair_capacity,
+        acc=sc.acc, rho_grad=sc.rho_grad, wall_force=sh.wall_force, wall_torque=sh.wall_torque,
+        pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad,
+        diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
+    )
+
+
+def compute_density_rate(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: WCSPHScratch) -> None:
+    """The continuity equation's density rate with delta-SPH diffusion, over the pair list."""
+    rec.launch(
+        wcsph.compute_density_rate, m.n_particles, prm=m.params, b_volume=m.b_volume, x=st.x, v=st.v, acc=sc.acc, rho=st.rho, rho_grad=sc.rho_grad,
+        active=st.active, mass=st.mass, dt=sh.dt, bv=sh.bv, pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, drho=sc.drho,
+    )
+
+
+def integrate(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: WCSPHScratch) -> None:
+    """Symplectic Euler of velocity, position and density, the equation of state, the wall guard and diagnostics."""
+    rec.launch(
+        wcsph.integrate, m.n_particles, **sh.guard_args(m), drho=sc.drho, acc=sc.acc, free=st.free, mass=st.mass,
+        x=st.x, v=st.v, rho=st.rho, p=st.p, active=st.active, wall_force=sh.wall_force, wall_torque=sh.wall_torque,
+        diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
+    )
+
+
+class WCSPHStep:
+    """Weakly compressible SPH (Monaghan's Tait equation of state, delta-SPH; ``cosim.fluid.wcsph``): owns its
+    scratch; :meth:`substep` is the substep, stage by stage."""
+
+    def __init__(self, model: FluidModel, shared: SubstepScratch):
+        self.model = model
+        self.shared = shared
+        self.scratch = WCSPHScratch(model, shared)
+
+    def initialise(self, st: FluidState) -> None:
+        """The seeded liquid's pressure from its density (the equation of state)."""
+        launch_now(wcsph.equation_of_state, self.model.n_particles, self.model.device, dict(prm=self.model.params, rho=st.rho, p=st.p))
+
+    def internal_energy(self, st: FluidState) -> float:
+        """Elastic energy the Tait liquid stores (J): sum m u(rho)."""
+        energy = wp.zeros(self.model.n_particles, dtype=float, device=self.model.device)
+        launch_now(wcsph.measure_internal_energy, self.model.n_particles, self.model.device, dict(prm=self.model.params, rho=st.rho, energy=energy))
+        return float(energy.numpy().astype(np.float64).sum())
+
+    def begin_interval(self, st: FluidState, substeps: int) -> None:
+        """Nothing to prepare: the pressure is the last substep's."""
+
+    def substep(self, rec: Recorder, src: FluidState, st: FluidState) -> None:
+        """One substep: the liquid ``src`` reordered into ``st`` and advanced there."""
+        m, sh, sc = self.model, self.shared, self.scratch
+        start_substep(rec, m, src, st, sh)
+        update_free_liquid(rec, m, st, sh)
+        extrapolate_wall_state(rec, m, st, sh, sc)
+        compute_forces(rec, m, st, sh, sc)
+        compute_density_rate(rec, m, st, sh, sc)
+        integrate(rec, m, st, sh, sc)
+        end_substep(rec, m, sh)
