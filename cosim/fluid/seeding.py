@@ -9,7 +9,9 @@ conforms to a box's: each layer fills the disc to the inner radius R with one pa
 lies half a ring spacing inside the wall, whose first layer of dummy particles lies dx/2 outside it
 (:mod:`cosim.fluid.wall_sampling`). A square lattice cut to the disc leaves a stair-stepped gap to the wall and
 holds 8-15 % less liquid than pi R^2 times its layers at 32-16 particles across, so the liquid's depth at rest
-would depend on how far it spreads into the gap.
+would depend on how far it spreads into the gap. The rings do not start exactly at rest density: each ring's count is
+rounded, so its particles' kernel sums differ from the lattice's by up to about 2 % (the three-particle centre ring
+and the rings over the floor most), which the pressure solver removes in its first steps.
 """
 
 from __future__ import annotations
