@@ -136,7 +136,7 @@ def pour_row(pour: HeldoutPour, summary: dict | None, failed: dict | None) -> di
     row: dict[str, Any] = {
         "scene": pour.path.stem,
         "file": pour.path.as_posix(),
-        "solver": scene.fluid.pressure_solver.value,
+        "solver": f"{scene.fluid.pressure_solver.value} {scene.fluid.dim}-D",
         "pourer": f"{scene.vessels.pourer.shape.value} {1e3 * scene.vessels.pourer.inner_width:.0f} mm",
         "fill_percent": 100.0 * scene.liquid.fill_depth / scene.vessels.pourer.inner_height,
         "pour_fraction": scene.liquid.pour_fraction,
@@ -189,14 +189,15 @@ def markdown(rows: list[dict[str, Any]], header: str) -> str:
         f"Acceptance: spill <= {SPILL_LIMIT_PERCENT:g} % of the poured volume; landing error (median, CFS) <= "
         f"{LANDING_LIMIT_MM:g} mm; a partial pour within {PARTIAL_LIMIT_PERCENT:g} % of its target. A row passes when "
         f"each of its checks does.", "",
-        "| scene | solver | pourer | fill % of height | pour fraction | catcher x (m) | poured (mL) | spill (mL) "
-        "| spill % of poured (<= 1 %) | | landing median (mm) (<= 5 mm) | | partial error % of target (<= 3 %) | | row |",
+        "| scene | solver | pourer | fill (% of height) | pour fraction | catcher x (m) | poured (mL) | spill (mL) "
+        f"| spill (% of poured), limit {SPILL_LIMIT_PERCENT:g} % | verdict | landing median (mm), limit {LANDING_LIMIT_MM:g} mm "
+        f"| verdict | partial error (% of target), limit {PARTIAL_LIMIT_PERCENT:g} % | verdict | row |",
         "|---|---|---|---:|---:|---:|---:|---:|---:|---|---:|---|---:|---|---|",
     ]
     for r in rows:
         c = r["criteria"]
         lines.append(
-            f"| [{r['scene']}](../{r['file']}) | {r['solver']} | {r['pourer']} | {r['fill_percent']:.0f} | "
+            f"| {r['scene']} | {r['solver']} | {r['pourer']} | {r['fill_percent']:.0f} | "
             f"{r['pour_fraction']:g} | {r['catcher_home_x_m']:.2f} | {_number(r['poured_mL'])} | "
             f"{_number(r['spilled_mL'])} | {_number(c['spill'].value, 2)} | {_verdict(c['spill'])} | "
             f"{_number(c['landing'].value)} | {_verdict(c['landing'])} | "

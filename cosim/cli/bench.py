@@ -105,7 +105,7 @@ def _run_heldout(args) -> int:
     command = ("cosim bench --plan heldout" + (f" --scenes {args.scenes}" if args.scenes is not None else "")
                + (f" --docs {args.docs}" if args.docs else ""))
     header = (f"### Held-out pours ({datetime.now(timezone.utc):%Y-%m-%d})\n\n{_machine_line()}\n"
-              f"Command: `{command}`; scenes: {scenes}/ (one pour each, 2-D, one thread, no recording). "
+              f"Command: `{command}`; scenes: the files of {scenes}/ (one pour each, one thread, no recording). "
               f"Code version of the pours (cosim.bench.cache.code_version): {code}.")
     text = markdown(rows, header)
     write_text_atomic(args.out / "heldout.md", text)
