@@ -144,13 +144,13 @@ def pour_row(pour: HeldoutPour, summary: dict | None, failed: dict | None) -> di
         "failure": None if failed is None else f"{failed['kind']}: {failed['error']}",
     }
     if summary is None:
-        row.update(poured_mL=None, spilled_mL=None, pour_done=None, landing_samples=None, target_mL=None)
+        row.update(poured_mL=None, spilled_mL=None, pour_done=None, landing_samples=None, target_mL=None, wall_time_s=None)
         checks = {"spill": Criterion(None, SPILL_LIMIT_PERCENT), "landing": Criterion(None, LANDING_LIMIT_MM),
                   "partial": Criterion(None, PARTIAL_LIMIT_PERCENT, applies=scene.liquid.pour_fraction < 1.0)}
     else:
         row.update(poured_mL=OUTCOMES["poured_mL"][1](summary), spilled_mL=OUTCOMES["spilled_mL"][1](summary),
                    pour_done=summary["pour_done"], landing_samples=summary["landing"].get("samples", 0),
-                   target_mL=OUTCOMES["target_mL"][1](summary))
+                   target_mL=OUTCOMES["target_mL"][1](summary), wall_time_s=OUTCOMES["wall_time_s"][1](summary))
         checks = criteria(summary)
     row["criteria"] = checks
     row["passed"] = summary is not None and all(c.passed for c in checks.values())
@@ -204,7 +204,10 @@ def markdown(rows: list[dict[str, Any]], header: str) -> str:
             f"{_number(c['partial'].value, 2) if c['partial'].applies else 'n/a'} | "
             f"{_verdict(c['partial']) if c['partial'].applies else ''} | {'PASS' if r['passed'] else 'FAIL'} |")
     passed = sum(r["passed"] for r in rows)
-    lines += ["", f"{passed} of {len(rows)} rows pass."]
+    walls = [r["wall_time_s"] for r in rows if r["wall_time_s"] is not None]
+    lines += ["", f"{passed} of {len(rows)} rows pass. Simulation wall time of the {len(walls)} pours (summary.json "
+              f"`wall_time`, on one thread; it depends on the machine's load): {sum(walls) / 60:.0f} min in all, "
+              f"{min(walls, default=0):.0f} to {max(walls, default=0):.0f} s each."]
     notes = [f"- {r['scene']}: {r['failure']}" for r in rows if r["failure"]]
     notes += [f"- {r['scene']}: the pour did not end as done (it ran to coupling.max_duration)"
               for r in rows if r["pour_done"] is False]
