@@ -111,3 +111,23 @@ def test_bench_refuses_scenes_without_the_heldout_plan_and_an_empty_scene_folder
     assert "--scenes: only with --plan heldout" in capsys.readouterr().err
     assert main(["bench", "--plan", "heldout", "--scenes", str(tmp_path), "--out", str(tmp_path / "out")]) == 2
     assert f"--scenes: no scene files (*.toml) in {tmp_path}" in capsys.readouterr().err
+
+
+def test_an_interrupted_heldout_run_still_writes_its_report(tmp_path, monkeypatch, capsys):
+    import cosim.bench.heldout
+
+    scenes = tmp_path / "scenes"
+    scenes.mkdir()
+    (scenes / "one.toml").write_text("[liquid]\nfill_depth = 0.1\n")
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cosim.bench.heldout, "run_missing", interrupted)
+    docs = tmp_path / "heldout.md"
+    docs.write_text("# Held-out pours\n\nkept text\n")
+    argv = ["bench", "--plan", "heldout", "--scenes", str(scenes), "--out", str(tmp_path / "out"), "--docs", str(docs)]
+    assert main(argv) == 130
+    report = (tmp_path / "out" / "heldout.md").read_text()
+    assert "| one |" in report and "not run: no run folder" in report and "0 of 1 rows pass." in report
+    assert "kept text" in docs.read_text() and "| one |" in docs.read_text()

@@ -19,7 +19,8 @@ device when one is present; the default pour's wall time on the CPU), afresh eac
 examples/heldout, one pour at a time on one thread, no recording) and reports per scene its spill, landing error and
 partial-pour error against the acceptance thresholds, PASS or FAIL, into ``heldout.md`` and ``heldout.csv``; with
 ``--docs`` it rewrites that file's generated block. The pours are kept under ``--cache`` (default OUT/heldout), keyed
-by the scene and the simulation code, so a rerun only runs what is missing. Exit status 1 when a row fails.
+by the scene and the simulation code, so a rerun only runs what is missing; Ctrl-C or SIGTERM stops the pour in
+flight and still writes the report (the pours not run marked so). Exit status 1 when a row fails.
 """
 
 from __future__ import annotations
@@ -100,20 +101,22 @@ def _run_heldout(args) -> int:
     code = code_version(BenchCase.POUR)
     pours = load_pours(scenes, code)
     store = SweepStore(args.cache or args.out / "heldout")
-    run_missing(pours, store, fresh=args.fresh, progress=not args.quiet)
-    rows = collect_rows(pours, store)
-    command = ("cosim bench --plan heldout" + (f" --scenes {args.scenes}" if args.scenes is not None else "")
-               + (f" --docs {args.docs}" if args.docs else ""))
-    header = (f"### Held-out pours ({datetime.now(timezone.utc):%Y-%m-%d})\n\n{_machine_line()}\n"
-              f"Command: `{command}`; scenes: the files of {scenes}/ (one pour each, one thread, no recording). "
-              f"Code version of the pours (cosim.bench.cache.code_version): {code}.")
-    text = markdown(rows, header)
-    write_text_atomic(args.out / "heldout.md", text)
-    write_text_atomic(args.out / "heldout.csv", rows_csv(rows))
-    if args.docs is not None:
-        update_document(args.docs, text, HELDOUT_BEGIN, HELDOUT_END)
-    print(text)
-    print(f"wrote {args.out / 'heldout.md'} and {args.out / 'heldout.csv'}" + (f"; updated {args.docs}" if args.docs else ""))
+    try:
+        run_missing(pours, store, fresh=args.fresh, progress=not args.quiet)
+    finally:  # the report of what is done, also after Ctrl-C or SIGTERM (the pours not run are rows marked so)
+        rows = collect_rows(pours, store)
+        command = ("cosim bench --plan heldout" + (f" --scenes {args.scenes}" if args.scenes is not None else "")
+                   + (f" --docs {args.docs}" if args.docs else ""))
+        header = (f"### Held-out pours ({datetime.now(timezone.utc):%Y-%m-%d})\n\n{_machine_line()}\n"
+                  f"Command: `{command}`; scenes: the files of {scenes}/ (one pour each, one thread, no recording). "
+                  f"Code version of the pours (cosim.bench.cache.code_version): {code}.")
+        text = markdown(rows, header)
+        write_text_atomic(args.out / "heldout.md", text)
+        write_text_atomic(args.out / "heldout.csv", rows_csv(rows))
+        if args.docs is not None:
+            update_document(args.docs, text, HELDOUT_BEGIN, HELDOUT_END)
+        print(text)
+        print(f"wrote {args.out / 'heldout.md'} and {args.out / 'heldout.csv'}" + (f"; updated {args.docs}" if args.docs else ""))
     return 0 if all(r["passed"] for r in rows) else 1
 
 
