@@ -14,6 +14,13 @@ is missing.
 particles beside warp's example_sph, the 2-D steps per second at 10k, the 3-D pour's real-time factor, all on a CUDA
 device when one is present; the default pour's wall time on the CPU), afresh each time, into ``targets.md`` and
 ``targets.json``; with ``--docs`` it rewrites that file's block for this machine's kind (cpu or cuda).
+
+``--plan heldout`` runs the held-out pours (:mod:`cosim.bench.heldout`: every scene of ``--scenes``, default
+examples/heldout, one pour at a time on one thread, no recording) and reports per scene its spill, landing error and
+partial-pour error against the acceptance thresholds, PASS or FAIL, into ``heldout.md`` and ``heldout.csv``; with
+``--docs`` it rewrites that file's generated block. The pours are kept under ``--cache`` (default OUT/heldout), keyed
+by the scene and the simulation code, so a rerun only runs what is missing; Ctrl-C or SIGTERM stops the pour in
+flight and still writes the report (the pours not run marked so). Exit status 1 when a row fails.
 """
 
 from __future__ import annotations
@@ -27,15 +34,17 @@ from cosim.atomic_files import check_output_folder, write_text_atomic
 from cosim.errors import InputError
 
 DEFAULT_OUT = Path("recordings") / "bench"
-PLANS = ("full", "smoke", "targets")
+PLANS = ("full", "smoke", "targets", "heldout")
+HELDOUT_BEGIN, HELDOUT_END = "<!-- cosim bench heldout: generated, begin -->", "<!-- cosim bench heldout: generated, end -->"
 
 
 def register(subparsers, summary: str) -> None:
     p = subparsers.add_parser("bench", help=summary, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--plan", default="full", help="which configurations: full (default), smoke (seconds, for checks) or targets (the speed targets on "
-                   "this machine's devices, measured afresh: no cache)")
+    p.add_argument("--plan", default="full", help="which configurations: full (default), smoke (seconds, for checks), targets (the speed targets on "
+                   "this machine's devices, measured afresh: no cache) or heldout (the held-out pours against their acceptance thresholds)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for bench.csv, bench.md and the plots (default {DEFAULT_OUT})")
-    p.add_argument("--cache", type=Path, help="result cache folder (default OUT/cache)")
+    p.add_argument("--cache", type=Path, help="result cache folder (default OUT/cache; with --plan heldout: the pours' folder, default OUT/heldout)")
+    p.add_argument("--scenes", type=Path, help="with --plan heldout: the folder of held-out scene files (default examples/heldout)")
     p.add_argument("--docs", type=Path, help="also rewrite the generated part of this Markdown file (e.g. docs/benchmarks.md), plots beside it")
     p.add_argument("--fresh", action="store_true", help="recompute every configuration (overwrites the cache)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -80,6 +89,37 @@ def _run_targets(args) -> int:
     return 1 if any(m.failed for m in measurements) else 0
 
 
+def _run_heldout(args) -> int:
+    """``--plan heldout``: the held-out pours against their acceptance thresholds (:mod:`cosim.bench.heldout`)."""
+    from cosim.bench.cache import code_version
+    from cosim.bench.config import BenchCase
+    from cosim.bench.heldout import DEFAULT_SCENES, collect_rows, load_pours, markdown, rows_csv, run_missing
+    from cosim.bench.report import update_document
+    from cosim.sweep.store import SweepStore
+
+    scenes = args.scenes if args.scenes is not None else DEFAULT_SCENES
+    code = code_version(BenchCase.POUR)
+    pours = load_pours(scenes, code)
+    store = SweepStore(args.cache or args.out / "heldout")
+    try:
+        run_missing(pours, store, fresh=args.fresh, progress=not args.quiet)
+    finally:  # the report of what is done, also after Ctrl-C or SIGTERM (the pours not run are rows marked so)
+        rows = collect_rows(pours, store)
+        command = ("cosim bench --plan heldout" + (f" --scenes {args.scenes}" if args.scenes is not None else "")
+                   + (f" --docs {args.docs}" if args.docs else ""))
+        header = (f"### Held-out pours ({datetime.now(timezone.utc):%Y-%m-%d})\n\n{_machine_line()}\n"
+                  f"Command: `{command}`; scenes: the files of {scenes}/ (one pour each, one thread, no recording). "
+                  f"Code version of the pours (cosim.bench.cache.code_version): {code}.")
+        text = markdown(rows, header)
+        write_text_atomic(args.out / "heldout.md", text)
+        write_text_atomic(args.out / "heldout.csv", rows_csv(rows))
+        if args.docs is not None:
+            update_document(args.docs, text, HELDOUT_BEGIN, HELDOUT_END)
+        print(text)
+        print(f"wrote {args.out / 'heldout.md'} and {args.out / 'heldout.csv'}" + (f"; updated {args.docs}" if args.docs else ""))
+    return 0 if all(r["passed"] for r in rows) else 1
+
+
 def run(args) -> int:
     if args.plan not in PLANS:
         raise InputError(f"--plan: must be one of {', '.join(PLANS)}, got {args.plan!r}")
@@ -87,6 +127,8 @@ def run(args) -> int:
         raise InputError(f"--docs: must be a Markdown file (.md), got {args.docs}")
     if args.plan == "targets" and (args.cache is not None or args.fresh):
         raise InputError(f"{'--cache' if args.cache is not None else '--fresh'}: the targets plan measures afresh every time and caches nothing")
+    if args.scenes is not None and args.plan != "heldout":
+        raise InputError("--scenes: only with --plan heldout")
     check_output_folder(args.out, "--out")
     if args.docs is not None:
         check_output_folder(args.docs.parent, "--docs")
@@ -94,6 +136,8 @@ def run(args) -> int:
         check_output_folder(args.cache, "--cache")
     if args.plan == "targets":
         return _run_targets(args)
+    if args.plan == "heldout":
+        return _run_heldout(args)
     from cosim.bench.cache import ResultCache
     from cosim.bench.plan import build_plan
     from cosim.bench.report import build_rows, markdown, plot_case, rows_csv, skip_table, update_document

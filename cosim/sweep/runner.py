@@ -41,9 +41,9 @@ def pour_task(scene: PourScene, folder: str, code: str) -> None:
     run_pour(worker_scene(scene), Path(folder), progress=False, long_run_ok=True)
 
 
-def failure_record(pour: PlannedPour, exc: BaseException) -> dict:
-    """What is kept of a failed pour: its axes, the failure's kind and its first line."""
-    import ray.exceptions
+def failure(exc: BaseException) -> dict[str, str]:
+    """A failed pour's kind ('bad input', 'simulation failed', 'code version', 'lost worker' or 'error (<type>)') and
+    its first line; ``exc`` is the pour's own exception, or Ray's wrapping of it."""
     from controllers.errors import ControllerInputError, MeasurementError
 
     cause = getattr(exc, "cause", None) or exc  # a task's own exception, inside Ray's RayTaskError
@@ -53,12 +53,18 @@ def failure_record(pour: PlannedPour, exc: BaseException) -> dict:
         kind = "simulation failed"
     elif isinstance(cause, CodeVersionMismatch):
         kind = "code version"
-    elif isinstance(exc, (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError, ray.exceptions.ObjectLostError)):
-        kind = "lost worker"
     else:
-        kind = f"error ({type(cause).__name__})"
+        import ray.exceptions
+
+        lost = (ray.exceptions.WorkerCrashedError, ray.exceptions.NodeDiedError, ray.exceptions.ObjectLostError)
+        kind = "lost worker" if isinstance(exc, lost) else f"error ({type(cause).__name__})"
     lines = str(cause).strip().splitlines() or [type(cause).__name__]
-    return {"axes": pour.point.axes, "kind": kind, "error": lines[0]}
+    return {"kind": kind, "error": lines[0]}
+
+
+def failure_record(pour: PlannedPour, exc: BaseException) -> dict:
+    """What is kept of a failed pour: its axes, the failure's kind and its first line (:func:`failure`)."""
+    return {"axes": pour.point.axes, **failure(exc)}
 
 
 def connect(address: str | None) -> bool:
