@@ -39,7 +39,7 @@ MESH_SUFFIXES = (".obj", ".stl")
 MESH_SIZE_RANGE = (0.005, 2.0)
 # Azimuth around the pour direction (deg) within which the rim's lowest point is the crest.
 CREST_HALF_ANGLE = 45.0
-# Azimuth bins (deg) of the rim's height.
+# Azimuth step (deg) at which the rim's height is taken.
 RIM_BIN = 5.0
 # Voxels across the mesh's largest extent for the cavity classification of faces.
 VOXELS_ACROSS = 64
@@ -174,14 +174,19 @@ def _liquid_facing(mesh) -> np.ndarray:
     return facing
 
 
-def _rim_height(vertices: np.ndarray) -> float:
-    """m: the lowest of the rim's heights (the highest liquid-facing vertex per :data:`RIM_BIN` of azimuth) within
-    :data:`CREST_HALF_ANGLE` of +x."""
-    azimuth = np.degrees(np.arctan2(vertices[:, 1], vertices[:, 0]))
-    near = np.abs(azimuth) <= CREST_HALF_ANGLE + 1e-9
-    bins = np.floor((azimuth[near] + CREST_HALF_ANGLE) / RIM_BIN).astype(int)
-    z = vertices[near, 2]
-    return float(min(z[bins == b].max() for b in np.unique(bins)))
+def _rim_height(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """m: the lowest of the rim's heights within :data:`CREST_HALF_ANGLE` of +x, every :data:`RIM_BIN` of azimuth; the
+    rim's height at an azimuth is the top of the liquid-facing ``faces``' section by the half-plane there."""
+    trimesh = _trimesh()
+    mesh = trimesh.Trimesh(vertices, faces, process=False)
+    heights = []
+    for angle in np.radians(np.arange(-CREST_HALF_ANGLE, CREST_HALF_ANGLE + 1e-9, RIM_BIN)):
+        toward = np.array([math.cos(angle), math.sin(angle), 0.0])
+        segments = trimesh.intersections.mesh_plane(mesh, [-toward[1], toward[0], 0.0], [0.0, 0.0, 0.0]).reshape(-1, 3)
+        ahead = segments[segments @ toward > 0.0]
+        if len(ahead):
+            heights.append(float(ahead[:, 2].max()))
+    return min(heights)
 
 
 def _closed_form(vessel: VesselMesh, widths: list[tuple[float, float]], heights: np.ndarray) -> dict:
@@ -259,11 +264,11 @@ def _cached(path: str, pour_direction: float, mtime: float, field_name: str) -> 
     mesh.apply_translation([-0.5 * (lo[0] + hi[0]), -0.5 * (lo[1] + hi[1]), -lo[2]])
     vertices = np.asarray(mesh.vertices, dtype=float)
     faces = np.asarray(mesh.faces, dtype=np.int64)
-    crest = _rim_height(vertices[np.unique(faces[facing])])
+    crest = _rim_height(vertices, faces[facing])
     below_rim = crest - min(1e-4, 0.01 * crest)
     inner = _crossings(_plane_section(vertices, faces[facing])[0], below_rim)
     walls = _crossings(_plane_section(vertices, faces)[0], below_rim)
-    if len(inner) < 2 or inner[-1] <= 0.0:
+    if len(inner) == 0 or inner[-1] <= 0.0:
         raise InputError(f"{field_name}: {source}'s opening does not cross the pour plane y = 0 on the pour side "
                          "(allowed: the vessel's axis at its centre, the pour direction toward a wall)")
     inner_x = float(inner[-1])

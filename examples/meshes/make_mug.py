@@ -1,10 +1,10 @@
-"""Write the example mug (examples/meshes/mug.obj) and a box vessel as a mesh (examples/meshes/box.obj).
+"""Write the example mug (examples/meshes/mug.obj) and a box vessel as a mesh (examples/meshes/beaker.obj).
 
 The mug: a revolved wall profile (80 mm inside, 100 mm from the inner floor to the rim, 4 mm walls, a 6 mm floor with
 a rounded outer edge) and a C-shaped handle of round section on the -x side, opposite the pour direction (+x). The
 handle's ends sink into the wall, so the mesh is two closed solids that overlap there: watertight, which is what
-cosim needs. The box: the paper's vessel (inner 0.191 x 0.10 m, 0.191 m high, 5 mm walls), to pour it as a mesh and
-as dimensions. Metres, opening up.
+cosim needs. The box: examples/small_beaker.toml's beaker (inner 80 x 60 mm, 0.10 m high, 3 mm walls), to pour it as
+a mesh and as dimensions. Metres, opening up.
 
     python examples/meshes/make_mug.py [OUT_DIR]
 """
@@ -65,7 +65,7 @@ def handle() -> trimesh.Trimesh:
     return tube
 
 
-def box_vessel(width=0.191, depth=0.10, height=0.191, wall=0.005) -> trimesh.Trimesh:
+def box_vessel(width=0.08, depth=0.06, height=0.10, wall=0.003) -> trimesh.Trimesh:
     """An open box: the outer block less the cavity, as one closed solid."""
     b, d = 0.5 * width, 0.5 * depth
     outer = [(-b - wall, -d - wall), (b + wall, -d - wall), (b + wall, d + wall), (-b - wall, d + wall)]
@@ -88,8 +88,8 @@ def main(out: Path) -> None:
     out.mkdir(parents=True, exist_ok=True)
     mug = trimesh.util.concatenate([mug_body(), handle()])
     mug.export(out / "mug.obj")
-    box_vessel().export(out / "box.obj")
-    print(f"wrote {out / 'mug.obj'} ({len(mug.faces)} faces) and {out / 'box.obj'}")
+    box_vessel().export(out / "beaker.obj")
+    print(f"wrote {out / 'mug.obj'} ({len(mug.faces)} faces) and {out / 'beaker.obj'}")
 
 
 if __name__ == "__main__":
