@@ -59,7 +59,13 @@ def test_fill_volume_integrates_the_cross_section():
     assert mug.fill_volume(0.07) == pytest.approx(polygon * 0.07, rel=1e-6)
     assert mug.capacity == pytest.approx(polygon * 0.1, rel=1e-6)
     assert mug.section_depth == pytest.approx(polygon / 0.08, rel=1e-6)  # the 2-D slice holds the mug's volume
-    assert mug.liquid_shape(3) is VesselShape.CYLINDER
+    assert mug.liquid_shape(3) is VesselShape.CYLINDER and mug.has_closed_form(2)
+    flared = mesh_vessel_spec("pourer", load_vessel_mesh(EXAMPLES / "meshes" / "flared_cup.obj"))
+    assert not flared.has_closed_form(2) and not flared.has_closed_form(3)  # its plant is identified from the liquid
+    # a cone's frustum: V(z) = pi z (r0^2 + r0 r + r^2) / 3 with r = r0 + (r1 - r0) z / H (the 48-gon's share of it)
+    r = 0.030 + 0.015 * 0.05 / 0.09
+    frustum = math.pi * 0.05 * (0.030**2 + 0.030 * r + r**2) / 3 * 48 * math.sin(2 * math.pi / 48) / (2 * math.pi)
+    assert flared.fill_volume(0.05) == pytest.approx(frustum, rel=1e-6)
 
 
 def test_the_crest_is_the_rims_lowest_point_toward_the_pour(tmp_path):
@@ -125,7 +131,7 @@ def test_the_example_scene_loads_its_mesh_relative_to_itself():
 
 def test_the_committed_meshes_are_what_the_script_makes(tmp_path):
     runpy.run_path(str(EXAMPLES / "meshes" / "make_mug.py"), run_name="not_main")["main"](tmp_path)
-    for name in ("mug.obj", "beaker.obj"):
+    for name in ("mug.obj", "beaker.obj", "flared_cup.obj"):
         assert (tmp_path / name).read_bytes() == (EXAMPLES / "meshes" / name).read_bytes()
 
 

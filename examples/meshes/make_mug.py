@@ -1,10 +1,12 @@
-"""Write the example mug (examples/meshes/mug.obj) and a box vessel as a mesh (examples/meshes/beaker.obj).
+"""Write the example mug (examples/meshes/mug.obj), a box vessel as a mesh (examples/meshes/beaker.obj) and a flared
+cup (examples/meshes/flared_cup.obj).
 
 The mug: a revolved wall profile (80 mm inside, 100 mm from the inner floor to the rim, 4 mm walls, a 6 mm floor with
 a rounded outer edge) and a C-shaped handle of round section on the -x side, opposite the pour direction (+x). The
 handle's ends sink into the wall, so the mesh is two closed solids that overlap there: watertight, which is what
 cosim needs. The box: examples/small_beaker.toml's beaker (inner 80 x 60 mm, 0.10 m high, 3 mm walls), to pour it as
-a mesh and as dimensions. Metres, opening up.
+a mesh and as dimensions. The flared cup: walls widening from 60 mm across the floor to 90 mm at the rim, 90 mm high,
+a vessel whose slosh has no closed form. Metres, opening up.
 
     python examples/meshes/make_mug.py [OUT_DIR]
 """
@@ -65,6 +67,15 @@ def handle() -> trimesh.Trimesh:
     return tube
 
 
+def flared_cup() -> trimesh.Trimesh:
+    """A revolved cup whose inner radius grows linearly from 30 mm at the floor to 45 mm at the rim, 3 mm walls."""
+    profile = [(0.0, -0.004), (0.033, -0.004), (0.048, 0.09), (0.045, 0.09), (0.030, 0.0), (0.0, 0.0)]
+    cup = trimesh.creation.revolve(np.array(profile), sections=SEGMENTS)
+    if cup.volume < 0:
+        cup.invert()
+    return cup
+
+
 def box_vessel(width=0.08, depth=0.06, height=0.10, wall=0.003) -> trimesh.Trimesh:
     """An open box: the outer block less the cavity, as one closed solid."""
     b, d = 0.5 * width, 0.5 * depth
@@ -89,7 +100,8 @@ def main(out: Path) -> None:
     mug = trimesh.util.concatenate([mug_body(), handle()])
     mug.export(out / "mug.obj")
     box_vessel().export(out / "beaker.obj")
-    print(f"wrote {out / 'mug.obj'} ({len(mug.faces)} faces) and {out / 'beaker.obj'}")
+    flared_cup().export(out / "flared_cup.obj")
+    print(f"wrote {out / 'mug.obj'} ({len(mug.faces)} faces), {out / 'beaker.obj'} and {out / 'flared_cup.obj'}")
 
 
 if __name__ == "__main__":
