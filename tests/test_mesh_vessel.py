@@ -190,3 +190,16 @@ def test_the_mujoco_body_weighs_the_mesh_and_collides_by_convex_parts():
     parts_only = np.array([0, 0, 0, 1, 0, 0], np.uint8)
     down = mujoco.mj_ray(model, data, np.array([0.01, 0.003, 0.2]), np.array([0.0, 0.0, -1.0]), parts_only, 1, -1, geomid)
     assert down == pytest.approx(0.2, abs=1e-6)  # a ray down the mug's middle meets the floor, not a hull over the cavity
+
+
+@pytest.mark.slow
+def test_the_mug_scene_builds_its_cell_and_reads_the_mesh_back():
+    from cosim.pour_checks import robot_scene
+    from cosim.robots.scene_config import ArmRole
+
+    scene = load_scene(EXAMPLES / "mug_pour.toml")
+    robots = robot_scene(scene)
+    pourer = robots.arms[ArmRole.POUR].vessel  # parsed back from the scene's vessel record
+    assert pourer.is_mesh and pourer == scene.vessels.pourer.spec("pourer")
+    assert pourer.mesh.source == str(MUG) and pourer.mass == pytest.approx(scene.vessels.pourer.spec("pourer").mass)
+    np.testing.assert_allclose(robots.lip_position(ArmRole.POUR) - robots.arms[ArmRole.POUR].home_pos, pourer.lip_local, atol=1e-6)
