@@ -203,3 +203,27 @@ def test_the_mug_scene_builds_its_cell_and_reads_the_mesh_back():
     assert pourer.is_mesh and pourer == scene.vessels.pourer.spec("pourer")
     assert pourer.mesh.source == str(MUG) and pourer.mass == pytest.approx(scene.vessels.pourer.spec("pourer").mass)
     np.testing.assert_allclose(robots.lip_position(ArmRole.POUR) - robots.arms[ArmRole.POUR].home_pos, pourer.lip_local, atol=1e-6)
+
+
+@pytest.mark.slow
+def test_a_pourer_without_closed_form_takes_the_identified_plant(tmp_path):
+    from dataclasses import replace
+
+    from controllers.slosh import SloshModel
+    from cosim.pour_run import prepare
+
+    scene = load_scene(EXAMPLES / "mug_pour.toml")
+    flared = replace(scene.vessels.pourer, mesh=str(EXAMPLES / "meshes" / "flared_cup.obj"))
+    scene = replace(scene, vessels=replace(scene.vessels, pourer=flared))
+    identified = SloshModel(0.03, 0.02, 0.05, source="SPH identification")
+    calls = []
+
+    def identify(pourer, fill, cfg):
+        calls.append((pourer.mesh.source, fill, cfg.dim))
+        return identified
+
+    pour = prepare(scene, identify_plant=identify)
+    assert calls == [(flared.mesh, 0.07, 2)]
+    assert pour.controller.config.slosh_model() is identified
+    mug = prepare(load_scene(EXAMPLES / "mug_pour.toml"), identify_plant=identify)  # a closed form: not called
+    assert len(calls) == 1 and mug.controller.config.slosh is None
