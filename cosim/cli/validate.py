@@ -123,7 +123,7 @@ def run(args) -> int:
         print(f"running {name} ({', '.join(f'{k}={v}' for k, v in vars(params).items() if v is not None)}) ...", file=sys.stderr)
         result = CASES[name].run(params)
         results.append(result)
-        for extent in ("width", "depth"):  # the cases build tanks of whole particle spacings (whole_spacings)
+        for extent in ("width", "depth") if not getattr(params, "scene", "") else ():  # tanks of whole spacings
             asked, built = getattr(params, extent, None), result.parameters.get(extent)
             if asked is not None and built is not None and built != asked:
                 print(f"  {extent} {built:.4g} m: {asked:g} m rounded to whole particle spacings", file=sys.stderr)

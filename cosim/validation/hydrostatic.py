@@ -7,8 +7,9 @@ holds a whole number of layers). Also: max density error, particles outside the 
 liquid's vertical force on the tank against its weight.
 
 ``scene``: a scene file whose pourer (a box, a cylinder or a mesh, ``[vessels.pourer]``) is the tank instead, as it
-is; H is then the liquid's lattice height (its whole layers times the spacing) and the probes lie in the pour plane
-within the inner width.
+is; H is then the height at which the tank's cavity holds the liquid's volume (a mesh's V(H), or its pour-plane
+section's area S(H) times the depth in 2-D; the lattice keeps half a spacing from curved walls, so the settled
+liquid is lower than its seeded layers) and the probes lie in the pour plane within the inner width.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 
 from cosim.checks import check_positive
 from cosim.fluid.config import GRAVITY
-from cosim.fluid.seeding import fill_layers, fill_vessel
+from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
 from cosim.pour_scene import load_scene
@@ -77,6 +78,17 @@ def _interpolate(points: np.ndarray, x: np.ndarray, values: np.ndarray, volumes:
     return out
 
 
+def _mesh_liquid_height(tank: VesselSpec, volume: float, dim: int, depth: float) -> float:
+    """m: the height H at which the mesh tank holds ``volume`` (m^3): V(H), or in 2-D S(H) ``depth``; by bisection
+    to a micrometre (V and S grow monotonically with H)."""
+    held = tank.mesh.cavity_volume if dim == 3 else (lambda h: tank.mesh.section_area(h) * depth)
+    lo, hi = 0.0, tank.inner_height
+    while hi - lo > 1e-6:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if held(mid) < volume else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
     require_particles_across("spacing", p.tank_width, dx, 8)
@@ -101,8 +113,8 @@ def run(p: Params) -> CaseResult:
     x, pressure, rho, active = solver.positions(), solver.pressures(), solver.densities(), solver.active_mask()
     h = cfg.smoothing_length
     volume0 = solver.n_particles * cfg.particle_volume
-    if p.scene:
-        height = fill_layers(tank, p.fill, dx) * dx
+    if p.scene and tank.is_mesh:
+        height = _mesh_liquid_height(tank, volume0, p.dim, depth)
     else:
         height = volume0 / (tank.inner_floor_area if p.dim == 3 else width * depth)
     clearance = PROBE_CLEARANCE * h
