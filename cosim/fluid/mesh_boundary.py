@@ -7,10 +7,11 @@ a ``wp.Mesh``. Both functions take vessel-frame points, as the box and cylinder 
 Inside (the vessel's cavity, :func:`mesh_inside`): walls below and on all four horizontal sides and none above (rays
 along -z, +x, -x, +y, -y hit the mesh, the ray along +z does not; a point inside the walls has them above it, so it is
 not inside). The same rule :mod:`cosim.mesh_vessel` applies on a voxel grid.
-The rays are turned off the axes, the horizontal ones by :data:`RAY_SKEW` rad, the vertical ones by
-:data:`VERTICAL_SKEW` rad (less: one rising by RAY_SKEW from near a wall would meet it): a ray along an axis from a
-lattice point (or from the pour plane y = 0) meets a mesh's faces on their shared edges, where a ray can pass between
-two triangles.
+The rays that must hit are turned off the axes, the horizontal ones by :data:`RAY_SKEW` rad, the one down by
+:data:`VERTICAL_SKEW` rad: a ray along an axis from a lattice point (or from the pour plane y = 0) meets a mesh's
+faces on their shared edges (a revolved floor's centre, a quad's diagonal), where a ray can pass between two
+triangles. The ray up, which must miss, stays vertical: turned, it would meet the wall from liquid resting against
+it, closer to the wall than its drift over the height to the rim.
 
 Guard (:func:`mesh_guard`): the particle's path from q_old to q_new is cast as a ray; if it enters the walls
 through a face (hits the front of an outward-wound face) it is put back on that face plus ``margin`` on the side it
@@ -42,7 +43,7 @@ def mesh_inside(mesh: wp.uint64, cavity_lo: wp.vec3, cavity_hi: wp.vec3, q: wp.v
             return 0
     reach = 2.0 * wp.length(cavity_hi - cavity_lo)
     v = VERTICAL_SKEW
-    if wp.mesh_query_ray_anyhit(mesh, q, wp.vec3(v, v, 1.0), reach):
+    if wp.mesh_query_ray_anyhit(mesh, q, wp.vec3(0.0, 0.0, 1.0), reach):
         return 0
     if not wp.mesh_query_ray_anyhit(mesh, q, wp.vec3(-v, v, -1.0), reach):
         return 0
