@@ -7,10 +7,9 @@ holds a whole number of layers). Also: max density error, particles outside the 
 liquid's vertical force on the tank against its weight.
 
 ``scene``: a scene file whose pourer (a box, a cylinder or a mesh, ``[vessels.pourer]``) is the tank instead, as it
-is; for a mesh tank H is the liquid's free surface as the particles show it (the mean over the columns of the
-probes of the top particle's height, plus half a spacing): the lattice stands off curved walls by more than half a
-spacing, so neither the seeded layers nor the cavity's volume give the settled surface to 2 %. The probes lie in
-the pour plane within the inner width.
+is; H is then the height at which the tank's cavity holds the liquid's volume (a mesh's V(H), or its pour-plane
+section's area S(H) times the depth in 2-D; the lattice keeps half a spacing from curved walls, so the settled
+liquid is lower than its seeded layers) and the probes lie in the pour plane within the inner width.
 """
 
 from __future__ import annotations
@@ -79,13 +78,15 @@ def _interpolate(points: np.ndarray, x: np.ndarray, values: np.ndarray, volumes:
     return out
 
 
-def _surface_height(x: np.ndarray, half_span: float, dx: float) -> float:
-    """m: the free surface of the resting liquid at positions ``x`` (N, 3): the mean over the columns of width
-    ``dx`` within ``half_span`` (m) of the axis, in the pour plane, of the top particle's height, plus dx / 2."""
-    near = (np.abs(x[:, 0]) < half_span) & (np.abs(x[:, 1]) < 0.5 * dx)
-    column = np.floor(x[near, 0] / dx).astype(int)
-    tops = [x[near][column == c, 2].max() for c in np.unique(column)]
-    return float(np.mean(tops)) + 0.5 * dx
+def _mesh_liquid_height(tank: VesselSpec, volume: float, dim: int, depth: float) -> float:
+    """m: the height H at which the mesh tank holds ``volume`` (m^3): V(H), or in 2-D S(H) ``depth``; by bisection
+    to a micrometre (V and S grow monotonically with H)."""
+    held = tank.mesh.cavity_volume if dim == 3 else (lambda h: tank.mesh.section_area(h) * depth)
+    lo, hi = 0.0, tank.inner_height
+    while hi - lo > 1e-6:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if held(mid) < volume else (lo, mid)
+    return 0.5 * (lo + hi)
 
 
 def run(p: Params) -> CaseResult:
@@ -113,7 +114,7 @@ def run(p: Params) -> CaseResult:
     h = cfg.smoothing_length
     volume0 = solver.n_particles * cfg.particle_volume
     if p.scene and tank.is_mesh:
-        height = _surface_height(x[active.astype(bool)], 0.5 * width - PROBE_CLEARANCE * h, dx)
+        height = _mesh_liquid_height(tank, volume0, p.dim, depth)
     else:
         height = volume0 / (tank.inner_floor_area if p.dim == 3 else width * depth)
     clearance = PROBE_CLEARANCE * h
