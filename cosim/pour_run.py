@@ -24,15 +24,18 @@ from dataclasses import asdict, replace
 from datetime import datetime, timezone
 from importlib import metadata
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from controllers.config import CFS_MAX_HEAD, CatcherConfig, PourConfig
 from controllers.geometry import VesselGeometry
+from controllers.slosh import SloshModel
 from cosim.atomic_files import check_output_folder
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.loop import CoupledPour, build_pour
 from cosim.errors import InputError
+from cosim.fluid.config import FluidConfig
 from cosim.fluid.runtime import kernel_modules, load_kernels, resolve_device
 from cosim.io.pour_series import write_series_csv
 from cosim.pour_checks import PourPlan, check_pour
@@ -43,6 +46,7 @@ from cosim.trajectory.driver_names import driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.smoothness import trajectory_smoothness
 from cosim.trajectory.torques import required_torques
+from cosim.vessel import VesselSpec
 
 DEFAULT_RECORDINGS = Path("recordings")
 VERSIONED_PACKAGES = ("cosim", "warp-lang", "mujoco", "numpy", "control", "ruckig", "rerun-sdk")
@@ -60,8 +64,13 @@ def cfs_head_reference(scene: PourScene, spacing: float) -> float:
     return max(scene.controller.cfs.h_q_ref, min(floor, CFS_MAX_HEAD))
 
 
-def _controller_config(scene: PourScene, spacing: float):
-    """``pour_config`` callback of :func:`build_pour`: the scene's controller settings on the simulated geometry."""
+# Identifies the slosh plant of a pourer with no closed form: (pourer, fill depth m, the liquid's settings) -> plant.
+PlantIdentifier = Callable[[VesselSpec, float, FluidConfig], SloshModel]
+
+
+def _controller_config(scene: PourScene, spacing: float, slosh: SloshModel | None = None):
+    """``pour_config`` callback of :func:`build_pour`: the scene's controller settings on the simulated geometry
+    (``slosh``: the pourer's identified plant, None for potential flow)."""
     c = scene.controller
     h_q_ref = cfs_head_reference(scene, spacing)
 
@@ -75,18 +84,24 @@ def _controller_config(scene: PourScene, spacing: float):
         return PourConfig(
             catcher=catcher, vessel=geometry, fill_depth=fill, target_volume=target, control_rate=c.control_rate,
             start_time=scene.coupling.start_delay, sim=c.sim, approach=c.approach, cfs=replace(c.cfs, h_q_ref=h_q_ref),
-            returning=c.returning,
+            returning=c.returning, slosh=slosh,
         )
 
     return make
 
 
-def prepare(scene: PourScene, plan: PourPlan | None = None) -> CoupledPour:
+def prepare(scene: PourScene, plan: PourPlan | None = None, identify_plant: PlantIdentifier | None = None) -> CoupledPour:
     """Build the pour (robots, liquid, controller, trajectory generators) for ``scene`` from its checked ``plan``
-    (:func:`cosim.pour_checks.check_pour`, run here when not given, any estimated run time accepted)."""
+    (:func:`cosim.pour_checks.check_pour`, run here when not given, any estimated run time accepted). A pourer whose
+    slosh has no closed form (:meth:`cosim.vessel.VesselSpec.has_closed_form`) takes its plant from
+    ``identify_plant``; without one, the controller uses potential flow for the box of its equivalent sizes."""
     plan = plan or check_pour(scene, long_run_ok=True)
+    pourer = plan.robots.arms[ROLES[0]].vessel
+    slosh = None
+    if identify_plant is not None and not pourer.has_closed_form(plan.fluid_base.dim):
+        slosh = identify_plant(pourer, scene.liquid.fill_depth, plan.fluid_base)
     return build_pour(
-        plan.robots, plan.fluid_base, _controller_config(scene, plan.fluid_base.spacing), plan.limits, scene.liquid.fill_depth,
+        plan.robots, plan.fluid_base, _controller_config(scene, plan.fluid_base.spacing, slosh), plan.limits, scene.liquid.fill_depth,
         scene.coupling, scene.device, scene.controller.pose_filter, scene.trajectory.sample_rate_hz,
     )
 
@@ -149,10 +164,12 @@ def _add_torque_report(arm_load: dict, joint_names, torques: np.ndarray, limits)
         record["rated_torque"] = {n: rated[n] for n in names}
 
 
-def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, long_run_ok: bool = False) -> tuple[Path, dict]:
+def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, long_run_ok: bool = False,
+             identify_plant: PlantIdentifier | None = None) -> tuple[Path, dict]:
     """Run ``scene`` and write its outputs; returns (run folder, summary). The scene's checks
     (:func:`cosim.pour_checks.check_pour`; ``long_run_ok`` accepts a run estimated at over an hour) come first, and
-    with ``progress``, their particle counts and run-time estimate are printed before the first step."""
+    with ``progress``, their particle counts and run-time estimate are printed before the first step.
+    ``identify_plant``: see :func:`prepare`."""
     final = destination(out, scene.run_name)
     field = "--out" if out is not None else "--out (default recordings/)"
     check_output_folder(final.parent, field)
@@ -163,7 +180,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
     seconds = load_kernels(resolve_device(scene.device), kernel_modules("cosim"))
     if progress:
         print(f"kernels ready in {seconds:.1f} s", file=sys.stderr, flush=True)
-    pour = prepare(scene, plan)
+    pour = prepare(scene, plan, identify_plant)
     try:
         final.parent.mkdir(parents=True, exist_ok=True)
         work = Path(tempfile.mkdtemp(prefix=f".{final.name}.partial-", dir=final.parent))

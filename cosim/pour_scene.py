@@ -29,7 +29,8 @@ from cosim.robots.scene_config import (
     CATCHER_HOME_X, POUR_HEIGHT, POURER_FLOOR_ABOVE_TABLE, TABLE_TOP, SceneConfig, pour_cell_config,
 )
 from cosim.trajectory.limits import JointLimitOverride
-from cosim.vessel import VesselShape, VesselSpec, default_catching_vessel, seed_pouring_vessel
+from cosim.mesh_vessel import load_vessel_mesh
+from cosim.vessel import VesselShape, VesselSpec, default_catching_vessel, mesh_vessel_spec, seed_pouring_vessel
 
 
 @dataclass(frozen=True)
@@ -226,11 +227,14 @@ VESSEL_SIZE_RANGE = (0.02, 0.6)
 WALL_THICKNESS_RANGE = (0.001, 0.05)
 # Wall material density, kg/m^3: from foamed plastics to tungsten.
 WALL_DENSITY_RANGE = (100.0, 25000.0)
+# A mesh's pour direction, deg about +z from the file's +x.
+POUR_DIRECTION_RANGE = (-180.0, 180.0)
 
 
 @dataclass(frozen=True)
 class VesselSettings:
-    """shape: 'box' or 'cylinder', an open vessel standing on its floor.
+    """shape: 'box' or 'cylinder', an open vessel standing on its floor; or 'mesh', the vessel's walls from the file
+      ``mesh`` (the sizes and the wall thickness then come from the mesh, docs/mesh_vessels.md).
     inner_width: m, inner size along the pour direction (the vessel's x, toward its lip); a cylinder's inner
       diameter. [0.02, 0.6]
     inner_depth: m, a box's inner size across the pour plane (a cylinder's is its diameter: this key is not used).
@@ -239,6 +243,10 @@ class VesselSettings:
     wall_thickness: m, floor and walls; less than the inner width (and a box's inner depth). [0.001, 0.05]
     wall_density: kg/m^3, the wall material (acrylic 1180, glass 2500, steel 7850); with the walls' volume it sets
       the empty vessel's mass. [100, 25000]
+    mesh: a 'mesh' vessel's file: OBJ or STL, one watertight solid of the walls, in metres, its opening up (+z);
+      relative to the scene file. Its bounding box within [0.005, 2] m.
+    pour_direction: deg, a 'mesh' vessel's pour direction: the azimuth about +z, from the file's +x, of the wall the
+      liquid leaves over. [-180, 180]
     """
 
     shape: VesselShape = VesselSpec.shape
@@ -247,6 +255,8 @@ class VesselSettings:
     inner_height: float = VesselSpec.inner_height
     wall_thickness: float = VesselSpec.wall_thickness
     wall_density: float = VesselSpec.wall_density
+    mesh: str = ""
+    pour_direction: float = 0.0
 
     @classmethod
     def of(cls, spec: VesselSpec) -> "VesselSettings":
@@ -254,7 +264,16 @@ class VesselSettings:
         return cls(spec.shape, spec.inner_width, spec.inner_depth, spec.inner_height, spec.wall_thickness, spec.wall_density)
 
     def check(self, prefix: str) -> None:
-        """Range checks, each message naming the field as ``<prefix>.<field>``."""
+        """Range checks, each message naming the field as ``<prefix>.<field>``; a mesh is loaded and checked
+        (:func:`cosim.mesh_vessel.load_vessel_mesh`)."""
+        check_range(f"{prefix}.pour_direction", self.pour_direction, *POUR_DIRECTION_RANGE, "deg")
+        if (self.shape is VesselShape.MESH) != bool(self.mesh):
+            raise InputError(f"{prefix}.mesh: a file for shape 'mesh' (and only for it), got shape {self.shape.value!r} "
+                             f"and mesh {self.mesh!r}")
+        if self.shape is VesselShape.MESH:
+            check_range(f"{prefix}.wall_density", self.wall_density, *WALL_DENSITY_RANGE, "kg/m^3")
+            self.spec(prefix.rsplit(".", 1)[-1], prefix)
+            return
         lo, hi = VESSEL_SIZE_RANGE
         for name in ("inner_width", "inner_depth", "inner_height"):
             check_range(f"{prefix}.{name}", getattr(self, name), lo, hi, "m")
@@ -263,8 +282,12 @@ class VesselSettings:
         hi = min(WALL_THICKNESS_RANGE[1], narrowest)
         check_range(f"{prefix}.wall_thickness", self.wall_thickness, WALL_THICKNESS_RANGE[0], hi, "m", hi_open=hi < WALL_THICKNESS_RANGE[1])
 
-    def spec(self, name: str) -> VesselSpec:
-        """The :class:`VesselSpec` named ``name`` (a cylinder's depth is its diameter)."""
+    def spec(self, name: str, prefix: str = "vessels") -> VesselSpec:
+        """The :class:`VesselSpec` named ``name`` (a cylinder's depth is its diameter; a mesh's from its file, errors
+        naming ``<prefix>.mesh``)."""
+        if self.shape is VesselShape.MESH:
+            mesh = load_vessel_mesh(self.mesh, self.pour_direction, f"{prefix}.mesh")
+            return mesh_vessel_spec(name, mesh, self.wall_density)
         depth = self.inner_depth if self.shape is VesselShape.BOX else self.inner_width
         return VesselSpec(name, self.shape, self.inner_width, depth, self.inner_height, self.wall_thickness, self.wall_density)
 
@@ -362,7 +385,8 @@ class PourScene:
         if self.vessels == VesselsSettings() and self.placement == PlacementSettings() and self.arms == ArmsSettings():
             return None
         p = self.placement
-        return self.arms.apply(pour_cell_config(self.vessels.pourer.spec("pourer"), self.vessels.catcher.spec("catcher"),
+        return self.arms.apply(pour_cell_config(self.vessels.pourer.spec("pourer", "vessels.pourer"),
+                                                self.vessels.catcher.spec("catcher", "vessels.catcher"),
                                                 p.table_height, p.pourer_height, p.catcher_home_x, p.pour_height))
 
     @property
@@ -381,6 +405,9 @@ def load_scene(path: str | Path) -> PourScene:
     (``arms.*.mjcf``) given by a relative path are taken from the scene file's folder."""
     path = Path(path)
     table = read_toml_file(path, "scene file")
+    for vessel in table.get("vessels", {}).values() if isinstance(table.get("vessels"), dict) else ():
+        if isinstance(vessel, dict) and isinstance(vessel.get("mesh"), str) and vessel["mesh"]:
+            vessel["mesh"] = str((path.parent / vessel["mesh"]).resolve())  # relative to the scene file (an absolute path stays)
     try:
         scene = from_mapping(PourScene, table, "scene")
     except InputError as exc:

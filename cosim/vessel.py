@@ -14,12 +14,13 @@ from __future__ import annotations
 import functools
 import math
 import operator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 
 import numpy as np
 
 from cosim.checks import check_choice, check_positive, check_range
+from cosim.mesh_vessel import VesselMesh
 
 # Poly(methyl methacrylate), a common lab vessel material (kg/m^3).
 ACRYLIC_DENSITY = 1180.0
@@ -38,6 +39,7 @@ class VesselShape(Enum):
 
     BOX = "box"  # open rectangular box (the paper's vessel)
     CYLINDER = "cylinder"  # open cylindrical cup
+    MESH = "mesh"  # the walls from a mesh file (cosim.mesh_vessel)
 
 
 @dataclass(frozen=True)
@@ -61,6 +63,8 @@ class VesselSpec:
       inner_height: m, inner floor to rim (local z); the paper's L. (0, 2]
       wall_thickness: m, thickness of floor and walls. (0, 0.05]
       wall_density: kg/m^3, wall material density (sets the empty vessel's mass). (0, 25000]
+      mesh: the walls of a 'mesh' vessel (:class:`cosim.mesh_vessel.VesselMesh`, vessel frame); its box
+        equivalent (:func:`mesh_vessel_spec`) gives the sizes above. None for a box or cylinder.
     """
 
     name: str = "pourer"
@@ -70,10 +74,13 @@ class VesselSpec:
     inner_height: float = 0.191
     wall_thickness: float = 0.005
     wall_density: float = ACRYLIC_DENSITY
+    mesh: VesselMesh | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         p = f"vessel[{self.name}]"
         object.__setattr__(self, "shape", check_choice(f"{p}.shape", self.shape, VesselShape))
+        if (self.shape is VesselShape.MESH) != (self.mesh is not None):
+            raise ValueError(f"{p}: a mesh vessel needs its mesh, and only a mesh vessel has one")
         for field_name in ("inner_width", "inner_depth", "inner_height"):
             object.__setattr__(self, field_name, check_positive(f"{p}.{field_name}", getattr(self, field_name), "m", 2.0))
         object.__setattr__(self, "wall_thickness", check_positive(f"{p}.wall_thickness", self.wall_thickness, "m", 0.05))
@@ -85,20 +92,29 @@ class VesselSpec:
         return self.shape is VesselShape.BOX
 
     @property
+    def is_mesh(self) -> bool:
+        return self.shape is VesselShape.MESH
+
+    @property
     def section_depth(self) -> float:
-        """m, inner extent perpendicular to the pour plane (box depth, cylinder diameter)."""
-        return self.inner_depth if self.is_box else self.inner_width
+        """m, inner extent perpendicular to the pour plane (box depth, cylinder diameter; a mesh's cavity volume over
+        its pour-plane section's area)."""
+        return self.inner_width if self.shape is VesselShape.CYLINDER else self.inner_depth
 
     @property
     def inner_floor_area(self) -> float:
-        """m^2, inner horizontal cross-section (upright vessel)."""
+        """m^2, inner horizontal cross-section (upright vessel); a mesh's mean one, its capacity over its height."""
         if self.is_box:
             return self.inner_width * self.inner_depth
+        if self.is_mesh:
+            return self.capacity / self.inner_height
         return math.pi * (0.5 * self.inner_width) ** 2
 
     @property
     def capacity(self) -> float:
-        """m^3, inner volume up to the rim."""
+        """m^3, inner volume up to the rim (a mesh's up to its crest)."""
+        if self.is_mesh:
+            return self.mesh.cavity_volume(self.inner_height)
         return self.inner_floor_area * self.inner_height
 
     def liquid_depth(self, dim: int) -> float:
@@ -109,12 +125,24 @@ class VesselSpec:
 
     def liquid_shape(self, dim: int) -> VesselShape:
         """The horizontal section of the ``dim``-D liquid, which sets its slosh mode: a 2-D liquid is a pour-plane
-        slice, so a box whatever the vessel; a 3-D liquid takes the vessel's shape."""
-        return VesselShape.BOX if dim == 2 else self.shape
+        slice, so a box whatever the vessel; a 3-D liquid takes the vessel's shape (a mesh's closed form, else
+        the box of its equivalent sizes; :attr:`has_closed_form` says which)."""
+        if dim == 2:
+            return VesselShape.BOX
+        if self.is_mesh:
+            return VesselShape(self.mesh.closed_form[3] or "box")
+        return self.shape
+
+    def has_closed_form(self, dim: int) -> bool:
+        """Whether potential flow describes the ``dim``-D liquid's slosh: always for a box or a cylinder; for a mesh
+        when its cavity is box- or cylinder-like (:mod:`cosim.mesh_vessel`)."""
+        return not self.is_mesh or bool(self.mesh.closed_form[dim])
 
     def fill_volume(self, fill_depth: float) -> float:
         """m^3 of liquid that fills the upright vessel to ``fill_depth`` (m); checked against the rim."""
         check_range(f"vessel[{self.name}].fill_depth", fill_depth, 0.0, self.inner_height, "m (rim height)", lo_open=True)
+        if self.is_mesh:
+            return self.mesh.cavity_volume(fill_depth)
         return self.inner_floor_area * fill_depth
 
     @property
@@ -142,6 +170,8 @@ class VesselSpec:
 
     def _wall_parts(self) -> list[tuple[float, np.ndarray]]:
         """(volume m^3, centroid m) of each solid part of the walls."""
+        if self.is_mesh:
+            return [(self.mesh.volume, np.array(self.mesh.centre_of_mass))]
         if self.is_box:
             return [(8.0 * float(np.prod(w.half_size)), np.array(w.center)) for w in self.wall_boxes()]
         r, t, h = 0.5 * self.inner_width, self.wall_thickness, self.inner_height
@@ -172,6 +202,9 @@ class VesselSpec:
     def outer_half_extents(self) -> np.ndarray:
         """Half sizes (m) of the vessel's outer bounding box, which spans z in [-wall_thickness, inner_height]."""
         t = self.wall_thickness
+        if self.is_mesh:
+            lo, hi = self.mesh.bounds
+            return np.array([max(-lo[0], hi[0]), max(-lo[1], hi[1]), 0.5 * (hi[2] - lo[2])])
         half_y = 0.5 * self.section_depth + t
         return np.array([0.5 * self.inner_width + t, half_y, 0.5 * (self.inner_height + t)])
 
@@ -184,3 +217,12 @@ def seed_pouring_vessel() -> VesselSpec:
 def default_catching_vessel() -> VesselSpec:
     """The catching vessel: wider and deeper than the pourer so that a full pour fits with margin."""
     return VesselSpec(name="catcher", inner_width=0.26, inner_depth=0.14, inner_height=0.16)
+
+
+def mesh_vessel_spec(name: str, mesh: VesselMesh, wall_density: float = ACRYLIC_DENSITY) -> VesselSpec:
+    """The vessel of ``mesh`` with walls of ``wall_density`` (kg/m^3). Its sizes are the box equivalent the pour
+    controller and the checks read: inner width twice the inner rim's x at the crest (the lip then sits at the mesh's
+    outer wall, ``inner_width / 2 + wall_thickness``), inner depth the 2-D liquid's depth (cavity volume over the
+    pour-plane section's area), inner height the crest's, wall thickness the wall's at the crest in the pour plane."""
+    return VesselSpec(name, VesselShape.MESH, 2.0 * mesh.inner_x, mesh.depth_2d, mesh.crest_height,
+                      mesh.lip_x - mesh.inner_x, wall_density, mesh)

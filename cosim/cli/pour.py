@@ -59,8 +59,14 @@ def scene_from_args(args) -> PourScene:
 def run(args) -> int:
     scene = scene_from_args(args)  # a bad scene is refused before the simulation's libraries load
     from cosim.pour_run import run_pour
+    from cosim.validation.mesh_plant import identified_plant
 
-    folder, summary = run_pour(scene, args.out, progress=not args.quiet, long_run_ok=args.yes)
+    def identify(pourer, fill, cfg):
+        print(f"identifying the slosh plant of {pourer.name} ({pourer.mesh.source}: no closed form) from the liquid ...",
+              file=sys.stderr, flush=True)
+        return identified_plant(pourer, fill, cfg.dim, cfg.spacing, cfg.pressure_solver, scene.device)
+
+    folder, summary = run_pour(scene, args.out, progress=not args.quiet, long_run_ok=args.yes, identify_plant=identify)
     initial = summary["initial_volume"]
     ml = 1e6
     print(f"wrote {folder}: {', '.join(summary['outputs'])}")

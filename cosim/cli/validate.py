@@ -41,6 +41,7 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--fill", type=float, help="fill depth A (hydrostatic, slosh, slosh-plant) or column height (dam-break), m; "
                    "slosh without --fill runs the fills 0.054, 0.108, 0.162 m of Camporredondo et al. (2019)")
     p.add_argument("--shape", choices=("box", "cylinder"), help="slosh-plant's vessel: box or cylinder (3-D only) (default box)")
+    p.add_argument("--scene", help="a scene file whose pourer (a box, cylinder or mesh) is the vessel (hydrostatic, tilt, shake)")
     p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
     p.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2-D (pour plane) or 3-D (default 2)")
     p.add_argument("--device", default="cpu", help="cpu or cuda[:N] (default cpu)")
@@ -76,6 +77,9 @@ def _case_params(name: str, args) -> list:
         return [params(**common, head=head) for head in weir.HEADS]  # the weir's own channel, at two heads
     if name == "slosh-plant" and args.shape is not None:
         geometry["shape"] = args.shape
+    if args.scene is not None and name in ("hydrostatic", "tilt", "shake"):
+        geometry["scene"] = args.scene
+        geometry.pop("width", None)
     if name == "slosh" and args.fill is None:
         return [params(**common, **geometry, fill=fill) for fill in slosh.SEED_FILLS]
     return [params(**common, **geometry)]
@@ -119,7 +123,7 @@ def run(args) -> int:
         print(f"running {name} ({', '.join(f'{k}={v}' for k, v in vars(params).items() if v is not None)}) ...", file=sys.stderr)
         result = CASES[name].run(params)
         results.append(result)
-        for extent in ("width", "depth"):  # the cases build tanks of whole particle spacings (whole_spacings)
+        for extent in ("width", "depth") if not getattr(params, "scene", "") else ():  # tanks of whole spacings
             asked, built = getattr(params, extent, None), result.parameters.get(extent)
             if asked is not None and built is not None and built != asked:
                 print(f"  {extent} {built:.4g} m: {asked:g} m rounded to whole particle spacings", file=sys.stderr)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import warp as wp
 
 from cosim.fluid.lanes import lane_item
+from cosim.fluid.mesh_boundary import SHAPE_MESH, mesh_guard, mesh_inside
 from cosim.fluid.neighbors import GridSpec, block_cell, neighbor_cells
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_w
@@ -30,7 +31,9 @@ SHAPE_CYLINDER = 1
 
 @wp.struct
 class VesselGeometry:
-    """Vessel frame geometry (m). shape: SHAPE_BOX or SHAPE_CYLINDER (a cylinder is a box section in 2-D).
+    """Vessel frame geometry (m). shape: SHAPE_BOX, SHAPE_CYLINDER (a cylinder is a box section in 2-D) or
+    SHAPE_MESH (:mod:`cosim.fluid.mesh_boundary`: ``mesh`` the walls' ``wp.Mesh`` id, ``cavity_lo``/``cavity_hi`` the
+    cavity's bounding box; the sizes below its box equivalent).
 
     half_width: b = inner_width / 2 (a cylinder's inner radius); half_depth: inner_depth / 2 (box, 3-D);
     height: inner height H; thickness: wall thickness the liquid sees (the dummy layers', if thicker than the
@@ -46,6 +49,9 @@ class VesselGeometry:
     thickness: float
     com: wp.vec3
     liquid_mass: float
+    mesh: wp.uint64
+    cavity_lo: wp.vec3
+    cavity_hi: wp.vec3
 
 
 @wp.struct
@@ -324,7 +330,9 @@ def guard_vessel(q_old: wp.vec3, q_new: wp.vec3, geo: VesselGeometry, dim: int, 
     normal = wp.vec3(0.0)
     max_depth = float(0.0)
     hits = int(0)
-    if geo.shape == 1 and dim == 3:
+    if geo.shape == SHAPE_MESH:
+        q, normal, max_depth, hits = mesh_guard(geo.mesh, q_old, q_new, margin, geo.thickness, dim)
+    elif geo.shape == 1 and dim == 3:
         q, normal, max_depth, hits = cylinder_guard(q_old, q_new, geo, margin)
     else:
         n_slabs = wp.where(dim == 2, 3, 5)
@@ -342,6 +350,8 @@ def guard_vessel(q_old: wp.vec3, q_new: wp.vec3, geo: VesselGeometry, dim: int, 
 @wp.func
 def inside_vessel(q: wp.vec3, geo: VesselGeometry, dim: int) -> int:
     """1 if the vessel-frame point q is in the vessel's inner volume (below the rim), else 0."""
+    if geo.shape == SHAPE_MESH:
+        return mesh_inside(geo.mesh, geo.cavity_lo, geo.cavity_hi, q)
     if q[2] <= 0.0 or q[2] >= geo.height:
         return 0
     if geo.shape == 1 and dim == 3:

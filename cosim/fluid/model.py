@@ -19,6 +19,8 @@ import numpy as np
 import warp as wp
 
 from cosim.fluid.boundary import SHAPE_BOX, SHAPE_CYLINDER, VesselGeometry
+from cosim.fluid.mesh_boundary import SHAPE_MESH
+from cosim.fluid.mesh_sampling import cavity_bounds, warp_mesh
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.memory import check_memory
 from cosim.fluid.neighbors import CellGrid
@@ -44,6 +46,7 @@ class FluidModel:
     grid, b_grid: neighbour grids for liquid and wall particles (identical cell layout).
     densest_smoothing_ratio: h over the spacing of the densest liquid the particles can pack to (2-D: of the
     smallest in-plane mass, :func:`densest_smoothing_ratio`; the configured ratio otherwise).
+    meshes: the mesh vessels' ``wp.Mesh`` (their ids are in ``vessels``; held here so that they live as long).
     """
 
     config: FluidConfig
@@ -60,6 +63,7 @@ class FluidModel:
     grid: CellGrid
     b_grid: CellGrid
     densest_smoothing_ratio: float
+    meshes: tuple = ()
 
     @property
     def n_vessels(self) -> int:
@@ -98,9 +102,14 @@ def densest_smoothing_ratio(cfg: FluidConfig, specs: tuple[VesselSpec, ...]) -> 
     return cfg.smoothing_ratio * math.sqrt(cfg.particle_mass / min(masses))
 
 
-def _geometry(spec: VesselSpec, wall_thickness: float, liquid_mass: float) -> VesselGeometry:
+def _geometry(spec: VesselSpec, wall_thickness: float, liquid_mass: float, mesh: wp.Mesh | None) -> VesselGeometry:
     geo = VesselGeometry()
-    geo.shape = SHAPE_BOX if spec.is_box else SHAPE_CYLINDER
+    geo.shape = SHAPE_MESH if spec.is_mesh else SHAPE_BOX if spec.is_box else SHAPE_CYLINDER
+    if mesh is not None:
+        geo.mesh = mesh.id
+        lo, hi = cavity_bounds(spec)
+        geo.cavity_lo = wp.vec3(*lo)
+        geo.cavity_hi = wp.vec3(*hi)
     geo.half_width = 0.5 * spec.inner_width
     geo.half_depth = 0.5 * spec.section_depth
     geo.height = spec.inner_height
@@ -123,13 +132,14 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
     reach = np.array([np.linalg.norm(s, axis=1).max() for s in samples]) if samples else np.zeros(0)
     thickness = np.array([numerical_wall_thickness(s, cfg.spacing, cfg.support_radius) for s in specs])
     densest = densest_smoothing_ratio(cfg, specs)
+    meshes = [warp_mesh(s.mesh.vertices, s.mesh.faces, device) if s.is_mesh else None for s in specs]
     make_grid = lambda capacity: CellGrid(cfg.domain_min, cfg.domain_max, cfg.support_radius, cfg.dim, capacity, device, cfg.grid_reset)  # noqa: E731
     return FluidModel(
         config=cfg,
         device=device,
         params=make_params(cfg, len(specs), atomic_replicas, densest),
         vessel_specs=tuple(specs),
-        vessels=wp.array([_geometry(s, t, caught_liquid_mass(cfg, s)) for s, t in zip(specs, thickness)], dtype=VesselGeometry, device=device),
+        vessels=wp.array([_geometry(s, t, caught_liquid_mass(cfg, s), m) for s, t, m in zip(specs, thickness, meshes)], dtype=VesselGeometry, device=device),
         b_local=wp.array(b_local.astype(np.float32), dtype=wp.vec3, device=device),
         b_vessel=wp.array(b_vessel, dtype=wp.int32, device=device),
         b_volume=wp.array(b_volume.astype(np.float32), dtype=float, device=device),
@@ -139,6 +149,7 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
         grid=make_grid(n_particles),
         b_grid=make_grid(len(b_local)),
         densest_smoothing_ratio=densest,
+        meshes=tuple(m for m in meshes if m is not None),
     )
 
 

@@ -23,6 +23,7 @@ import numpy as np
 
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig
+from cosim.fluid.mesh_sampling import cavity_bounds, fill_mesh_vessel
 from cosim.frames import Pose
 from cosim.vessel import VesselSpec
 
@@ -130,7 +131,12 @@ def fill_vessel(spec: VesselSpec, fill_depth: float, cfg: FluidConfig, pose: Pos
     check_resolution(spec, fill_depth, cfg)
     dx = cfg.spacing
     n_z = fill_layers(spec, fill_depth, dx)
-    if spec.is_box or cfg.dim == 2:
+    if spec.is_mesh:
+        (lo_x, lo_y, _), (hi_x, hi_y, _) = cavity_bounds(spec)
+        local = liquid_block((lo_x, lo_y, 0.0), (hi_x, hi_y, fill_depth), cfg, None).positions
+        local = local[fill_mesh_vessel(spec, local, dx)]
+        local = local[local[:, 2] < n_z * dx]
+    elif spec.is_box or cfg.dim == 2:
         b = 0.5 * spec.inner_width
         d = 0.5 * spec.section_depth
         local = liquid_block((-b, -d, 0.0), (b, d, fill_depth), cfg, None).positions

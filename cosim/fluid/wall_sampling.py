@@ -18,6 +18,7 @@ import math
 
 import numpy as np
 
+from cosim.fluid.mesh_sampling import mesh_wetted_layer, sample_mesh_walls
 from cosim.vessel import VesselSpec
 
 
@@ -83,6 +84,8 @@ def sample_vessel_walls(spec: VesselSpec, spacing: float, support: float, dim: i
     """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim)."""
     h = spec.inner_height
     t = numerical_wall_thickness(spec, spacing, support)
+    if spec.is_mesh:
+        return sample_mesh_walls(spec, spacing, t, dim)
     if dim == 2 or spec.is_box:
         b = 0.5 * spec.inner_width
         d = 0.5 * spec.section_depth
@@ -105,6 +108,8 @@ def wetted_layer(spec: VesselSpec, points: np.ndarray, spacing: float, dim: int)
     one ``spacing`` from the vessel's inner volume (the inner corners' diagonal ones included). Only this layer has
     a full kernel support of liquid and wall in a resting, filled vessel (the deeper ones lack the layers beyond
     the last), so only it can be held to rest density (DFSPH's pressure-carrying wall, ``cosim.fluid.dfsph``)."""
+    if spec.is_mesh:
+        return mesh_wetted_layer(spec, points, spacing)
     x, y, z = points[:, 0], points[:, 1], points[:, 2]
     below = np.maximum(-z, 0.0)
     if dim == 2 or spec.is_box:

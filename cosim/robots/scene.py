@@ -23,6 +23,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import unquote
 
 import mujoco
 import numpy as np
@@ -36,7 +37,8 @@ from cosim.robots.scene_builder import CUSTOM_PREFIX, HOME_KEY, build_scene_spec
 from cosim.robots.scene_config import ArmRole, SceneConfig
 from cosim.robots.vessel_mjcf import frame_site, lip_site
 from cosim.frames import cross3
-from cosim.vessel import VesselShape, VesselSpec
+from cosim.mesh_vessel import load_vessel_mesh
+from cosim.vessel import VesselShape, VesselSpec, mesh_vessel_spec
 
 
 @dataclass(frozen=True)
@@ -108,6 +110,9 @@ def _numeric(model: mujoco.MjModel, name: str, source: str) -> np.ndarray:
 def _parse_vessel(record: str, source: str) -> VesselSpec:
     fields = dict(item.split("=", 1) for item in record.split())
     try:
+        if fields["shape"] == VesselShape.MESH.value:
+            mesh = load_vessel_mesh(unquote(fields["mesh"]), float(fields["pour_direction"]), f"{source}: vessel {fields['name']} mesh")
+            return mesh_vessel_spec(fields["name"], mesh, float(fields["wall_density"]))
         return VesselSpec(
             name=fields["name"],
             shape=VesselShape(fields["shape"]),

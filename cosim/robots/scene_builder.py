@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from urllib.parse import quote
 
 import mujoco
 import numpy as np
@@ -223,17 +224,20 @@ def _add_mount_and_vessel(scene: mujoco.MjSpec, compiled: mujoco.MjModel, placem
     pos, quat = vessel_in_site(placement.vessel, placement.mount_side, m.thickness)
     pos = pos if placement.grasp_pos is None else np.array(placement.grasp_pos)
     quat = quat if placement.grasp_quat is None else np.array(placement.grasp_quat)
-    add_vessel_body(mount, placement.vessel, pos, quat, gravcomp=gravcomp)
+    add_vessel_body(mount, placement.vessel, pos, quat, gravcomp=gravcomp, spec=scene)
     scene.add_exclude(bodyname1=link_name, bodyname2=placement.vessel.name)
     return link_name
 
 
 def _vessel_record(vessel: VesselSpec) -> str:
-    return (
+    record = (
         f"name={vessel.name} shape={vessel.shape.value} inner_width={vessel.inner_width!r} "
         f"inner_depth={vessel.inner_depth!r} inner_height={vessel.inner_height!r} "
         f"wall_thickness={vessel.wall_thickness!r} wall_density={vessel.wall_density!r}"
     )
+    if vessel.is_mesh:  # the file (its path URL-quoted: the record is split at spaces) and its pour direction
+        record += f" mesh={quote(vessel.mesh.source)} pour_direction={vessel.mesh.pour_direction!r}"
+    return record
 
 
 def _add_mapping(scene: mujoco.MjSpec, placement: ArmPlacement, flange_link: str) -> None:

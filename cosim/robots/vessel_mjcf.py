@@ -19,6 +19,7 @@ import math
 import mujoco
 import numpy as np
 
+from cosim.robots.vessel_mesh_mjcf import add_mesh_geoms
 from cosim.vessel import VesselSpec
 
 # Number of box staves approximating a cylindrical wall (15 deg each).
@@ -110,19 +111,27 @@ def add_vessel_body(
     pos: np.ndarray = np.zeros(3),
     quat: np.ndarray = np.array([1.0, 0.0, 0.0, 0.0]),
     gravcomp: float = 0.0,
+    spec: mujoco.MjSpec | None = None,
 ) -> mujoco.MjsBody:
     """Add the vessel as a child body of ``parent`` at ``pos`` (3,) m / ``quat`` (4,) [w, x, y, z] in the parent frame.
 
     ``gravcomp`` is the body's gravity-compensation fraction (1 when the holding arm's controller compensates the
-    vessel's weight, as for the project's arms). Returns the new body, named ``vessel.name``.
+    vessel's weight, as for the project's arms). ``spec``: the MjSpec ``parent`` belongs to, which takes a mesh
+    vessel's mesh assets (:mod:`cosim.robots.vessel_mesh_mjcf`). Returns the new body, named ``vessel.name``.
     """
     body = parent.add_body(name=vessel.name, pos=list(map(float, pos)), quat=list(map(float, quat)))
     body.gravcomp = gravcomp
     body.explicitinertial = True
     body.mass = vessel.mass
     body.ipos = list(map(float, vessel.com_local))
-    body.inertia = list(map(float, vessel_inertia(vessel)))
-    if vessel.is_box:
+    if vessel.is_mesh:
+        inertia = vessel.wall_density * np.asarray(vessel.mesh.inertia)  # full tensor about the centre of mass
+        body.fullinertia = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]]
+        if spec is None:
+            raise ValueError(f"vessel {vessel.name!r}: a mesh vessel's body needs the MjSpec for its mesh assets")
+        add_mesh_geoms(spec, body, vessel, VESSEL_GEOM_GROUP, VESSEL_RGBA)
+    elif vessel.is_box:
+        body.inertia = list(map(float, vessel_inertia(vessel)))
         for wall in vessel.wall_boxes():
             body.add_geom(
                 name=f"{vessel.name}/{wall.name}",
@@ -133,6 +142,7 @@ def add_vessel_body(
                 rgba=list(VESSEL_RGBA),
             )
     else:
+        body.inertia = list(map(float, vessel_inertia(vessel)))
         _add_cylinder_geoms(body, vessel)
     body.add_site(name=frame_site(vessel), size=[SITE_SIZE] * 3, group=4)
     body.add_site(name=lip_site(vessel), pos=list(map(float, vessel.lip_local)), size=[SITE_SIZE] * 3, group=4)
@@ -151,5 +161,5 @@ def vessel_mjcf(vessel: VesselSpec) -> str:
         "Frame: origin at the centre of the inner floor, +x toward the pour lip, +z up. "
     )
     spec.compiler.degree = False
-    add_vessel_body(spec.worldbody, vessel)
+    add_vessel_body(spec.worldbody, vessel, spec=spec)
     return spec.to_xml()

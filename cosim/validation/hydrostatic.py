@@ -5,6 +5,11 @@ is interpolated (Shepard, the solver's kernel) at probes more than 2h from walls
 with rho0 g (H - z), H being the liquid's actual height (its volume over the tank's floor area: the lattice
 holds a whole number of layers). Also: max density error, particles outside the tank, volume drift, and the
 liquid's vertical force on the tank against its weight.
+
+``scene``: a scene file whose pourer (a box, a cylinder or a mesh, ``[vessels.pourer]``) is the tank instead, as it
+is; H is then the height at which the tank's cavity holds the liquid's volume (a mesh's V(H), or its pour-plane
+section's area S(H) times the depth in 2-D; the lattice keeps half a spacing from curved walls, so the settled
+liquid is lower than its seeded layers) and the probes lie in the pour plane within the inner width.
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ from cosim.fluid.config import GRAVITY
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
+from cosim.pour_scene import load_scene
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
 from cosim.vessel import VesselSpec
 
@@ -35,11 +41,13 @@ INTERVAL = 0.02  # s, how often vessel poses are (re)set; the tank does not move
 
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
-    """width: m, tank inner width (B). fill: m, fill depth. duration: s, simulated time before measuring."""
+    """width: m, tank inner width (B). fill: m, fill depth. duration: s, simulated time before measuring. scene: a scene
+    file whose pourer is the tank ('': a box of ``width`` and ``depth``)."""
 
     width: float = 0.191
     fill: float = 0.159
     duration: float = 2.0
+    scene: str = ""
 
     def __post_init__(self) -> None:
         self.validate_common()
@@ -49,7 +57,15 @@ class Params(FluidCaseParams):
 
     @property
     def resolved_spacing(self) -> float:
-        return self.spacing if self.spacing is not None else self.width / MIN_PARTICLES_ACROSS
+        return self.spacing if self.spacing is not None else self.tank_width / MIN_PARTICLES_ACROSS
+
+    @property
+    def tank_width(self) -> float:
+        return self.scene_tank().inner_width if self.scene else self.width
+
+    def scene_tank(self) -> VesselSpec:
+        """The scene's pourer as the tank."""
+        return load_scene(self.scene).vessels.pourer.spec("tank", "vessels.pourer")
 
 
 def _interpolate(points: np.ndarray, x: np.ndarray, values: np.ndarray, volumes: np.ndarray, h: float) -> np.ndarray:
@@ -62,11 +78,26 @@ def _interpolate(points: np.ndarray, x: np.ndarray, values: np.ndarray, volumes:
     return out
 
 
+def _mesh_liquid_height(tank: VesselSpec, volume: float, dim: int, depth: float) -> float:
+    """m: the height H at which the mesh tank holds ``volume`` (m^3): V(H), or in 2-D S(H) ``depth``; by bisection
+    to a micrometre (V and S grow monotonically with H)."""
+    held = tank.mesh.cavity_volume if dim == 3 else (lambda h: tank.mesh.section_area(h) * depth)
+    lo, hi = 0.0, tank.inner_height
+    while hi - lo > 1e-6:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if held(mid) < volume else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
-    require_particles_across("spacing", p.width, dx, 8)
-    width, depth = whole_spacings(p.width, dx), p.tank_depth(dx)
-    tank = VesselSpec(name="tank", inner_width=width, inner_depth=depth, inner_height=p.fill * 1.25 + 4 * dx)
+    require_particles_across("spacing", p.tank_width, dx, 8)
+    if p.scene:
+        tank = p.scene_tank()
+        width, depth = tank.inner_width, tank.section_depth
+    else:
+        width, depth = whole_spacings(p.width, dx), p.tank_depth(dx)
+        tank = VesselSpec(name="tank", inner_width=width, inner_depth=depth, inner_height=p.fill * 1.25 + 4 * dx)
     margin = 0.05 * width + 10 * dx
     half = 0.5 * width + margin
     cfg = case_fluid_config(
@@ -82,7 +113,10 @@ def run(p: Params) -> CaseResult:
     x, pressure, rho, active = solver.positions(), solver.pressures(), solver.densities(), solver.active_mask()
     h = cfg.smoothing_length
     volume0 = solver.n_particles * cfg.particle_volume
-    height = volume0 / (tank.inner_floor_area if p.dim == 3 else width * depth)
+    if p.scene and tank.is_mesh:
+        height = _mesh_liquid_height(tank, volume0, p.dim, depth)
+    else:
+        height = volume0 / (tank.inner_floor_area if p.dim == 3 else width * depth)
     clearance = PROBE_CLEARANCE * h
     zs = np.linspace(clearance, height - clearance, 12)
     xs = np.linspace(-0.5 * width + clearance, 0.5 * width - clearance, 5)
@@ -117,7 +151,8 @@ def run(p: Params) -> CaseResult:
         "steps": solver.step_count,
         "active": int(active.sum()),
     }
-    params = dict(width=width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, duration=p.duration, depth=depth)
+    params = dict(width=width, fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, duration=p.duration, depth=depth,
+                  tank=tank.shape.value, scene=p.scene)
     return CaseResult("hydrostatic", params, metrics, raw, wall)
 
 

@@ -10,6 +10,9 @@ every 2 ms sample (numpy): no particle inside the wall solid (the wall region th
 that went from the vessel's inside to its outside below the rim (through a wall) between two samples. Non-finite
 values or a breached wall would stop the run with the solver's instability error, which the case reports as a
 failure.
+
+``scene``: a scene file whose pourer (``[vessels.pourer]``: a box, a cylinder or a mesh) is the vessel instead; a
+mesh vessel's wall solid and inner volume are the mesh's (:mod:`cosim.validation.mesh_regions`).
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cosim.checks import check_positive, check_range
+from cosim.pour_scene import load_scene
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
 from cosim.validation.scripted import FALL_HEIGHT, PoseScript, domain_around, run_scripted, shake_sideways, tilt_about_lip
 from cosim.validation.slosh import eq17_frequency
@@ -31,7 +35,8 @@ HOLD_AFTER_TILT = 0.5  # s the tilted vessel is held before the run ends
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
     """fill: m. rate: deg/s (tilt). angle: deg (tilt). amplitude: m (shake). periods: shake periods.
-    particles_across: resolution across the vessel's inner width when ``spacing`` is not given."""
+    particles_across: resolution across the vessel's inner width when ``spacing`` is not given. scene: a scene file
+    whose pourer is the vessel ('': the paper's vessel)."""
 
     fill: float = 0.159
     rate: float = 60.0
@@ -39,17 +44,18 @@ class Params(FluidCaseParams):
     amplitude: float = 0.01
     periods: float = 4.0
     particles_across: int = 24
+    scene: str = ""
 
     def __post_init__(self) -> None:
         self.validate_common()
-        check_positive("fill", self.fill, "m", seed_pouring_vessel().inner_height)
+        check_positive("fill", self.fill, "m", self.spec().inner_height)
         check_positive("rate", self.rate, "deg/s", 600.0)
         check_range("angle", self.angle, 0.0, 180.0, "deg", lo_open=True)
         check_range("amplitude", self.amplitude, 0.0, 0.1, "m")
         check_positive("periods", self.periods, "", 50.0)
 
     def spec(self) -> VesselSpec:
-        return seed_pouring_vessel()
+        return load_scene(self.scene).vessels.pourer.spec("pourer", "vessels.pourer") if self.scene else seed_pouring_vessel()
 
     def duration_for(self, case: str) -> float:
         """Simulated time (s): the tilt plus a hold, or the shake periods."""
@@ -89,7 +95,7 @@ def _run(name: str, p: Params, pose_at: PoseScript) -> CaseResult:
         "volume_in_vessel": run.volume_in_vessel,
     }
     params = dict(fill=p.fill, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value, rate=p.rate, angle=p.angle,
-                  amplitude=p.amplitude, periods=p.periods)
+                  amplitude=p.amplitude, periods=p.periods, vessel=spec.shape.value, scene=p.scene)
     return CaseResult(name, params, metrics, raw, run.wall_time)
 
 

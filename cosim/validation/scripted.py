@@ -20,6 +20,7 @@ from cosim.fluid.config import FluidConfig
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidInstabilityError, FluidSolver
 from cosim.frames import Pose, rotation_y
+from cosim.validation.mesh_regions import MeshWallRegions
 from cosim.vessel import VesselSpec
 
 SAMPLE_INTERVAL = 0.002  # s, pose update and leak-check interval
@@ -76,7 +77,9 @@ class WallRegions:
     dim: int
 
     @classmethod
-    def of(cls, spec: VesselSpec, solver: FluidSolver) -> "WallRegions":
+    def of(cls, spec: VesselSpec, solver: FluidSolver) -> "WallRegions | MeshWallRegions":
+        if spec.is_mesh:
+            return MeshWallRegions(spec)
         return cls(0.5 * spec.inner_width, 0.5 * spec.section_depth, spec.inner_height, float(solver.model.wall_thickness[0]), solver.config.dim)
 
     def classify(self, local: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
