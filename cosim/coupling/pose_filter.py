@@ -28,6 +28,7 @@ import numpy as np
 
 from controllers.motion import CriticallyDampedSmoother
 from cosim.checks import check_positive
+from cosim.coupling.tracking_filter import TrackingFilter
 from cosim.robots.planar import PlanarPose
 from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
 from cosim.trajectory.limits import ArmLimits, JointLimits
@@ -45,6 +46,11 @@ SMOOTHING_STAGES = 3
 # the blend of a difference d peaks at 1.9 d / HANDOVER_TIME in rate and 5.8 d / HANDOVER_TIME^2 in acceleration
 # (d = 36 ms x 0.1 rad/s = 3.6 mrad, a slosh damping's rate: 0.03 rad/s, 0.5 rad/s^2).
 HANDOVER_TIME = 0.2
+# rad/s: the closed-loop bandwidth of the tracking filter that follows a moving target (in CFS). Replaying the
+# controller's recorded CFS targets, 30 rad/s follows the tilt command 104 ms late (140 ms with the smoothing
+# stages; the re-planned jerk-limited filter: 117-122 ms, 154-160 ms) with a third of the jerk-limited path's
+# acceleration content above 10 Hz.
+TRACKING_BANDWIDTH = 30.0
 
 
 @dataclass(frozen=True)
@@ -93,12 +99,20 @@ class PoseFilter:
         arm = ArmLimits(name, "task space", tuple(joint(c) for c in coordinates))
         settings = GeneratorSettings(cycle_time=control_period, control_period=control_period)
         self._generator = TrajectoryGenerator(arm, np.zeros(len(coordinates)), settings)
+        self._tracker = TrackingFilter(
+            np.array([j.max_velocity for j in arm.joints]), np.array([j.max_acceleration for j in arm.joints]),
+            np.array([j.max_jerk for j in arm.joints]), TRACKING_BANDWIDTH, control_period,
+        )
+        self._tracking = False  # the last call tracked its target (the tracker holds the path's state)
         self._period = control_period
         self._passed: list[np.ndarray] = []  # the last pass-through targets (at most three), for their rates
         self.passing = False  # the last call passed its target through
 
-    def __call__(self, target: PlanarPose, pass_through: bool = False) -> PlanarPose:
-        """The smoothed pose one control period after the previous call, heading for ``target``; with
+    def __call__(self, target: PlanarPose, pass_through: bool = False, track: bool = False) -> PlanarPose:
+        """The smoothed pose one control period after the previous call, heading for ``target``; with ``track``
+        a target that moves on every period (the CFS law's), followed by the :class:`TrackingFilter` from the
+        path's current state, which follows a ramp at a constant lag with no jerk instead of re-planning a stop at
+        every target (the jerk-limited generator takes over again from the tracker's state); with
         ``pass_through`` the target itself (a command the controller has already smoothed, whose timing matters:
         the slosh damping's feedback), the filter's own state following it (its rates from the last three
         targets) so that filtering resumes from where the path is. Pass-through starts only once the filtered
@@ -115,14 +129,26 @@ class PoseFilter:
             velocity = rates[-1] if len(rates) else np.zeros_like(values)
             acceleration = (rates[-1] - rates[-2]) / self._period if len(rates) > 1 else np.zeros_like(values)
             self._generator.reset(values, velocity, acceleration)
+            self._tracking = False
             return target
         self._passed = []
+        if track:
+            if not self._tracking:
+                self._tracker.reset(*self._generator.state)
+            self._tracking = True
+            q = self._tracker.step(values)
+            self._generator.reset(q, self._tracker.velocity, self._tracker.acceleration)
+            return self._pose(q)
+        self._tracking = False
         # Each target is one to come to rest at. Estimating a path velocity from the targets (what the joint
         # generators do with the already smooth output of this filter) reads the controller's step-to-step
         # corrections of either sign as velocity and drove a +-0.1 rad limit cycle of the tilt in the coupled pour.
         zero = np.zeros(len(self.coordinates))
         self._generator.set_target(values, zero, zero)
         q, _, _ = self._generator.step()
+        return self._pose(q)
+
+    def _pose(self, q: np.ndarray) -> PlanarPose:
         values = dict(zip(self.coordinates, map(float, q)))
         return PlanarPose(values.get("dx", 0.0), values.get("dz", 0.0), values.get("theta", 0.0))
 
