@@ -47,10 +47,14 @@ SMOOTHING_STAGES = 3
 # (d = 36 ms x 0.1 rad/s = 3.6 mrad, a slosh damping's rate: 0.03 rad/s, 0.5 rad/s^2).
 HANDOVER_TIME = 0.2
 # rad/s: the closed-loop bandwidth of the tracking filter that follows a moving target (in CFS). Replaying the
-# controller's recorded CFS targets, 30 rad/s follows the tilt command 104 ms late (140 ms with the smoothing
-# stages; the re-planned jerk-limited filter: 117-122 ms, 154-160 ms) with a third of the jerk-limited path's
-# acceleration content above 10 Hz.
-TRACKING_BANDWIDTH = 30.0
+# controller's recorded CFS targets (default and partial pour) through this filter and the smoothing stages, 35 rad/s
+# follows the tilt command 93-114 ms late (129-151 ms with the smoothing stages; the jerk-limited filter re-planned
+# to rest: 117-118 ms, 154-155 ms) with half its acceleration content above 10 Hz.
+TRACKING_BANDWIDTH = 35.0
+# How far beyond the jerk limit the tracking filter's linear law may ask before the jerk-limited generator moves the
+# path instead (toward the target as one to stop at): clipped to the limits, a linear law asking far more overshoots
+# a step (by 20 % to 180 % of a 0.02-1 rad step at 30 rad/s and 20 rad/s^3).
+TRACKING_SATURATION = 1.5
 
 
 @dataclass(frozen=True)
@@ -103,7 +107,6 @@ class PoseFilter:
             np.array([j.max_velocity for j in arm.joints]), np.array([j.max_acceleration for j in arm.joints]),
             np.array([j.max_jerk for j in arm.joints]), TRACKING_BANDWIDTH, control_period,
         )
-        self._tracking = False  # the last call tracked its target (the tracker holds the path's state)
         self._period = control_period
         self._passed: list[np.ndarray] = []  # the last pass-through targets (at most three), for their rates
         self.passing = False  # the last call passed its target through
@@ -112,7 +115,8 @@ class PoseFilter:
         """The smoothed pose one control period after the previous call, heading for ``target``; with ``track``
         a target that moves on every period (the CFS law's), followed by the :class:`TrackingFilter` from the
         path's current state, which follows a ramp at a constant lag with no jerk instead of re-planning a stop at
-        every target (the jerk-limited generator takes over again from the tracker's state); with
+        every target (where its linear law would ask more than :data:`TRACKING_SATURATION` times the jerk limit,
+        the jerk-limited generator takes the step toward the target as one to stop at); with
         ``pass_through`` the target itself (a command the controller has already smoothed, whose timing matters:
         the slosh damping's feedback), the filter's own state following it (its rates from the last three
         targets) so that filtering resumes from where the path is. Pass-through starts only once the filtered
@@ -129,17 +133,16 @@ class PoseFilter:
             velocity = rates[-1] if len(rates) else np.zeros_like(values)
             acceleration = (rates[-1] - rates[-2]) / self._period if len(rates) > 1 else np.zeros_like(values)
             self._generator.reset(values, velocity, acceleration)
-            self._tracking = False
             return target
         self._passed = []
         if track:
-            if not self._tracking:
-                self._tracker.reset(*self._generator.state)
-            self._tracking = True
-            q = self._tracker.step(values)
-            self._generator.reset(q, self._tracker.velocity, self._tracker.acceleration)
-            return self._pose(q)
-        self._tracking = False
+            state = self._generator.state
+            linear = self._tracker.limited_step(values, *state)
+            if linear is None and self._tracker.saturation(values, *state) <= TRACKING_SATURATION:
+                linear = self._tracker.clipped_step(values, *state)
+            if linear is not None:
+                self._generator.reset(*linear)
+                return self._pose(linear[0])
         # Each target is one to come to rest at. Estimating a path velocity from the targets (what the joint
         # generators do with the already smooth output of this filter) reads the controller's step-to-step
         # corrections of either sign as velocity and drove a +-0.1 rad limit cycle of the tilt in the coupled pour.
