@@ -6,7 +6,10 @@ the intended vessel path by centimetres. The targets (dx, dz, theta of the poure
 ruckig generator in those coordinates first (the same :class:`TrajectoryGenerator`, one "joint" per coordinate),
 stepped at the control rate; the joint generators then follow IK of the smoothed path within their limits. Each
 target is approached as a state at rest, so a moving target is followed with a small lag (a 0.35 rad/s ramp: 0.055
-rad, a jerk-limited stop's distance plus the re-planning) and a chattering one never sets the filter swinging.
+rad, a jerk-limited stop's distance plus the re-planning) and a chattering one never sets the filter swinging. In
+CFS, whose targets move on every period, the path is moved by a linear tracking filter wherever its jerk is
+admissible (:class:`cosim.coupling.tracking_filter.TrackingFilter`): a ramp is then followed at a constant lag with
+no jerk at all.
 
 The jerk-limited filter's own motion is bang-bang in jerk (ruckig's phases use the limit jerk or none), re-planned
 every period toward a target that the controller moves every period: its path carries a ripple at the control rate
@@ -103,6 +106,7 @@ class PoseFilter:
         arm = ArmLimits(name, "task space", tuple(joint(c) for c in coordinates))
         settings = GeneratorSettings(cycle_time=control_period, control_period=control_period)
         self._generator = TrajectoryGenerator(arm, np.zeros(len(coordinates)), settings)
+        self._tracking = False  # the last call tracked its target
         self._tracker = TrackingFilter(
             np.array([j.max_velocity for j in arm.joints]), np.array([j.max_acceleration for j in arm.joints]),
             np.array([j.max_jerk for j in arm.joints]), TRACKING_BANDWIDTH, control_period,
@@ -140,9 +144,17 @@ class PoseFilter:
             linear = self._tracker.limited_step(values, *state)
             if linear is None and self._tracker.saturation(values, *state) <= TRACKING_SATURATION:
                 linear = self._tracker.clipped_step(values, *state)
+            reference = self._tracker.follow(values, state if linear is not None or not self._tracking else None)
+            self._tracking = True
             if linear is not None:
                 self._generator.reset(*linear)
                 return self._pose(linear[0])
+            # onto the law's steady motion: the target's estimated rate, the law's lag behind the target
+            rate = reference[1]
+            self._generator.set_target(values - self._tracker.lag * rate, rate, np.zeros_like(rate))
+            q, _, _ = self._generator.step()
+            return self._pose(q)
+        self._tracking = False
         # Each target is one to come to rest at. Estimating a path velocity from the targets (what the joint
         # generators do with the already smooth output of this filter) reads the controller's step-to-step
         # corrections of either sign as velocity and drove a +-0.1 rad limit cycle of the tilt in the coupled pour.

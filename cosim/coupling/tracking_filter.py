@@ -55,6 +55,15 @@ class TrackingFilter:
         k0, k1, k2 = np.asarray(control.acker(transition, jerk_input, [math.exp(-bandwidth * h)] * 3)).ravel()
         self._gains = (k0, k1, k2)
         self.lag = k1 / k0  # s: how far the state follows a ramp behind, once the start has died away
+        n = len(self.velocity_limit)
+        self.reference = (np.zeros(n), np.zeros(n), np.zeros(n))  # the law's own path, unlimited
+
+    def follow(self, target: np.ndarray, state: tuple[np.ndarray, np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Advance the law's own unlimited path one period toward ``target`` (from ``state`` where given: the
+        limited path, where it moves by the law); returns it. Its velocity is the target's rate low-passed by the
+        law, an estimate without the target's step-to-step noise."""
+        self.reference = self._linear_step(target, *(state if state is not None else self.reference))
+        return self.reference
 
     def saturation(self, target: np.ndarray, position: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray) -> float:
         """The linear law's jerk from a path's state toward ``target`` over the jerk limit, the largest over the
