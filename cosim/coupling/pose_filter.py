@@ -49,14 +49,15 @@ SMOOTHING_STAGES = 3
 # the blend of a difference d peaks at 1.9 d / HANDOVER_TIME in rate and 5.8 d / HANDOVER_TIME^2 in acceleration
 # (d = 36 ms x 0.1 rad/s = 3.6 mrad, a slosh damping's rate: 0.03 rad/s, 0.5 rad/s^2).
 HANDOVER_TIME = 0.2
-# rad/s: the closed-loop bandwidth of the tracking filter that follows a moving target (in CFS). Replaying the
-# controller's recorded CFS targets (default and partial pour) through this filter and the smoothing stages, 35 rad/s
-# follows the tilt command 93-114 ms late (129-151 ms with the smoothing stages; the jerk-limited filter re-planned
-# to rest: 117-118 ms, 154-155 ms) with half its acceleration content above 10 Hz.
+# rad/s: the closed-loop bandwidth of the tracking filter that follows a moving target (in CFS). Replaying the CFS
+# targets of the default, partial and low-fill pours recorded with the filter that re-plans to rest
+# (cosim.bench.pose_filter_replay), 35 rad/s follows the tilt command 80 ms late (117 ms with the smoothing stages;
+# re-planned to rest: 114-118 ms, 151-155 ms), with a third to a half of the translations' and up to a third less of
+# the tilt's acceleration content above 10 Hz.
 TRACKING_BANDWIDTH = 35.0
-# How far beyond the jerk limit the tracking filter's linear law may ask before the jerk-limited generator moves the
-# path instead (toward the target as one to stop at): clipped to the limits, a linear law asking far more overshoots
-# a step (by 20 % to 180 % of a 0.02-1 rad step at 30 rad/s and 20 rad/s^3).
+# How far beyond the jerk limit the tracking filter's linear law may ask (clipped to the limits) before the
+# jerk-limited generator moves the path instead: a linear law clipped far beyond its limits winds up (in cascade form
+# with the commanded rate and acceleration saturated too, it overshot 0.02-1 rad steps by 20 % to 180 %).
 TRACKING_SATURATION = 1.5
 
 
@@ -120,7 +121,8 @@ class PoseFilter:
         a target that moves on every period (the CFS law's), followed by the :class:`TrackingFilter` from the
         path's current state, which follows a ramp at a constant lag with no jerk instead of re-planning a stop at
         every target (where its linear law would ask more than :data:`TRACKING_SATURATION` times the jerk limit,
-        the jerk-limited generator takes the step toward the target as one to stop at); with
+        the jerk-limited generator takes the step toward the law's steady motion: the target less the law's lag
+        times its estimate of the target's rate, at that rate); with
         ``pass_through`` the target itself (a command the controller has already smoothed, whose timing matters:
         the slosh damping's feedback), the filter's own state following it (its rates from the last three
         targets) so that filtering resumes from where the path is. Pass-through starts only once the filtered
