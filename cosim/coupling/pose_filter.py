@@ -56,8 +56,8 @@ HANDOVER_TIME = 0.2
 # the tilt's acceleration content above 10 Hz.
 TRACKING_BANDWIDTH = 35.0
 # How far beyond the jerk limit the tracking filter's linear law may ask (clipped to the limits) before the
-# jerk-limited generator moves the path instead: a linear law clipped far beyond its limits winds up (in cascade form
-# with the commanded rate and acceleration saturated too, it overshot 0.02-1 rad steps by 20 % to 180 %).
+# jerk-limited generator moves the path instead: a linear law clipped far beyond its limits winds up (0.02-1 rad steps
+# overshot by 13 % to several times the step, see cosim.coupling.tracking_filter).
 TRACKING_SATURATION = 1.5
 
 

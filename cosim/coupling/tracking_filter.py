@@ -13,11 +13,12 @@ the constant lag ``K1 / K0`` (about 3 / w) with no jerk at all once the start ha
 is rolled off as f^-3 above w.
 
 A linear law cannot follow a step within a jerk limit far below w^3 times the step (at 35 rad/s and 20 rad/s^3, any
-step over half a milliradian): clipped to the limits, the integrator chain overshoots (by 20 % to 180 % of a 0.02-1 rad
-step, even in cascade form with the commanded rate and acceleration saturated as well). So a path moves by the
+step over half a milliradian): clipped to the limits, the integrator chain winds up and overshoots (0.02-1 rad steps by 13 % to
+several times the step, in cascade form with or without the commanded rate and acceleration saturated as well). So a path moves by the
 linear law where its jerk is admissible (:meth:`TrackingFilter.limited_step`), by the law clipped to the limits
 where it asks a little more (:meth:`TrackingFilter.clipped_step`, :meth:`TrackingFilter.saturation`), and otherwise
-by a time-optimal generator (the caller's choice: :class:`cosim.coupling.pose_filter.PoseFilter`).
+by a time-optimal generator heading for the law's steady motion: the target less the lag times the rate of the
+law's own unlimited path (:meth:`TrackingFilter.follow`), at that rate (:class:`cosim.coupling.pose_filter.PoseFilter`).
 
 Limits hold by construction, from a state within them: a linear step is taken only with a jerk within the limit
 jerk, a next acceleration within its limit, and a next state from which the limit jerk can still bring the
