@@ -61,6 +61,9 @@ TARGET_IK = IKSettings(position_tolerance=1e-10, rotation_tolerance=1e-10, max_i
 # feedback are timed against the liquid's own oscillation and the arm's known delay, so the pourer's path in them is
 # not delayed by the pose smoothing (cosim.coupling.pose_filter.PoseSmoother).
 SLOSH_INDUCTION = (Phase.SIM_EXCITE, Phase.SIM_HOLD, Phase.SIM_DAMP)
+# The phases whose targets move on every period (the CFS law's tilt and the catcher's landing point): the pose filter
+# tracks them instead of approaching each as a target to stop at (cosim.coupling.pose_filter.PoseFilter).
+TRACKED = (Phase.CFS, Phase.CFS_FINAL)
 
 
 def coupled_step(
@@ -187,7 +190,9 @@ class CoupledPour:
         smoothed = {}
         for role in ROLES:
             t = targets[role]
-            limited = self.filters[role](PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback)
+            limited = self.filters[role](
+                PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback, track=cmd.phase in TRACKED,
+            )
             passed = self.filters[role].passing
             undelayed = passed or (role is ArmRole.POUR and cmd.phase in SLOSH_INDUCTION)
             pose = self.smoothers[role](limited, passing=undelayed, source="command" if passed else "limited")

@@ -6,7 +6,10 @@ the intended vessel path by centimetres. The targets (dx, dz, theta of the poure
 ruckig generator in those coordinates first (the same :class:`TrajectoryGenerator`, one "joint" per coordinate),
 stepped at the control rate; the joint generators then follow IK of the smoothed path within their limits. Each
 target is approached as a state at rest, so a moving target is followed with a small lag (a 0.35 rad/s ramp: 0.055
-rad, a jerk-limited stop's distance plus the re-planning) and a chattering one never sets the filter swinging.
+rad, a jerk-limited stop's distance plus the re-planning) and a chattering one never sets the filter swinging. In
+CFS, whose targets move on every period, the path is moved by a linear tracking filter wherever its jerk is
+admissible (:class:`cosim.coupling.tracking_filter.TrackingFilter`): a ramp is then followed at a constant lag with
+no jerk at all.
 
 The jerk-limited filter's own motion is bang-bang in jerk (ruckig's phases use the limit jerk or none), re-planned
 every period toward a target that the controller moves every period: its path carries a ripple at the control rate
@@ -28,6 +31,7 @@ import numpy as np
 
 from controllers.motion import CriticallyDampedSmoother
 from cosim.checks import check_positive
+from cosim.coupling.tracking_filter import TrackingFilter
 from cosim.robots.planar import PlanarPose
 from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
 from cosim.trajectory.limits import ArmLimits, JointLimits
@@ -45,6 +49,16 @@ SMOOTHING_STAGES = 3
 # the blend of a difference d peaks at 1.9 d / HANDOVER_TIME in rate and 5.8 d / HANDOVER_TIME^2 in acceleration
 # (d = 36 ms x 0.1 rad/s = 3.6 mrad, a slosh damping's rate: 0.03 rad/s, 0.5 rad/s^2).
 HANDOVER_TIME = 0.2
+# rad/s: the closed-loop bandwidth of the tracking filter that follows a moving target (in CFS). Replaying the CFS
+# targets of the default, partial and low-fill pours recorded with the filter that re-plans to rest
+# (cosim.bench.pose_filter_replay), 35 rad/s follows the tilt command 80 ms late (117 ms with the smoothing stages;
+# re-planned to rest: 114-118 ms, 151-155 ms), with a third to a half of the translations' and up to a third less of
+# the tilt's acceleration content above 10 Hz.
+TRACKING_BANDWIDTH = 35.0
+# How far beyond the jerk limit the tracking filter's linear law may ask (clipped to the limits) before the
+# jerk-limited generator moves the path instead: a linear law clipped far beyond its limits winds up (0.02-1 rad steps
+# overshot by 13 % to several times the step, see cosim.coupling.tracking_filter).
+TRACKING_SATURATION = 1.5
 
 
 @dataclass(frozen=True)
@@ -93,12 +107,22 @@ class PoseFilter:
         arm = ArmLimits(name, "task space", tuple(joint(c) for c in coordinates))
         settings = GeneratorSettings(cycle_time=control_period, control_period=control_period)
         self._generator = TrajectoryGenerator(arm, np.zeros(len(coordinates)), settings)
+        self._tracking = False  # the last call tracked its target
+        self._tracker = TrackingFilter(
+            np.array([j.max_velocity for j in arm.joints]), np.array([j.max_acceleration for j in arm.joints]),
+            np.array([j.max_jerk for j in arm.joints]), TRACKING_BANDWIDTH, control_period,
+        )
         self._period = control_period
         self._passed: list[np.ndarray] = []  # the last pass-through targets (at most three), for their rates
         self.passing = False  # the last call passed its target through
 
-    def __call__(self, target: PlanarPose, pass_through: bool = False) -> PlanarPose:
-        """The smoothed pose one control period after the previous call, heading for ``target``; with
+    def __call__(self, target: PlanarPose, pass_through: bool = False, track: bool = False) -> PlanarPose:
+        """The smoothed pose one control period after the previous call, heading for ``target``; with ``track``
+        a target that moves on every period (the CFS law's), followed by the :class:`TrackingFilter` from the
+        path's current state, which follows a ramp at a constant lag with no jerk instead of re-planning a stop at
+        every target (where its linear law would ask more than :data:`TRACKING_SATURATION` times the jerk limit,
+        the jerk-limited generator takes the step toward the law's steady motion: the target less the law's lag
+        times its estimate of the target's rate, at that rate); with
         ``pass_through`` the target itself (a command the controller has already smoothed, whose timing matters:
         the slosh damping's feedback), the filter's own state following it (its rates from the last three
         targets) so that filtering resumes from where the path is. Pass-through starts only once the filtered
@@ -117,12 +141,31 @@ class PoseFilter:
             self._generator.reset(values, velocity, acceleration)
             return target
         self._passed = []
+        if track:
+            state = self._generator.state
+            linear = self._tracker.limited_step(values, *state)
+            if linear is None and self._tracker.saturation(values, *state) <= TRACKING_SATURATION:
+                linear = self._tracker.clipped_step(values, *state)
+            reference = self._tracker.follow(values, state if linear is not None or not self._tracking else None)
+            self._tracking = True
+            if linear is not None:
+                self._generator.reset(*linear)
+                return self._pose(linear[0])
+            # onto the law's steady motion: the target's estimated rate, the law's lag behind the target
+            rate = reference[1]
+            self._generator.set_target(values - self._tracker.lag * rate, rate, np.zeros_like(rate))
+            q, _, _ = self._generator.step()
+            return self._pose(q)
+        self._tracking = False
         # Each target is one to come to rest at. Estimating a path velocity from the targets (what the joint
         # generators do with the already smooth output of this filter) reads the controller's step-to-step
         # corrections of either sign as velocity and drove a +-0.1 rad limit cycle of the tilt in the coupled pour.
         zero = np.zeros(len(self.coordinates))
         self._generator.set_target(values, zero, zero)
         q, _, _ = self._generator.step()
+        return self._pose(q)
+
+    def _pose(self, q: np.ndarray) -> PlanarPose:
         values = dict(zip(self.coordinates, map(float, q)))
         return PlanarPose(values.get("dx", 0.0), values.get("dz", 0.0), values.get("theta", 0.0))
 
