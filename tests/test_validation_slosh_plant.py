@@ -38,6 +38,33 @@ def test_fit_recovers_a_known_plant():
     assert model.damping_ratio == fit.damping_ratio and model.source == "SPH identification"
 
 
+def _own_fit_hinge(pivots, t, sigmas):
+    """The hinge from each run fitted on its own (its own omega and zeta), for comparison with the joint fit."""
+    own = [plant_fit.fit_damped_sine(t, s, 13.6) for s in sigmas]
+    slope, intercept = np.polyfit(pivots, plant_fit.signed_amplitudes([f.a for f in own], [f.b for f in own]), 1)
+    return -intercept / slope, own
+
+
+def test_shared_frequency_keeps_a_transient_in_the_quiet_run_off_the_hinge():
+    """The run nearest the hinge hardly rings; a start-up transient (16 rad/s, zeta 0.21, 30 mrad) in its record
+    draws its own fit away from the first mode and bends the amplitude line. Fitted jointly (one omega1 and zeta),
+    the hinge stays within the acceptance, at every phase of the transient, and closer than by the own fits."""
+    hinge, pivots = 0.114, [0.0, 0.058, 0.1166, 0.14]
+    t, clean = _ring_downs(pivots, hinge, 13.6, 0.09, noise=0.003)
+    shared_errors, own_errors = [], []
+    for phase in np.linspace(0.0, 2 * math.pi, 8, endpoint=False):
+        sigmas = list(clean)
+        sigmas[2] = clean[2] + 0.03 * np.exp(-0.21 * 16.0 * t) * np.cos(16.0 * t + phase)
+        fit = plant_fit.identify_plant(pivots, t, sigmas)
+        own_hinge, own = _own_fit_hinge(pivots, t, sigmas)
+        assert fit.omega1 == pytest.approx(13.6, rel=0.002) and fit.damping_ratio == pytest.approx(0.09, abs=0.003)
+        assert abs(own[2].omega - 13.6) > 1.0  # the quiet run's own fit follows the transient
+        shared_errors.append(abs(fit.hinge_height - hinge))
+        own_errors.append(abs(own_hinge - hinge))
+    assert max(shared_errors) < slosh_plant.HINGE_TOLERANCE < max(own_errors)
+    assert max(shared_errors) < 0.6 * max(own_errors)
+
+
 def test_a_hinge_below_the_pivots_is_found_by_the_line():
     pivots = [0.08, 0.1, 0.12]
     t, sigmas = _ring_downs(pivots, 0.064, 12.6, 0.02, noise=0.001)  # all pivots above the hinge: one sign

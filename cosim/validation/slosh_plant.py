@@ -5,8 +5,8 @@ tilted by :data:`TILT_ANGLE` over :data:`TILT_DURATION` (theta = angle (1 - cos(
 its axis, then held for ``hold`` seconds. The pivots sit at :data:`PIVOT_FRACTIONS` of the potential-flow hinge H
 above the inner floor, on both sides of it. The slosh angle sigma = theta1 - theta is what the pour controller
 reads (:class:`cosim.coupling.measure.LiquidProbe`: the free-surface line through the columns' top particles),
-sampled every 2 ms. :mod:`cosim.validation.plant_fit` fits each ring-down and identifies omega1, the damping
-ratio and the hinge (the zero of the residual amplitude, a line in the pivot height); the potential-flow model is
+sampled every 2 ms. :mod:`cosim.validation.plant_fit` fits the ring-downs jointly (one omega1 and damping ratio,
+one phasor per run) and identifies the hinge (the zero of the residual amplitude, a line in the pivot height); the potential-flow model is
 evaluated for the liquid's actual depth (its volume over the floor area: the lattice holds whole layers).
 
 :func:`identify` runs the tilts and the fit for any vessel and pivots, so that a vessel with no closed form takes
@@ -173,6 +173,14 @@ def identified_model(fit: PlantFit | None, gravity: float) -> dict[str, float] |
     return {"l1": model.l1, "hinge_height": model.hinge_height, "damping_ratio": model.damping_ratio, "omega1": model.omega1}
 
 
+def shared_fit_summary(fit: PlantFit | None) -> dict[str, float] | None:
+    """The joint fit's omega1 (rad/s) and damping ratio with their standard errors; None where there is none."""
+    if fit is None or fit.shared is None:
+        return None
+    s = fit.shared
+    return {"omega1": s.omega1, "omega1_std": math.sqrt(s.omega1_variance), "damping_ratio": s.zeta, "damping_ratio_std": math.sqrt(s.zeta_variance)}
+
+
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
     spec = p.tank()
@@ -202,8 +210,10 @@ def run(p: Params) -> CaseResult:
         "signed_amplitudes": list(fit.signed_amplitudes) if fit else [],
         "amplitude_line": list(fit.line) if fit else [],
         "amplitude_line_rms": fit.line_rms if fit else math.nan,
-        "fits": [{"omega": f.omega, "damping_ratio": f.zeta, "a": f.a, "b": f.b, "offset": f.offset, "rms_residual": f.rms_residual}
-                 for f in fit.fits] if fit else [],
+        "shared_fit": shared_fit_summary(fit),
+        "fits": [{"a": a, "b": b, "offset": c, "rms_residual": r, "own_omega": f.omega, "own_damping_ratio": f.zeta, "own_rms_residual": f.rms_residual}
+                 for a, b, c, r, f in zip(fit.shared.a, fit.shared.b, fit.shared.offset, fit.shared.rms_residual, fit.free_fits)]
+        if fit and fit.shared else [],
         "identified_model": identified_model(fit, cfg.gravity_magnitude),
         "failures": ident.failures,
         "t": ident.t,
