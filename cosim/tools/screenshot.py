@@ -19,6 +19,7 @@ import base64
 import json
 import os
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -100,6 +101,22 @@ async def _capture(devtools_port: int, url: str, width: int, height: int, poll: 
                 return png, changed
 
 
+def _stop_group(process: subprocess.Popen) -> None:
+    """End ``process`` and every process it started (its process group): SIGTERM, then SIGKILL after 10 s."""
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        try:
+            os.killpg(process.pid, sig)
+        except ProcessLookupError:
+            return
+        try:
+            process.wait(timeout=10)
+            os.killpg(process.pid, 0)  # the leader has exited: is any child of its group left?
+        except subprocess.TimeoutExpired:
+            continue
+        except ProcessLookupError:
+            return
+
+
 def screenshot(recording: Path, out: Path, size: tuple[int, int], poll: float, settle: float, timeout: float) -> float:
     """Write the screenshot of ``recording`` to ``out``; returns the seconds the viewer took to load and draw it (when
     the page last changed)."""
@@ -114,22 +131,19 @@ def screenshot(recording: Path, out: Path, size: tuple[int, int], poll: float, s
             started.append(subprocess.Popen(
                 [rerun, "--web-viewer", "--web-viewer-port", str(web_port), "--port", str(grpc_port), str(recording)],
                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env={**os.environ, "BROWSER": "true"},
+                start_new_session=True,  # its own process group: the `rerun` script starts the viewer's binary as a child
             ))
             _wait_http(f"http://127.0.0.1:{web_port}/", START_TIMEOUT)
             started.append(subprocess.Popen(
                 [chromium, *CHROMIUM_FLAGS, f"--remote-debugging-port={devtools_port}", f"--user-data-dir={profile}",
                  f"--window-size={size[0]},{size[1]}", "about:blank"],
-                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
             ))
             url = viewer_url(web_port, grpc_port)
             png, elapsed = asyncio.run(_capture(devtools_port, url, size[0], size[1], poll, settle, timeout))
         finally:
             for process in reversed(started):
-                process.terminate()
-                try:
-                    process.wait(timeout=10)
-                except subprocess.TimeoutExpired:
-                    process.kill()
+                _stop_group(process)
     with atomic_path(out) as tmp:
         Path(tmp).write_bytes(png)
     return elapsed
