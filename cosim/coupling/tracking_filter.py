@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import math
 
-import control
 import numpy as np
 
 from cosim.checks import check_positive, check_range
@@ -46,6 +45,7 @@ class TrackingFilter:
     the closed loop's triple pole; period: h (s), the time between calls. The path's state is the caller's."""
 
     def __init__(self, velocity: np.ndarray, acceleration: np.ndarray, jerk: np.ndarray, bandwidth: float, period: float):
+        import control  # here, so that reading a scene and refusing bad input stay fast
         check_positive("tracking_filter.bandwidth", bandwidth, "rad/s", None)
         check_range("tracking_filter.period", period, 0.0, 1.0, "s", lo_open=True)
         self.velocity_limit, self.acceleration_limit, self.jerk_limit = (np.asarray(x, dtype=float) for x in (velocity, acceleration, jerk))
