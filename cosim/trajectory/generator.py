@@ -550,7 +550,7 @@ class TrajectoryGenerator:
 
     def _in_range(self, q: list[float]) -> np.ndarray:
         """ruckig's positions (rad) clipped onto the joint range: its braking onto a boundary lands on it up to
-        round-off (measured: 1e-12 rad beyond), which the range check must not see."""
+        round-off (of order 1e-12 rad beyond it), which the range check must not see."""
         return np.clip(np.array(q), self._lo, self._hi)
 
     # ---- state -----------------------------------------------------------------------------------------------------
