@@ -47,12 +47,16 @@ def check_range(
     below = lo is not None and (v <= lo if lo_open else v < lo)
     above = hi is not None and (v >= hi if hi_open else v > hi)
     if below or above:
-        left = "-inf" if lo is None else f"{lo:g}"
-        right = "inf" if hi is None else f"{hi:g}"
-        interval = f"{'(' if lo_open or lo is None else '['}{left}, {right}{')' if hi_open or hi is None else ']'}"
         suffix = f" {unit}" if unit else ""
-        raise InputError(f"{field}: must be in {interval}{suffix}, got {v:g}")
+        raise InputError(f"{field}: must be in {interval_text(lo, hi, lo_open, hi_open)}{suffix}, got {v:g}")
     return v
+
+
+def interval_text(lo: float | None, hi: float | None, lo_open: bool = False, hi_open: bool = False) -> str:
+    """The interval as messages and references write it, e.g. ``(0, 0.05]``; a None bound is infinite."""
+    left = "-inf" if lo is None else f"{lo:g}"
+    right = "inf" if hi is None else f"{hi:g}"
+    return f"{'(' if lo_open or lo is None else '['}{left}, {right}{')' if hi_open or hi is None else ']'}"
 
 
 def check_positive(field: str, value: object, unit: str = "", hi: float | None = None) -> float:

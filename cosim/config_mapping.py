@@ -5,8 +5,10 @@ are sub-tables (a sub-table changes only its own keys of the parent's default, e
 keeps the scene's ``max_duration``, not the section class's), enums are given by their string value, tuples as
 arrays, ``None`` fields are left out of the file. An unknown key, a wrong type or a value out of range is one
 :class:`InputError` line naming the dotted field (range checks are the dataclasses' own ``__post_init__``).
-``to_toml(obj)`` writes the TOML document of a configuration with every field's documentation (unit and range, from
-the dataclass docstrings) as a comment.
+``to_toml(obj)`` writes the TOML document of a configuration with every field's documentation as a comment: a field
+declared as a :class:`cosim.setting.Setting` with its meaning and allowed values, under a comment naming its group
+(and a class's ``derived_settings``, the settings it does not set, as comments saying where they come from); other
+fields with their lines of the dataclass docstring (unit and range).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from typing import Any
 import tomlkit
 
 from cosim.errors import InputError
+from cosim.setting import SETTING, Setting
 
 _FIELD_DOC = re.compile(r"^\s*([a-z_][a-z0-9_]*)\s*:\s*(.*)$")
 
@@ -142,11 +145,26 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _setting_comment(spec: Setting) -> str:
+    return f"{spec.meaning} Allowed: {spec.allowed()}."
+
+
 def _fill_table(table, obj: Any) -> None:
     docs = field_docs(type(obj))
     nested = []
+    group = None
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
+        spec = f.metadata.get(SETTING)
+        if spec is not None:
+            if spec.group != group:
+                group = spec.group
+                table.add(tomlkit.comment(f"-- {group} --"))
+            if value is None:
+                table.add(tomlkit.comment(f"{f.name} = (not set)  # {_setting_comment(spec)}"))
+            else:
+                table.add(f.name, tomlkit.item(_plain(value)).comment(_setting_comment(spec)))
+            continue
         if dataclasses.is_dataclass(value):
             nested.append((f.name, value, docs.get(f.name, "")))
             continue
@@ -170,6 +188,11 @@ def _fill_table(table, obj: Any) -> None:
         if text:
             item.comment(text)
         table.add(f.name, item)
+    derived = getattr(type(obj), "derived_settings", ())
+    if derived:
+        table.add(tomlkit.comment("-- not set here: where each comes from --"))
+    for d in derived:
+        table.add(tomlkit.comment(f"{d.name}: {_setting_comment(d.spec)} Set by: {d.source}."))
     for name, value, doc in nested:
         if doc is None:  # an already built table (a dict field)
             table.add(name, value)

@@ -14,16 +14,18 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import ClassVar
 
 from controllers.config import ApproachConfig, CfsConfig, ReturnConfig, SimConfig
-from cosim.checks import check_device, check_int, check_positive, check_range
+from cosim.checks import check_device, check_positive, check_range
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.pose_filter import PoseFilterLimits
 from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
-from cosim.fluid.config import DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
+from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
+from cosim.setting import Derived, check_settings, declared_fields, derived, like, setting
 from cosim.trajectory.driver_names import JointPrefix
 from cosim.robots.scene_config import (
     CATCHER_HOME_X, POUR_HEIGHT, POURER_FLOOR_ABOVE_TABLE, TABLE_TOP, SceneConfig, pour_cell_config,
@@ -49,88 +51,65 @@ class LiquidSettings:
 
 @dataclass(frozen=True)
 class FluidSettings:
-    """dim: 2 (liquid in the pour plane, times the pourer's depth) or 3. [2, 3]
-    particles_across: particles across the pourer's inner width; sets the spacing dx = B / n. [8, 400]
-    kernel: 'wendland_c2' or 'cubic_spline' (the paper's).
-    pressure_solver: 'dfsph' (divergence-free SPH, time step set by the flow speed; the default: it passes the
-      validations WCSPH passes and pours the default scene about 3.5 x faster) or 'wcsph' (weakly compressible, time
-      step set by an artificial sound speed).
-    smoothing_ratio: h / dx. [1.0, 2.5]
-    cfl: Courant number of the time step (on the sound speed for WCSPH, on the flow speed for DFSPH). (0, 0.6]
-    grid_reset: 'occupied' resets only the neighbour-grid cells the liquid and walls occupied (work restricted to
-      where they are) or 'whole' (every cell of the domain); identical results.
-    adaptive_time_step: true plans each 2 ms interval's step from the last one's largest speed and acceleration and
-      the vessels' speed; false runs one fixed step from the expected speed (nothing to measure, nothing shortens it).
-    sound_speed_factor: c0 / expected maximum speed (>= 10 keeps density errors near 1 %). [10, 100]
-    artificial_viscosity: Monaghan alpha. [0, 1]
-    free_liquid: true treats the liquid outside both vessels (the stream, spray) as free: no tension, a
-      memoryless density (WCSPH; the stream then falls on its free-fall parabola, ``cosim validate free-fall``).
-    free_artificial_viscosity: Monaghan alpha of pairs with free liquid, which makes its impacts inelastic. [0, 1]
-    max_tension: Pa, the most tension the (WCSPH) liquid carries; more flings thin films at a rim. [0, 1e6]
-    density_diffusion: delta-SPH delta. [0, 1]
-    kinematic_viscosity: m^2/s (water 1e-6). [0, 0.01]
-    max_density_error: compression that counts as an instability (impacts reach about v / c0). (0, 1]
-    density_iteration: DFSPH: 'gauss_seidel' (the default; fewer iterations at equal error, the same results on any
-      number of threads and any device) or 'jacobi' (every particle at once: the choice for large scenes on a GPU).
-    density_tolerance: DFSPH: the density solve stops when the average compression is below this fraction of rho0;
-      not set: the iteration's own default, 1.5e-4 for 'gauss_seidel', 5e-5 for 'jacobi'
-      (``cosim.fluid.config.FluidConfig``; the pour's time against its errors at other tolerances is in
-      docs/benchmarks.md). (0, 0.05]
-    cpu_threads: threads the CPU solver splits each substep over; 0: one per available core (at most one per 200
-      particles). The results are the same for any number. [0, 256]
-    """
+    """The liquid's settings a scene sets: every :class:`FluidConfig` setting (declared there, with its default and
+    range) but those the pour derives from the robot scene (:attr:`derived_settings`,
+    :func:`cosim.coupling.loop.pour_fluid_config`), and the resolution ``particles_across``."""
 
-    dim: int = 2
-    particles_across: int = 32
-    kernel: KernelType = KernelType.WENDLAND_C2
-    pressure_solver: PressureSolver = PressureSolver.DFSPH
-    smoothing_ratio: float = 1.5
-    cfl: float = 0.25
-    adaptive_time_step: bool = True
-    grid_reset: GridReset = GridReset.OCCUPIED
-    sound_speed_factor: float = 10.0
-    artificial_viscosity: float = 0.01
-    free_liquid: bool = True
-    free_artificial_viscosity: float = 0.25
-    max_tension: float = 1000.0
-    density_diffusion: float = 0.1
-    kinematic_viscosity: float = 1.0e-6
-    max_density_error: float = 0.3
-    density_iteration: DensityIteration = FluidConfig.density_iteration
-    density_tolerance: float | None = None  # the iteration's own default (FluidConfig)
-    cpu_threads: int = FluidConfig.cpu_threads
+    # ---- discretisation
+    dim: int = like(FluidConfig, "dim")
+    particles_across: int = setting(32, DISCRETISATION, "Particles across the pourer's inner width B; sets the "
+                                    "spacing dx = B / particles_across.", "", 8, 400)
+    smoothing_ratio: float = like(FluidConfig, "smoothing_ratio")
+    kernel: KernelType = like(FluidConfig, "kernel")
+    boundary_spacing_ratio: float = like(FluidConfig, "boundary_spacing_ratio")
+    # ---- material
+    rest_density: float = like(FluidConfig, "rest_density")
+    kinematic_viscosity: float = like(FluidConfig, "kinematic_viscosity")
+    # ---- pressure, both solvers
+    pressure_solver: PressureSolver = like(FluidConfig, "pressure_solver", PressureSolver.DFSPH)
+    sound_speed_factor: float = like(FluidConfig, "sound_speed_factor")
+    artificial_viscosity: float = like(FluidConfig, "artificial_viscosity")
+    free_liquid: bool = like(FluidConfig, "free_liquid")
+    free_artificial_viscosity: float = like(FluidConfig, "free_artificial_viscosity")
+    # ---- WCSPH
+    gamma: float = like(FluidConfig, "gamma")
+    max_tension: float = like(FluidConfig, "max_tension")
+    density_diffusion: float = like(FluidConfig, "density_diffusion")
+    # ---- DFSPH
+    density_iteration: DensityIteration = like(FluidConfig, "density_iteration")
+    density_tolerance: float | None = like(FluidConfig, "density_tolerance")
+    divergence_tolerance: float = like(FluidConfig, "divergence_tolerance")
+    max_solver_iterations: int = like(FluidConfig, "max_solver_iterations")
+    # ---- time stepping
+    cfl: float = like(FluidConfig, "cfl")
+    adaptive_time_step: bool = like(FluidConfig, "adaptive_time_step")
+    # ---- guards
+    max_density_error: float = like(FluidConfig, "max_density_error")
+    max_wall_penetration: float = like(FluidConfig, "max_wall_penetration")
+    min_time_step: float = like(FluidConfig, "min_time_step")
+    max_energy_creation: float = like(FluidConfig, "max_energy_creation")
+    # ---- runtime
+    cpu_threads: int = like(FluidConfig, "cpu_threads")
+    grid_reset: GridReset = like(FluidConfig, "grid_reset")
+
+    # FluidConfig settings a scene does not set, and where the pour takes them from (the robot scene's vessels and
+    # placement: cosim.coupling.loop.pour_fluid_config).
+    derived_settings: ClassVar[tuple[Derived, ...]] = (
+        derived(FluidConfig, "spacing", "the pourer's inner width / particles_across"),
+        derived(FluidConfig, "depth_2d", "the pourer's depth"),
+        derived(FluidConfig, "domain_min", "a box around both vessels and the catcher's travel, its floor just below the catcher"),
+        derived(FluidConfig, "domain_max", "the same box's upper corner"),
+        derived(FluidConfig, "max_expected_speed", "the larger of the stream's speed at the catcher's floor and 2 sqrt(g fill_depth)"),
+        derived(FluidConfig, "gravity", "standard gravity, as the robot scene's"),
+    )
 
     def __post_init__(self) -> None:
-        check_int("fluid.dim", self.dim, 2, 3)
-        check_int("fluid.particles_across", self.particles_across, 8, 400)
-        FluidConfig(**self._numerics())  # every numerical setting's own range check, when the scene is read
+        check_settings(self, "fluid")
 
     def fluid_config(self, pourer_width: float) -> FluidConfig:
         """The solver configuration (domain and expected speed are set from the robot scene by the coupling)."""
-        return FluidConfig(spacing=pourer_width / self.particles_across, **self._numerics())
-
-    def _numerics(self) -> dict:
-        """The FluidConfig fields these settings set (all but the spacing, domain and expected speed)."""
-        return dict(
-            dim=self.dim,
-            kernel=self.kernel,
-            pressure_solver=self.pressure_solver,
-            smoothing_ratio=self.smoothing_ratio,
-            cfl=self.cfl,
-            adaptive_time_step=self.adaptive_time_step,
-            grid_reset=self.grid_reset,
-            sound_speed_factor=self.sound_speed_factor,
-            artificial_viscosity=self.artificial_viscosity,
-            free_liquid=self.free_liquid,
-            free_artificial_viscosity=self.free_artificial_viscosity,
-            max_tension=self.max_tension,
-            density_diffusion=self.density_diffusion,
-            kinematic_viscosity=self.kinematic_viscosity,
-            max_density_error=self.max_density_error,
-            density_iteration=self.density_iteration,
-            density_tolerance=self.density_tolerance,
-            cpu_threads=self.cpu_threads,
-        )
+        numerics = {name: getattr(self, name) for name, _ in declared_fields(FluidSettings) if name != "particles_across"}
+        return FluidConfig(spacing=pourer_width / self.particles_across, **numerics)
 
 
 @dataclass(frozen=True)
@@ -152,10 +131,9 @@ class CatcherSettings:
 
 
 # The CFS head's floor in particle spacings, by dimension (ControllerSettings.stream_particles not set). In 2-D a
-# head of 2.5 dx keeps the stream several particles thick and pours fastest without spilling (README Pour results).
-# In 3-D the sheet leaving the 0.1 m lip spreads sideways under its head once the side walls end (no surface tension
-# draws it in), past the catcher's 0.14 m depth: the 3-D pour at 16 across spilled 3.0 % of what it poured at 2.5 dx
-# (30 mm), 1.2 % at 1.5 dx, 0.3 % at 1.0 dx (12 mm; README Pour results).
+# head of a few spacings keeps the stream several particles thick. In 3-D the sheet leaving the lip spreads sideways
+# under its head once the side walls end (no surface tension draws it in), past the catcher's depth, and spills the
+# more the higher the head: one spacing (docs/physics-and-validation.md has the sweep).
 STREAM_PARTICLES = {2: 2.5, 3: 1.0}
 
 
@@ -165,7 +143,7 @@ class ControllerSettings:
     stream_particles: the CFS liquid height over the crest is at least this many particle spacings, so that the
       stream is resolved (the paper holds it near the smoothing length), up to 0.05 m (cfs.h_q_ref's limit); a
       partial pour's final stage holds cfs.final_head_fraction of it; not set: 2.5 in 2-D, 1.0 in 3-D (a 3-D sheet
-      spreads sideways off the lip under its head, README Pour results). [0, 10]
+      spreads sideways off the lip under its head, :data:`STREAM_PARTICLES`). [0, 10]
     sim: slosh induction (Camporredondo et al. 2019, Fig. 7).
     approach: tilt toward the crest without SIM.
     cfs: constant-flow stage (Camporredondo et al. 2019, Sec. 3.2).
@@ -346,7 +324,7 @@ class PourScene:
       .toml), 'seed-pour' for the embedded default scene. [letters, digits, '-', '_'; or '']
     device: 'cpu' or 'cuda[:N]'.
     liquid: fill and pour amount.
-    fluid: SPH resolution and numerics.
+    fluid: the liquid's resolution and numerics, grouped by concern.
     controller: the pour controller.
     coupling: MuJoCo <-> liquid coupling and run length.
     trajectory: exported joint trajectories.

@@ -10,9 +10,11 @@ import json
 from dataclasses import dataclass
 from enum import Enum
 
-from cosim.checks import check_choice, check_device, check_int, check_positive, check_range
+from cosim.checks import check_choice, check_device, check_positive
 from cosim.errors import InputError
-from cosim.fluid.config import KernelType, PressureSolver
+from cosim.fluid.config import FluidConfig, KernelType, PressureSolver
+from cosim.pour_scene import FluidSettings
+from cosim.setting import check_settings, declared, like
 
 
 class BenchCase(Enum):
@@ -32,55 +34,46 @@ OptionValue = str | bool | int | float
 @dataclass(frozen=True)
 class BenchConfig:
     """case: :class:`BenchCase`.
-    dim: 2 or 3.
     particles_across: resolution, particles across the case's width (tank width B for hydrostatic and slosh,
-        column width a for the dam break, the pourer's inner width for coupling-static and the pour). [8, 400]
-    kernel: :class:`cosim.fluid.config.KernelType`.
-    cfl: Courant number. (0, 0.6]
-    pressure_solver: :class:`cosim.fluid.config.PressureSolver`.
-    device: 'cpu' or 'cuda[:N]'.
+        column width a for the dam break, the pourer's inner width for coupling-static and the pour); the scene's
+        ``fluid.particles_across`` range.
     length: how long the case runs, in the case's own unit: hydrostatic s held, slosh periods after the pulse,
         dam-break dimensionless time T = t sqrt(2 g / a), free-fall s held after the tilt, coupling-static s held,
         pour s simulated
         (coupling.max_duration). (0, 600]
+    device: 'cpu' or 'cuda[:N]'.
     options: pour scene options as (dotted scene key, value) pairs, e.g. (("coupling.coupling", "one_way"),),
         sorted by key; only for the pour.
-    density_tolerance: DFSPH's density-solve tolerance (``FluidConfig.density_tolerance``); None: the solver's
-        default. Only with DFSPH. (0, 0.05]
-    smoothing_ratio: h / dx (``FluidConfig.smoothing_ratio``); None: the default. [1.0, 2.5]
+    dim, kernel, cfl, pressure_solver: the fluid's settings (:class:`cosim.fluid.config.FluidConfig`, its defaults and
+        ranges).
+    density_tolerance, smoothing_ratio: the fluid's settings where a row sets its own; None: the fluid's default
+        (a DFSPH density tolerance only with DFSPH).
     """
 
     case: BenchCase
     particles_across: int
     length: float
-    dim: int = 2
-    kernel: KernelType = KernelType.WENDLAND_C2
-    cfl: float = 0.25
-    pressure_solver: PressureSolver = PressureSolver.WCSPH
+    dim: int = like(FluidConfig, "dim")
+    kernel: KernelType = like(FluidConfig, "kernel")
+    cfl: float = like(FluidConfig, "cfl")
+    pressure_solver: PressureSolver = like(FluidConfig, "pressure_solver")
     device: str = "cpu"
     options: tuple[tuple[str, OptionValue], ...] = ()
-    density_tolerance: float | None = None
-    smoothing_ratio: float | None = None
+    density_tolerance: float | None = like(FluidConfig, "density_tolerance")
+    smoothing_ratio: float | None = like(FluidConfig, "smoothing_ratio", None, "the fluid's default")
 
     def __post_init__(self) -> None:
         s = object.__setattr__
         s(self, "case", check_choice("case", self.case, BenchCase))
-        check_int("particles_across", self.particles_across, 8, 400)
+        declared(FluidSettings, "particles_across").check("particles_across", self.particles_across)
         check_positive("length", self.length, "", 600.0)
-        check_int("dim", self.dim, 2, 3)
-        s(self, "kernel", check_choice("kernel", self.kernel, KernelType))
-        check_range("cfl", self.cfl, 0.0, 0.6, lo_open=True)
-        s(self, "pressure_solver", check_choice("pressure_solver", self.pressure_solver, PressureSolver))
+        check_settings(self)
         check_device("device", self.device)
         if self.options and self.case is not BenchCase.POUR:
             raise InputError(f"options: scene options apply to the pour only, not to {self.case.value}")
         s(self, "options", tuple(sorted((str(k), v) for k, v in self.options)))
-        if self.density_tolerance is not None:
-            check_range("density_tolerance", self.density_tolerance, 0.0, 0.05, lo_open=True)
-            if self.pressure_solver is not PressureSolver.DFSPH:
-                raise InputError(f"density_tolerance: applies to the dfsph solver only, not to {self.pressure_solver.value}")
-        if self.smoothing_ratio is not None:
-            check_range("smoothing_ratio", self.smoothing_ratio, 1.0, 2.5)
+        if self.density_tolerance is not None and self.pressure_solver is not PressureSolver.DFSPH:
+            raise InputError(f"density_tolerance: applies to the dfsph solver only, not to {self.pressure_solver.value}")
 
     def to_json(self) -> dict:
         """Plain JSON values (enums by value)."""

@@ -17,8 +17,9 @@ from pathlib import Path
 
 from typing import TYPE_CHECKING
 
-from cosim.checks import check_device, check_int, check_positive
-from cosim.fluid.config import MAX_CPU_THREADS
+from cosim.checks import check_device, check_positive
+from cosim.fluid.config import FluidConfig
+from cosim.setting import declared
 
 if TYPE_CHECKING:
     from cosim.pour_scene import PourScene
@@ -45,7 +46,7 @@ def scene_from_args(args) -> PourScene:
     if args.device is not None:
         scene = replace(scene, device=check_device("--device", args.device))
     if args.threads is not None:
-        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=check_int("--threads", args.threads, 0, MAX_CPU_THREADS)))
+        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=declared(FluidConfig, "cpu_threads").check("--threads", args.threads)))
     if args.dim is not None:
         scene = replace(scene, fluid=replace(scene.fluid, dim=args.dim))
     if args.duration is not None:

@@ -8,9 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from cosim.checks import check_choice, check_device, check_int, check_positive
+from cosim.checks import check_device
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
+from cosim.setting import declared
 
 # FluidConfig fields a case's numerics may override (the rest is the case's geometry, physics and solver).
 NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "density_iteration", "density_tolerance")
@@ -67,19 +68,19 @@ class FluidCaseParams:
     """
 
     spacing: float | None = None
-    dim: int = 2
+    dim: int = FluidConfig.dim
     device: str = "cpu"
-    depth: float = 0.1
-    solver: PressureSolver = PressureSolver.WCSPH
+    depth: float = FluidConfig.depth_2d
+    solver: PressureSolver = FluidConfig.pressure_solver
     numerics: tuple[tuple[str, Any], ...] = ()
 
     def validate_common(self) -> None:
         if self.spacing is not None:
-            check_positive("spacing", self.spacing, "m", 0.05)
-        check_int("dim", self.dim, 2, 3)
+            declared(FluidConfig, "spacing").check("spacing", self.spacing)
+        declared(FluidConfig, "dim").check("dim", self.dim)
         check_device("device", self.device)
-        check_positive("depth", self.depth, "m", 2.0)
-        object.__setattr__(self, "solver", check_choice("solver", self.solver, PressureSolver))
+        declared(FluidConfig, "depth_2d").check("depth", self.depth)
+        object.__setattr__(self, "solver", declared(FluidConfig, "pressure_solver").check("solver", self.solver))
         for name, _ in self.numerics:
             if name not in NUMERICS_FIELDS:
                 raise InputError(f"numerics: {name!r} cannot be overridden; choose from {', '.join(NUMERICS_FIELDS)}")
@@ -93,11 +94,9 @@ class FluidCaseParams:
 
 def whole_spacings(length: float, spacing: float) -> float:
     """m, a tank's ``length`` rounded to a whole number of ``spacing`` (at least one; kept where it is one already, to
-    1e-9 of a spacing), so that the seeded lattice fills the tank across. A remainder leaves the outer columns a gap
-    to the wall, and the liquid stands taller than its volume over the floor area: the default 0.1 m depth is 8.38,
-    12.57 or 16.75 spacings at 16, 24 or 32 across B = 0.191 m, so the lattice covered 95.5 % of it (3-D hydrostatic
-    tank at 16 across: worst probe +25.6 % in the 0.1 m tank, +2.8 % in the 8-spacing one), and at a spacing of 6 mm
-    B is 31.8 spacings (2-D hydrostatic: +6.2 %)."""
+    1e-9 of a spacing), so that the seeded lattice fills the tank across. A remainder would leave the outer columns a
+    gap to the wall, and the liquid would stand taller than its volume over the floor area (the hydrostatic error
+    this causes: docs/physics-and-validation.md)."""
     count = max(1, round(length / spacing))
     return length if abs(length / spacing - count) <= 1e-9 else count * spacing
 
@@ -110,7 +109,7 @@ def reference_speed(liquid_height: float) -> float:
 
 
 def case_fluid_config(
-    dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max, solver: PressureSolver = PressureSolver.WCSPH,
+    dim: int, spacing: float, liquid_height: float, depth: float, domain_min, domain_max, solver: PressureSolver = FluidConfig.pressure_solver,
     numerics=(),
 ) -> FluidConfig:
     """The fluid configuration every case uses: project defaults (or ``numerics``, see :class:`FluidCaseParams`),

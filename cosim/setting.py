@@ -1,0 +1,179 @@
+"""A configuration field declared once: its group, unit, default, allowed values and meaning.
+
+A frozen configuration dataclass declares each field as ``name: type = setting(default, group, meaning, ...)``: the
+default goes to the dataclass, the rest to the field's metadata as a :class:`Setting`. From that one declaration
+:func:`check_settings` checks a value (one :class:`cosim.errors.InputError` line naming the field and its allowed
+values), :func:`settings_reference` writes the class's reference (docstring) and :mod:`cosim.config_mapping` the
+scene file's comments. :func:`like` declares a field of another class as the same setting, with the same default.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from enum import Enum
+from typing import Any
+
+from cosim.checks import check_choice, check_int, check_range, check_vector, interval_text
+from cosim.errors import InputError
+
+SETTING = "setting"  # the metadata key of a field's Setting
+
+
+@dataclass(frozen=True)
+class Bounds:
+    """The closed (or, with ``lo_open``/``hi_open``, open) interval ``[lo, hi]``; None: unbounded on that side."""
+
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+
+    def text(self) -> str:
+        """The interval as written in messages and references, e.g. ``(0, 0.05]``."""
+        return interval_text(self.lo, self.hi, self.lo_open, self.hi_open)
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One configuration field's declaration (the field's name is the dataclass field's).
+
+    group: the concern it belongs to (a reference lists fields group by group).
+    meaning: what it is and why it matters (equations and references where physics), one or a few sentences.
+    unit: SI unit, '' where dimensionless.
+    kind: 'float', 'int', 'bool', 'choice' (an :class:`enum.Enum`, ``choices``) or 'vector' (3 numbers).
+    bounds: a number's allowed interval; a vector's magnitude's.
+    choices: the Enum of a 'choice'.
+    optional: None is allowed too (``none_means`` says what it stands for).
+    """
+
+    group: str
+    meaning: str
+    unit: str = ""
+    kind: str = "float"
+    bounds: Bounds | None = None
+    choices: type[Enum] | None = None
+    optional: bool = False
+    none_means: str = ""
+
+    def allowed(self) -> str:
+        """The allowed values in words, e.g. ``(0, 0.05] m``, ``one of 'wcsph', 'dfsph'``, ``true or false``."""
+        unit = f" {self.unit}" if self.unit else ""
+        if self.kind == "bool":
+            text = "true or false"
+        elif self.kind == "choice":
+            text = "one of " + ", ".join(repr(m.value) for m in self.choices)
+        elif self.kind == "vector":
+            text = f"3 numbers, magnitude in {self.bounds.text()}{unit}" if self.bounds else f"3 numbers ({self.unit})"
+        else:
+            text = (self.bounds or Bounds()).text() + unit
+        return f"{text}; or not set: {self.none_means}" if self.optional else text
+
+    def check(self, name: str, value: Any) -> Any:
+        """``value`` checked (and coerced: an enum from its value, a vector to a tuple of floats); an
+        :class:`InputError` line naming ``name`` and the allowed values where it is not allowed."""
+        if value is None and self.optional:
+            return None
+        b = self.bounds or Bounds()
+        if self.kind == "bool":
+            if not isinstance(value, bool):
+                raise InputError(f"{name}: must be true or false, got {value!r}")
+            return value
+        if self.kind == "choice":
+            return check_choice(name, value, self.choices)
+        if self.kind == "vector":
+            vector = check_vector(name, value, 3)
+            if self.bounds is not None:
+                check_range(f"{name} magnitude", math.hypot(*vector), b.lo, b.hi, self.unit, b.lo_open, b.hi_open)
+            return vector
+        if self.kind == "int":
+            check_int(name, value)
+            check_range(name, value, b.lo, b.hi, self.unit, b.lo_open, b.hi_open)
+            return value
+        return check_range(name, value, b.lo, b.hi, self.unit, b.lo_open, b.hi_open)
+
+
+def setting(
+    default: Any, group: str, meaning: str, unit: str = "", lo: float | None = None, hi: float | None = None,
+    lo_open: bool = False, hi_open: bool = False, kind: str | None = None, none_means: str = "",
+) -> Any:
+    """A dataclass field with ``default`` declared as a :class:`Setting` (``kind`` from the default where not given:
+    a bool, an Enum member, a tuple (vector), an int or a float; a None default makes it optional, ``none_means``
+    saying what None stands for)."""
+    if kind is None:
+        kind = ("bool" if isinstance(default, bool) else "choice" if isinstance(default, Enum)
+                else "vector" if isinstance(default, tuple) else "int" if isinstance(default, int) else "float")
+    bounds = None if lo is None and hi is None else Bounds(lo, hi, lo_open, hi_open)
+    spec = Setting(group, meaning, unit, kind, bounds, type(default) if kind == "choice" else None, default is None, none_means)
+    return dataclasses.field(default=default, metadata={SETTING: spec})
+
+
+def declared(cls: type, name: str) -> Setting:
+    """The :class:`Setting` of field ``name`` of the dataclass ``cls``."""
+    return cls.__dataclass_fields__[name].metadata[SETTING]
+
+
+def like(cls: type, name: str, default: Any = dataclasses.MISSING, none_means: str = "") -> Any:
+    """A field declared as the same setting as ``cls``'s field ``name``, with its default; ``default=None``
+    makes it an optional override (None: ``none_means``, e.g. the fluid's own default), any other ``default`` a
+    named override of it."""
+    spec = declared(cls, name)
+    if default is dataclasses.MISSING:
+        default = cls.__dataclass_fields__[name].default
+    elif default is None:
+        spec = dataclasses.replace(spec, optional=True, none_means=none_means)
+    return dataclasses.field(default=default, metadata={SETTING: spec})
+
+
+@dataclass(frozen=True)
+class Derived:
+    """A setting of another class that a configuration does not set itself: ``name``, its declaration ``spec``
+    and ``source``, where its value comes from instead."""
+
+    name: str
+    spec: Setting
+    source: str
+
+
+def derived(cls: type, name: str, source: str) -> Derived:
+    """``cls``'s setting ``name``, taken from ``source`` (see :class:`Derived`)."""
+    return Derived(name, declared(cls, name), source)
+
+
+def declared_fields(cls: type) -> list[tuple[str, Setting]]:
+    """(name, Setting) of every declared field of the dataclass ``cls``, in field order."""
+    return [(f.name, f.metadata[SETTING]) for f in dataclasses.fields(cls) if SETTING in f.metadata]
+
+
+def check_settings(obj: Any, prefix: str = "") -> None:
+    """Check every declared field of the frozen dataclass instance ``obj`` and store its coerced value; errors name
+    the field as ``<prefix>.<name>`` (``<name>`` with no prefix)."""
+    for name, spec in declared_fields(type(obj)):
+        value = spec.check(f"{prefix}.{name}" if prefix else name, getattr(obj, name))
+        object.__setattr__(obj, name, value)
+
+
+def default_text(value: Any) -> str:
+    """A default as the reference writes it."""
+    if isinstance(value, Enum):
+        return repr(value.value)
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, tuple):
+        return "(" + ", ".join(f"{v:g}" for v in value) + ")"
+    return "not set" if value is None else f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def settings_reference(cls: type, groups: tuple[str, ...]) -> str:
+    """The reference of ``cls``'s declared fields, group by group in the order ``groups``: each field's name,
+    meaning, allowed values and default."""
+    lines = []
+    fields = declared_fields(cls)
+    for group in groups:
+        lines.append(f"{group}:")
+        for name, spec in fields:
+            if spec.group == group:
+                default = cls.__dataclass_fields__[name].default
+                lines.append(f"    {name}: {spec.meaning} Allowed: {spec.allowed()}. Default: {default_text(default)}.")
+    return "\n".join(lines)
