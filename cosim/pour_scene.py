@@ -66,7 +66,7 @@ class FluidSettings:
     rest_density: float = like(FluidConfig, "rest_density")
     kinematic_viscosity: float = like(FluidConfig, "kinematic_viscosity")
     # ---- pressure, both solvers
-    pressure_solver: PressureSolver = like(FluidConfig, "pressure_solver", PressureSolver.DFSPH)
+    pressure_solver: PressureSolver = like(FluidConfig, "pressure_solver")
     sound_speed_factor: float = like(FluidConfig, "sound_speed_factor")
     artificial_viscosity: float = like(FluidConfig, "artificial_viscosity")
     free_liquid: bool = like(FluidConfig, "free_liquid")

@@ -116,13 +116,15 @@ def declared(cls: type, name: str) -> Setting:
 
 def like(cls: type, name: str, default: Any = dataclasses.MISSING, none_means: str = "") -> Any:
     """A field declared as the same setting as ``cls``'s field ``name``, with its default; ``default=None``
-    makes it an optional override (None: ``none_means``, e.g. the fluid's own default), any other ``default`` a
-    named override of it."""
+    makes it an optional override (None: ``none_means``, e.g. the fluid's own default). No other default: a
+    setting has one, and a caller that wants another value names it where it builds the configuration."""
     spec = declared(cls, name)
     if default is dataclasses.MISSING:
         default = cls.__dataclass_fields__[name].default
     elif default is None:
         spec = dataclasses.replace(spec, optional=True, none_means=none_means)
+    else:
+        raise ValueError(f"like({cls.__name__}, {name!r}): only None may replace the declared default")
     return dataclasses.field(default=default, metadata={SETTING: spec})
 
 

@@ -66,7 +66,7 @@ def test_cache_key_covers_every_parameter_and_the_code_version():
     variants = [BenchConfig(BenchCase.HYDROSTATIC, 21, 1.0), BenchConfig(BenchCase.HYDROSTATIC, 20, 2.0),
                 BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, cfl=0.3), BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, kernel="cubic_spline"),
                 BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, dim=3), BenchConfig(BenchCase.SLOSH, 20, 1.0),
-                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="dfsph"),
+                BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="wcsph"),
                 BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, pressure_solver="dfsph", density_tolerance=1e-4),
                 BenchConfig(BenchCase.HYDROSTATIC, 20, 1.0, smoothing_ratio=1.3)]
     keys = {a.key("v1"), a.key("v2"), *(v.key("v1") for v in variants)}

@@ -14,7 +14,7 @@ from cosim.validation import coupling_static
 
 
 def test_two_way_static_coupling_meets_the_acceptance_tolerances():
-    r = coupling_static.run(coupling_static.Params(spacing=0.191 / 14, duration=0.3))
+    r = coupling_static.run(coupling_static.Params(spacing=0.191 / 14, duration=0.3, solver="wcsph"))
     reaction, torques = r.metrics
     assert abs(reaction.error) <= coupling_static.WEIGHT_TOLERANCE
     assert abs(torques.error) <= coupling_static.TORQUE_TOLERANCE
@@ -24,7 +24,7 @@ def test_two_way_static_coupling_meets_the_acceptance_tolerances():
 def test_one_way_coupling_keeps_the_liquid_off_the_arm():
     scene = RobotScene.load()
     pourer = scene.arms[ArmRole.POUR].vessel
-    fluid = scene_liquid(scene, FluidConfig(dim=2, spacing=pourer.inner_width / 12), 0.15)
+    fluid = scene_liquid(scene, FluidConfig(dim=2, spacing=pourer.inner_width / 12, pressure_solver="wcsph"), 0.15)
     cfg = fluid.config
     settings = CouplingSettings(coupling=Coupling.ONE_WAY)
     targets = {r: (scene.arms[r].home_q, None) for r in ROLES}

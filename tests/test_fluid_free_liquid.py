@@ -21,7 +21,7 @@ DURATION = 0.05  # s
 
 
 def _stretched_block(free_liquid: bool) -> tuple[FluidSolver, ParticleSet]:
-    cfg = FluidConfig(dim=2, spacing=0.005, max_expected_speed=1.0, free_liquid=free_liquid,
+    cfg = FluidConfig(dim=2, spacing=0.005, pressure_solver="wcsph", max_expected_speed=1.0, free_liquid=free_liquid,
                       domain_min=(-0.3, -0.1, -0.3), domain_max=(0.3, 0.1, 0.3))
     block = liquid_block((-0.03, -0.05, 0.0), (0.03, 0.05, 0.06), cfg)
     v = np.zeros_like(block.positions)
@@ -55,7 +55,7 @@ def _packed_block_kick(free_liquid: bool, density_of_the_packing: bool) -> float
     disorder in a long pour), at rest in the air as liquid leaving over a lip is, with continuity density rho0 or
     (``density_of_the_packing``) the summation density's 1.04 rho0: its largest velocity change beyond gravity in
     10 ms (m/s)."""
-    cfg = FluidConfig(dim=2, spacing=0.005, max_expected_speed=1.0, free_liquid=free_liquid,
+    cfg = FluidConfig(dim=2, spacing=0.005, pressure_solver="wcsph", max_expected_speed=1.0, free_liquid=free_liquid,
                       domain_min=(-0.3, -0.1, -0.3), domain_max=(0.3, 0.1, 0.3))
     block = liquid_block((-0.03, -0.05, 0.0), (0.03, 0.05, 0.06), cfg)
     centre = block.positions.mean(axis=0)
@@ -80,7 +80,7 @@ def test_liquid_in_the_air_is_free_and_the_seeded_liquid_is_not():
     solver.advance(0.002)
     assert solver.free_mask().all()
     tank = VesselSpec(name="tank", inner_width=0.191, inner_height=0.2)
-    cfg = FluidConfig(dim=2, spacing=0.191 / 16, max_expected_speed=2.0, domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.35))
+    cfg = FluidConfig(dim=2, spacing=0.191 / 16, pressure_solver="wcsph", max_expected_speed=2.0, domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.35))
     resting = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, 0.1, cfg))
     resting.advance(0.01)
     assert not resting.free_mask().any()
@@ -93,7 +93,7 @@ def test_caught_rain_packs_like_the_liquid_it_joins():
     sum is a quarter of the liquid's) would prop the caught liquid up."""
     width, dx = 0.191, 0.191 / 16
     tank = VesselSpec(name="tank", inner_width=width, inner_height=0.2)
-    cfg = FluidConfig(dim=2, spacing=dx, max_expected_speed=2 * math.sqrt(2 * GRAVITY * 0.2),
+    cfg = FluidConfig(dim=2, spacing=dx, pressure_solver="wcsph", max_expected_speed=2 * math.sqrt(2 * GRAVITY * 0.2),
                       domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.45))
     pool = fill_vessel(tank, 0.06, cfg)
     xs, zs = np.meshgrid(np.arange(-3, 4) * 2 * dx, 0.25 + np.arange(4) * 2 * dx)
@@ -112,7 +112,7 @@ def test_caught_rain_packs_like_the_liquid_it_joins():
 
 @pytest.mark.slow
 def test_outflow_falls_on_its_parabola_as_free_liquid():
-    r = free_fall.run(free_fall.Params(particles_across=16))
+    r = free_fall.run(free_fall.Params(particles_across=16, solver="wcsph"))
     assert r.raw["failure"] == "" and len(r.raw["landing_error"]) >= free_fall.MIN_FOLLOWED
     assert r.raw["median_abs_error"] <= free_fall.LANDING_TOLERANCE
     assert r.passed
@@ -121,6 +121,6 @@ def test_outflow_falls_on_its_parabola_as_free_liquid():
 @pytest.mark.slow
 def test_outflow_under_the_continuity_density_lands_short():
     # the validation can fail: the continuity density's tension decelerates the falling stream (README)
-    r = free_fall.run(free_fall.Params(particles_across=16, numerics=(("free_liquid", False),)))
+    r = free_fall.run(free_fall.Params(particles_across=16, solver="wcsph", numerics=(("free_liquid", False),)))
     assert r.raw["median_abs_error"] > free_fall.LANDING_TOLERANCE and r.raw["mean_error"] < 0.0
     assert not r.passed

@@ -87,12 +87,10 @@ def test_the_scene_sets_every_fluid_setting_but_those_the_pour_derives():
 
 
 def test_the_scene_bench_and_validation_take_the_fluids_declarations_and_defaults():
-    own_default = {"pressure_solver"}  # the scene's named override of the solver
     for name, spec in declared_fields(FluidSettings):
         if name != "particles_across":
             assert spec == declared(FluidConfig, name), name
-            if name not in own_default:
-                assert getattr(FluidSettings(), name) == getattr(FluidConfig, name), name
+            assert getattr(FluidSettings(), name) == getattr(FluidConfig, name), name
     bench = BenchConfig(BenchCase.HYDROSTATIC, 16, 1.0)
     for name in ("dim", "kernel", "cfl", "pressure_solver", "density_tolerance"):
         assert getattr(bench, name) == getattr(FluidConfig, name), name
@@ -105,7 +103,7 @@ def test_the_scene_bench_and_validation_take_the_fluids_declarations_and_default
 def test_the_default_scenes_fluid_is_the_declarations_at_its_resolution():
     width = 0.191
     scene = FluidSettings()
-    expected = FluidConfig(spacing=width / scene.particles_across, pressure_solver=scene.pressure_solver)
+    expected = FluidConfig(spacing=width / scene.particles_across)
     assert scene.fluid_config(width) == expected
 
 

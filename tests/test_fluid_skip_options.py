@@ -18,7 +18,7 @@ from cosim.vessel import seed_pouring_vessel
 def _shaken(duration: float = 0.1, **overrides) -> FluidSolver:
     spec = seed_pouring_vessel()
     lo, hi = domain_around(spec, 0.02)
-    settings = dict(dim=2, spacing=spec.inner_width / 16, max_expected_speed=1.4, domain_min=lo, domain_max=hi)
+    settings = dict(dim=2, spacing=spec.inner_width / 16, pressure_solver="wcsph", max_expected_speed=1.4, domain_min=lo, domain_max=hi)
     cfg = FluidConfig(**(settings | overrides))
     pose_at = shake_sideways(0.02, 12.0)
     solver = FluidSolver(cfg, [spec], [pose_at(0.0)], fill_vessel(spec, 0.1, cfg), device="cpu")

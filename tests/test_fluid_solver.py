@@ -21,14 +21,14 @@ B = 0.191  # m, the width of the pouring vessel of Camporredondo et al. (2019)
 
 def _tank_solver(dim=2, across=12, fill=0.1, kernel=KernelType.WENDLAND_C2, device="cpu", **overrides):
     tank = VesselSpec(name="tank", inner_width=B, inner_height=0.2)
-    settings = dict(max_expected_speed=2 * math.sqrt(9.81 * fill), domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.35))
+    settings = dict(pressure_solver="wcsph", max_expected_speed=2 * math.sqrt(9.81 * fill), domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.35))
     settings.update(overrides)
     cfg = FluidConfig(dim=dim, spacing=B / across, kernel=kernel, **settings)
     return FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, fill, cfg), device=device), cfg
 
 
 def test_hydrostatic_coarse_2d_meets_the_acceptance_tolerances():
-    r = hydrostatic.run(hydrostatic.Params(spacing=B / 16, duration=1.0))
+    r = hydrostatic.run(hydrostatic.Params(spacing=B / 16, duration=1.0, solver="wcsph"))
     by_name = {m.name: m for m in r.metrics}
     assert abs(by_name["pressure (worst probe)"].error) <= hydrostatic.PRESSURE_TOLERANCE
     assert by_name["max density error"].measured <= hydrostatic.DENSITY_ERROR_LIMIT
@@ -46,7 +46,7 @@ SURFACE_HEIGHT_TOLERANCE = 0.1  # particle spacings
 @pytest.mark.slow
 def test_static_3d_tank_weighs_its_liquid_and_stands_at_its_volume_over_the_floor():
     dx = B / 10
-    r = hydrostatic.run(hydrostatic.Params(spacing=dx, duration=0.5, dim=3))
+    r = hydrostatic.run(hydrostatic.Params(spacing=dx, duration=0.5, dim=3, solver="wcsph"))
     reaction = {m.name: m for m in r.metrics}["vertical reaction"]
     assert abs(reaction.error) <= hydrostatic.WEIGHT_TOLERANCE
     assert r.raw["leaked"] == 0
@@ -66,14 +66,14 @@ def test_validation_tanks_are_whole_spacings_wide_and_deep():
 
 @pytest.mark.slow
 def test_hydrostatic_at_a_spacing_that_does_not_divide_the_tank():
-    r = hydrostatic.run(hydrostatic.Params(spacing=0.006, duration=1.0))  # B = 31.8 spacings: built 32 wide
+    r = hydrostatic.run(hydrostatic.Params(spacing=0.006, duration=1.0, solver="wcsph"))  # B = 31.8 spacings: built 32 wide
     assert r.parameters["width"] == pytest.approx(32 * 0.006)
     assert abs({m.name: m for m in r.metrics}["pressure (worst probe)"].error) <= hydrostatic.PRESSURE_TOLERANCE
 
 
 @pytest.mark.slow
 def test_slosh_coarse_frequency_matches_eq17():
-    r = slosh.run(slosh.Params(spacing=B / 16, fill=0.108, periods=3))
+    r = slosh.run(slosh.Params(spacing=B / 16, fill=0.108, periods=3, solver="wcsph"))
     assert r.raw["periods_used"] >= 1
     assert abs(r.metrics[0].error) <= slosh.FREQUENCY_TOLERANCE
 
@@ -122,7 +122,7 @@ def test_runs_are_deterministic():
 
 
 def test_particles_leaving_the_domain_are_deactivated_and_counted_as_spilled():
-    cfg = FluidConfig(dim=2, spacing=0.01, max_expected_speed=2.0, domain_min=(-0.3, -0.1, 0.0), domain_max=(0.3, 0.1, 0.5))
+    cfg = FluidConfig(dim=2, spacing=0.01, pressure_solver="wcsph", max_expected_speed=2.0, domain_min=(-0.3, -0.1, 0.0), domain_max=(0.3, 0.1, 0.5))
     blob = liquid_block((-0.03, -0.05, 0.2), (0.03, 0.05, 0.26), cfg)  # free falling, no vessel
     solver = FluidSolver(cfg, [], [], blob)
     while solver.time < 0.35:

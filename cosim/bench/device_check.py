@@ -138,8 +138,8 @@ def check_validation(device: str, quick: bool) -> list[dict]:
     from cosim.validation import hydrostatic, slosh
 
     runs = (
-        ("hydrostatic", hydrostatic.run, lambda d: hydrostatic.Params(device=d, duration=0.05 if quick else 0.5, spacing=0.191 / 16 if quick else None)),
-        ("slosh", slosh.run, lambda d: slosh.Params(device=d, periods=0.5 if quick else SLOSH_PERIODS, spacing=0.191 / 16 if quick else None)),
+        ("hydrostatic", hydrostatic.run, lambda d: hydrostatic.Params(device=d, solver="wcsph", duration=0.05 if quick else 0.5, spacing=0.191 / 16 if quick else None)),
+        ("slosh", slosh.run, lambda d: slosh.Params(device=d, solver="wcsph", periods=0.5 if quick else SLOSH_PERIODS, spacing=0.191 / 16 if quick else None)),
     )
     rows = []
     for name, run, params in runs:

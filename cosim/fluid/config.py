@@ -99,7 +99,7 @@ class FluidConfig:
                                                   "gravity has no scale; up to 10 g.", "m/s^2",
                                                   0.1, 10.0 * GRAVITY)
     # ---- pressure and viscosity, both solvers
-    pressure_solver: PressureSolver = setting(PressureSolver.WCSPH, PRESSURE, "How pressure is obtained: 'wcsph' "
+    pressure_solver: PressureSolver = setting(PressureSolver.DFSPH, PRESSURE, "How pressure is obtained: 'wcsph' "
                                               "(weakly compressible, Tait equation of state, Monaghan 1994) or 'dfsph' "
                                               "(divergence-free SPH, Bender & Koschier 2015/2017: iterative "
                                               "incompressibility, time step set by the flow speed).")

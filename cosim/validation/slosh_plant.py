@@ -24,7 +24,7 @@ from controllers.errors import ControllerInputError
 from controllers.slosh import SloshModel, VesselShape as SloshShape, potential_flow_model
 from cosim.checks import check_choice, check_int, check_positive
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig, PressureSolver
+from cosim.fluid.config import FluidConfig
 from cosim.fluid.solver import FluidSolver
 from cosim.coupling.measure import LiquidProbe, MeasurementGeometry
 from cosim.frames import Pose
@@ -55,7 +55,6 @@ class Params(FluidCaseParams):
     shape: VesselShape = VesselShape.BOX
     hold: float = 1.5
     particles_across: int = PARTICLES_ACROSS
-    solver: PressureSolver = PressureSolver.DFSPH
 
     def __post_init__(self) -> None:
         self.validate_common()
