@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 
 from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
-from cosim.fluid.config import DensityIteration, PressureSolver
+from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.validation import CASES, DEFAULT_CASES
 
 if TYPE_CHECKING:
@@ -43,7 +43,7 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--shape", choices=("box", "cylinder"), help="slosh-plant's vessel: box or cylinder (3-D only) (default box)")
     p.add_argument("--scene", help="a scene file whose pourer (a box, cylinder or mesh) is the vessel (hydrostatic, tilt, shake)")
     p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
-    p.add_argument("--dim", type=int, choices=(2, 3), default=2, help="2-D (pour plane) or 3-D (default 2)")
+    p.add_argument("--dim", type=int, choices=(2, 3), default=FluidConfig.dim, help=f"2-D (pour plane) or 3-D (default {FluidConfig.dim})")
     p.add_argument("--device", default="cpu", help="cpu or cuda[:N] (default cpu)")
     p.add_argument("--solver", choices=[s.value for s in PressureSolver],
                    help="pressure solver: wcsph (weakly compressible) or dfsph (divergence-free) (default: the default scene's "
