@@ -81,7 +81,16 @@ def run(args) -> int:
               f"({100 * summary['target_relative_error']:+.1f} %) off it")
     phases = " -> ".join(f"{p['phase']} {p['start']:.2f}-{p['end']:.2f}s" for p in summary["phases"])
     print(f"phases: {phases}")
-    threads = f" ({summary['fluid_threads']} thread{'s' if summary['fluid_threads'] > 1 else ''})" if summary["device"] == "cpu" else ""
+    threads = f" ({summary['fluid_threads']} thread{'s' if summary['fluid_threads'] > 1 else ''}{_one_thread_note(summary)})" if summary["device"] == "cpu" else ""
     print(f"simulated {summary['sim_time']:.2f} s in {summary['wall_time']:.1f} s wall (real-time factor {summary['real_time_factor']:.3f}), "
           f"{summary['particles']} particles, {summary['device']}{threads}", file=sys.stdout)
     return 0
+
+
+def _one_thread_note(summary: dict) -> str:
+    """How much of the liquid ran on one thread although it had more (its threads stalled each other on busy
+    cores, ``cosim.fluid.lane_choice``); empty when none did."""
+    if summary["fluid_substeps_one_thread"] == 0:
+        return ""
+    share = summary["fluid_substeps_one_thread"] / summary["sph_steps"]
+    return f", {100 * share:.0f} % of the substeps on one thread: the cores were busy"
