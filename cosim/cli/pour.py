@@ -39,17 +39,21 @@ def register(subparsers, summary: str) -> None:
 
 
 def scene_from_args(args) -> PourScene:
+    """The scene file's (or the default) scene with the command line's overrides. The options are checked before the
+    scene is loaded: a bad value is refused without importing the scene's libraries."""
+    device = check_device("--device", args.device) if args.device is not None else None
+    threads = check_int("--threads", args.threads, 0, MAX_CPU_THREADS) if args.threads is not None else None
+    duration = check_positive("--duration", args.duration, "s", 600.0) if args.duration is not None else None
     from cosim.pour_scene import PourScene, load_scene
 
     scene = load_scene(args.scene).named_after(args.scene) if args.scene is not None else PourScene()
-    if args.device is not None:
-        scene = replace(scene, device=check_device("--device", args.device))
-    if args.threads is not None:
-        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=check_int("--threads", args.threads, 0, MAX_CPU_THREADS)))
+    if device is not None:
+        scene = replace(scene, device=device)
+    if threads is not None:
+        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=threads))
     if args.dim is not None:
         scene = replace(scene, fluid=replace(scene.fluid, dim=args.dim))
-    if args.duration is not None:
-        duration = check_positive("--duration", args.duration, "s", 600.0)
+    if duration is not None:
         scene = replace(scene, coupling=replace(scene.coupling, max_duration=duration))
     if args.no_log:
         scene = replace(scene, logging=replace(scene.logging, enabled=False))
