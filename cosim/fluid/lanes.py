@@ -56,7 +56,7 @@ FUTEX_WAIT_PRIVATE = 128
 FUTEX_WAKE_PRIVATE = 129
 # The futex system call's number on the Linux machines warp builds for (asm/unistd.h); elsewhere a waiting lane
 # yields its core on every check after the spins instead of sleeping.
-FUTEX_SYSCALL = {"x86_64": 202, "amd64": 202, "aarch64": 98, "arm64": 98}
+FUTEX_SYSCALL = {"x86_64": 202, "aarch64": 98}
 
 
 # The barrier's native code is for the CPU only: CUDA runs one lane and never launches it. NVRTC, which compiles the
@@ -118,7 +118,7 @@ def lane_barrier(
 
 def _futex_syscall() -> int:
     """The futex system call's number here; 0 where there is none (not Linux, or an unknown machine)."""
-    return FUTEX_SYSCALL.get(platform.machine().lower(), 0) if sys.platform.startswith("linux") else 0
+    return FUTEX_SYSCALL.get(platform.machine(), 0) if sys.platform.startswith("linux") else 0
 
 
 def _os_function(futex: int) -> int:
