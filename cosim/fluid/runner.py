@@ -6,8 +6,8 @@ operations one by one (which compiles the kernels and sizes the sort's scratch m
 of each parity is captured and every later interval replays them: a CUDA graph on a CUDA device (DFSPH's solve
 loops become conditional nodes; the same results to the bit as the launches), on the CPU warp's operation stream
 (APIC), which replays the launches in C++ without Python's per-launch argument handling, one graph per lane, each
-lane's thread replaying its own share with barriers between the stages (``cosim.fluid.lanes``; the same results
-to the bit). Where capture fails the operations keep running one by one (:attr:`SubstepRunner.capture_error`).
+lane's thread replaying its own share with barriers between the stages, or, where the cores are busy, one graph of
+every lane's share replayed by one thread (``cosim.fluid.lanes``; the same results to the bit either way). Where capture fails the operations keep running one by one (:attr:`SubstepRunner.capture_error`).
 """
 
 from __future__ import annotations
