@@ -235,6 +235,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
             scene_name=scene.run_name,
             device=str(pour.fluid.device),
             fluid_threads=pour.fluid.lanes.count,
+            fluid_substeps_one_thread=pour.fluid.lanes.substeps_one_thread,
             dim=pour.fluid.config.dim,
             particle_spacing=pour.fluid.config.spacing,
             cfs_head_reference=pour.controller.config.cfs.h_q_ref,

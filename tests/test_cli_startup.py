@@ -15,8 +15,8 @@ from cosim.cli.main import SUBCOMMANDS
 
 ROOT = Path(__file__).resolve().parents[1]
 HEAVY = ("warp", "mujoco", "control", "scipy", "rerun", "ray")
-# Runs `cosim ARGS...` in this process, then prints its exit status and the heavy libraries it imported.
-PROBE = f"""
+# Runs `cosim ARGS...` in this process, then prints its exit status and which of the libraries LIBRARIES it imported.
+PROBE = """
 import contextlib, io, sys
 from cosim.cli.main import main
 with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
@@ -24,12 +24,12 @@ with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.St
         status = main(sys.argv[1:])
     except SystemExit as exc:
         status = exc.code
-print(status, *sorted(name for name in {HEAVY!r} if name in sys.modules))
+print(status, *sorted(name for name in LIBRARIES if name in sys.modules))
 """
 
 
-def _probe(args: list[str]) -> list[str]:
-    done = subprocess.run([sys.executable, "-c", PROBE, *args], cwd=ROOT, capture_output=True, text=True, timeout=120,
+def _probe(args: list[str], libraries: tuple[str, ...] = HEAVY) -> list[str]:
+    done = subprocess.run([sys.executable, "-c", f"LIBRARIES = {libraries!r}" + PROBE, *args], cwd=ROOT, capture_output=True, text=True, timeout=120,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert done.returncode == 0, done.stderr
     return done.stdout.split()
@@ -54,6 +54,13 @@ def test_help_loads_no_heavy_library(args):
                                   ["sweep", "/nonexistent/sweep.toml"], ["sweep", "BAD"]], ids=" ".join)
 def test_refused_input_loads_no_heavy_library(args, bad_scene):
     status, *loaded = _probe([str(bad_scene) if a == "BAD" else a for a in args])
+    assert status == "2" and loaded == []
+
+
+@pytest.mark.parametrize("args", [["pour", "--duration", "-1"], ["pour", "--threads", "-1"], ["pour", "--device", "tpu"]], ids=" ".join)
+def test_a_refused_pour_option_loads_not_even_numpy(args):
+    """An option's value is checked before the scene (and NumPy with it) is loaded."""
+    status, *loaded = _probe(args, ("numpy",))
     assert status == "2" and loaded == []
 
 
@@ -103,3 +110,13 @@ def test_the_pour_loads_the_kernel_modules_it_launches():
     assert {"cosim.fluid.dfsph", "cosim.fluid.wcsph", "cosim.fluid.neighbors", "cosim.coupling.measure"} <= set(modules)
     assert "cosim.fluid.sph_kernels" not in modules  # warp functions only: compiled into the kernels that call them
     assert "cosim.fluid.solver" not in modules  # launches kernels it imports: compiled with the modules defining them
+
+
+def test_exit_status_of_each_error_kind():
+    from controllers.errors import ControllerInputError, MeasurementError
+    from cosim.cli.main import exit_status
+    from cosim.errors import InputError, SimulationError
+
+    assert exit_status(InputError("x")) == 2 and exit_status(ControllerInputError("x")) == 2
+    assert exit_status(SimulationError("x")) == 1 and exit_status(MeasurementError("x")) == 1
+    assert exit_status(ValueError("x")) is None  # a bug: raised, not reported as bad input

@@ -1,6 +1,6 @@
 """A CPU substep split over threads (``cosim.fluid.lanes``): the liquid must evolve to the bit as on one thread,
-whatever the number of lanes, with the lanes replaying their graphs at once or run one after the other; only the
-energies' float sums may round differently, being summed per lane."""
+whatever the number of lanes, with the lanes replaying their graphs at once or one after the other on one thread, or
+run uncaptured one after the other; only the energies' float sums may round differently, being summed per lane."""
 
 from __future__ import annotations
 
@@ -15,8 +15,9 @@ import pytest
 import warp as wp
 
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig, PressureSolver
+from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.diagnostics import DIAG_KINETIC_ENERGY, DIAG_MAX_SPEED, N_DIAG_FLOAT, combine_lanes
+from cosim.fluid import lanes
 from cosim.fluid.lanes import LANE_CHUNK, MIN_PARTICLES_PER_LANE, available_cores, lane_count, lane_item, lane_sizes
 from cosim.fluid.solver import FluidSolver
 from tests.support.shaken_tank import SOLVER_VARIANTS, shake, tank
@@ -39,6 +40,19 @@ def _assert_same_run(fluid: FluidSolver, reference: FluidSolver) -> None:
             np.testing.assert_array_equal(fluid.history()[key], values, err_msg=key)
 
 
+class _Alternating:
+    """A replay choice that takes the lanes at once and one thread in turn, interval by interval."""
+
+    def __init__(self):
+        self.next = True
+
+    def parallel(self) -> bool:
+        return self.next
+
+    def record(self, parallel: bool, substeps: int, wall_s: float) -> None:
+        self.next = not parallel
+
+
 @pytest.mark.parametrize(("solver", "iteration"), SOLVER_VARIANTS)
 @pytest.mark.slow
 def test_lanes_give_the_single_thread_run_to_the_bit(solver, iteration):
@@ -47,11 +61,28 @@ def test_lanes_give_the_single_thread_run_to_the_bit(solver, iteration):
     assert one.lanes.count == 1
     for threads, graphs in ((2, True), (3, True), (2, False)):
         fluid = tank(solver, ACROSS, graphs, threads, iteration)
+        fluid.lanes.choice = _Alternating()
         shake(fluid, **SHAKE)
         assert fluid.lanes.count == threads
         assert fluid.runner.replays_graphs == graphs and fluid.graph_capture_error is None  # it replayed the lanes' graphs
+        if graphs:  # both ways of replaying ran
+            assert fluid.lanes.substeps_at_once > 0 and fluid.lanes.substeps_one_thread > 0
         _assert_same_run(fluid, one)
     assert one.history()["density_iterations" if solver is PressureSolver.DFSPH else "active"].max() > 0  # the solves ran
+
+
+def test_lanes_that_sleep_at_every_barrier_give_the_same_run(monkeypatch):
+    """No spins: every lane that waits sleeps (a futex on Linux) until the last lane wakes it; a lost wake-up would
+    hang here, a barrier that let a lane through early would change the particles."""
+    monkeypatch.setattr(lanes, "SPINS_BEFORE_SLEEP", 0)
+    solver, iteration = PressureSolver.DFSPH, DensityIteration.GAUSS_SEIDEL
+    one = tank(solver, ACROSS, threads=1, iteration=iteration)
+    shake(one, **SHAKE)
+    fluid = tank(solver, ACROSS, True, 2, iteration)
+    fluid.lanes.choice = _Alternating()
+    shake(fluid, **SHAKE)
+    assert fluid.lanes.substeps_at_once > 0
+    _assert_same_run(fluid, one)
 
 
 @wp.kernel

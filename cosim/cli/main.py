@@ -85,6 +85,22 @@ def _sigterm_unwinds() -> Iterator[None]:
         signal.signal(signal.SIGTERM, previous)
 
 
+def exit_status(exc: Exception) -> int | None:
+    """2 for bad input, 1 for a simulation that broke, None for anything else (a bug: raised). The controllers'
+    errors are looked up only where their package is loaded already (nothing else can have raised one), so that
+    refusing an option does not import it and NumPy with it."""
+    if isinstance(exc, InputError):
+        return 2
+    if isinstance(exc, SimulationError):
+        return 1
+    errors = sys.modules.get("controllers.errors")
+    if errors is not None and isinstance(exc, errors.ControllerInputError):
+        return 2
+    if errors is not None and isinstance(exc, errors.MeasurementError):
+        return 1
+    return None
+
+
 def main(argv: list[str] | None = None) -> int:
     pin_openblas_core()  # before any subcommand imports numpy
     argv = sys.argv[1:] if argv is None else argv
@@ -93,17 +109,15 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
-    from controllers.errors import ControllerInputError, MeasurementError  # after --help: the package loads numpy
-
     try:
         with _sigterm_unwinds():
             return int(args.func(args) or 0)
-    except (InputError, ControllerInputError) as exc:
-        print(f"cosim {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except (SimulationError, MeasurementError) as exc:
-        print(f"cosim {args.command}: simulation failed: {exc}", file=sys.stderr)
-        return 1
+    except Exception as exc:
+        status = exit_status(exc)
+        if status is None:
+            raise
+        print(f"cosim {args.command}: {'error' if status == 2 else 'simulation failed'}: {exc}", file=sys.stderr)
+        return status
     except Terminated:
         print(f"cosim {args.command}: terminated", file=sys.stderr)
         return 143

@@ -40,17 +40,21 @@ def register(subparsers, summary: str) -> None:
 
 
 def scene_from_args(args) -> PourScene:
+    """The scene file's (or the default) scene with the command line's overrides. The options are checked before the
+    scene is loaded: a bad value is refused without importing the scene's libraries."""
+    device = check_device("--device", args.device) if args.device is not None else None
+    threads = declared(FluidConfig, "cpu_threads").check("--threads", args.threads) if args.threads is not None else None
+    duration = check_positive("--duration", args.duration, "s", 600.0) if args.duration is not None else None
     from cosim.pour_scene import PourScene, load_scene
 
     scene = load_scene(args.scene).named_after(args.scene) if args.scene is not None else PourScene()
-    if args.device is not None:
-        scene = replace(scene, device=check_device("--device", args.device))
-    if args.threads is not None:
-        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=declared(FluidConfig, "cpu_threads").check("--threads", args.threads)))
+    if device is not None:
+        scene = replace(scene, device=device)
+    if threads is not None:
+        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=threads))
     if args.dim is not None:
         scene = replace(scene, fluid=replace(scene.fluid, dim=args.dim))
-    if args.duration is not None:
-        duration = check_positive("--duration", args.duration, "s", 600.0)
+    if duration is not None:
         scene = replace(scene, coupling=replace(scene.coupling, max_duration=duration))
     if args.no_log:
         scene = replace(scene, logging=replace(scene.logging, enabled=False))
@@ -82,7 +86,16 @@ def run(args) -> int:
               f"({100 * summary['target_relative_error']:+.1f} %) off it")
     phases = " -> ".join(f"{p['phase']} {p['start']:.2f}-{p['end']:.2f}s" for p in summary["phases"])
     print(f"phases: {phases}")
-    threads = f" ({summary['fluid_threads']} thread{'s' if summary['fluid_threads'] > 1 else ''})" if summary["device"] == "cpu" else ""
+    threads = f" ({summary['fluid_threads']} thread{'s' if summary['fluid_threads'] > 1 else ''}{_one_thread_note(summary)})" if summary["device"] == "cpu" else ""
     print(f"simulated {summary['sim_time']:.2f} s in {summary['wall_time']:.1f} s wall (real-time factor {summary['real_time_factor']:.3f}), "
           f"{summary['particles']} particles, {summary['device']}{threads}", file=sys.stdout)
     return 0
+
+
+def _one_thread_note(summary: dict) -> str:
+    """How much of the liquid ran on one thread although it had more (its threads stalled each other on busy
+    cores, ``cosim.fluid.lane_choice``); empty when none did."""
+    if summary["fluid_substeps_one_thread"] == 0:
+        return ""
+    share = summary["fluid_substeps_one_thread"] / summary["sph_steps"]
+    return f", {100 * share:.0f} % of the substeps on one thread: the cores were busy"

@@ -3,11 +3,14 @@ own the solver leaves every other core idle.
 
 Each lane launches the particle kernels over its own share of the particles (chunks dealt out in turn,
 :func:`lane_item`; the kernels take their lane as first argument) and every lane waits for the others between stages
-(:func:`barrier_wait`, a spin barrier in native code inside the captured graph), so each lane's substep is one graph
-of warp's CPU operation stream that its own thread replays. The split changes no result: every kernel computes each
-particle as before, and what the lanes accumulate together (the solves' error sums, the diagnostics' counts and
-maxima) is kept per lane and combined in a fixed order, as integers or maxima where it steers the run. Without
-graphs (the first interval, ``graphs=False``) the lanes' shares run one after the other on the calling thread.
+(:func:`barrier_wait`, a barrier in native code inside the captured graph that spins briefly, then sleeps), so each
+lane's substep is one graph of warp's CPU operation stream that its own thread replays. The split changes no result:
+every kernel computes each particle as before, and what the lanes accumulate together (the solves' error sums, the
+diagnostics' counts and maxima) is kept per lane and combined in a fixed order, as integers or maxima where it steers
+the run. The same operations are also captured as one graph of every lane's share in turn, for one thread: where the
+cores are shared with other processes, the lanes stall each other at the barriers, and the replay runs that way
+instead, as timing both shows (``cosim.fluid.lane_choice``). Without graphs (the first interval, ``graphs=False``)
+the lanes' shares run one after the other on the calling thread.
 
 A stage is the unit between two barriers: :class:`Stage` (the operations each lane runs) or :class:`Loop` (a
 ``wp.capture_while`` loop of stages on a device flag); the stage functions of the physics record them without
@@ -19,14 +22,17 @@ from __future__ import annotations
 import ctypes
 import functools
 import os
+import platform
 import sys
 import threading
+import time
 import weakref
 from dataclasses import dataclass
 from typing import Callable, Sequence, Union
 
 import warp as wp
 
+from cosim.fluid.lane_choice import ReplayChoice
 from cosim.fluid.launch import record_launch
 
 # Fewest particles per lane the automatic thread count gives a lane. Measured on the 2-core CPU (a resting 2-D tank,
@@ -34,10 +40,10 @@ from cosim.fluid.launch import record_launch
 # 1.52 and 1.79 x the particle-steps of one under DFSPH at 400, 784 and 1600 particles, 1.58, 1.74 and 1.84 x under
 # WCSPH; smaller liquids were not measured (the benchmark's tank needs 400), so 400 particles get 2 lanes, fewer one.
 MIN_PARTICLES_PER_LANE = 200
-# Spins (x86 ``pause`` / arm ``yield`` hints) before a waiting lane gives its core away on every further check:
-# about 40-100 us, several stages' worth, so a lane that is running is waited for on the spot, one whose core the OS
-# gave to another process is not spun against for a whole time slice.
-SPINS_BEFORE_YIELD = 4000
+# Spins (x86 ``pause`` / arm ``yield`` hints) before a waiting lane goes to sleep until the barrier opens: about
+# 40-100 us, several stages' worth, so a lane that is running is waited for on the spot, while one whose core the OS
+# gave to another process is waited for asleep, its core left to that lane or process instead of spun on.
+SPINS_BEFORE_SLEEP = 4000
 # Items are dealt out to the lanes in chunks of this many, in turn: the particles are in cell order, so contiguous
 # halves would give one lane the bulk and the other the sparse stream (measured on the default pour: 10 to 17 % more
 # neighbour pairs in one half, and every wall sample that touches liquid in one half of the walls). 16 float32 or
@@ -45,51 +51,89 @@ SPINS_BEFORE_YIELD = 4000
 LANE_CHUNK = wp.constant(16)
 
 
+# Linux futex operations (linux/futex.h): sleep while a word holds an expected value; wake the sleepers on a word.
+FUTEX_WAIT_PRIVATE = 128
+FUTEX_WAKE_PRIVATE = 129
+# The futex system call's number on the Linux machines warp builds for (asm/unistd.h); elsewhere a waiting lane
+# yields its core on every check after the spins instead of sleeping.
+FUTEX_SYSCALL = {"x86_64": 202, "aarch64": 98}
+
+
 # The barrier's native code is for the CPU only: CUDA runs one lane and never launches it. NVRTC, which compiles the
 # module whenever warp loads it for a GPU (wp.force_load, ahead-of-time builds), has no GCC atomics, so there it
-# compiles to nothing (tests/test_cuda_compile.py).
+# compiles to nothing (tests/test_cuda_compile.py). The waiting lanes' sleep is the word-wait of a futex on the
+# generation: the last lane to arrive advances it and wakes the sleepers only when some lane counted itself asleep
+# (sequentially consistent order on both sides, so either the sleeper sees the new generation, which makes its
+# futex call return at once, or the last lane sees the sleeper and wakes it).
 @wp.func_native(
     """
 #if !defined(__CUDA_ARCH__)
+typedef long (*syscall_t)(long, ...);
 if (__atomic_load_n(&state.data[2], __ATOMIC_ACQUIRE) != 0) {
     return;
 }
 const int generation = __atomic_load_n(&state.data[1], __ATOMIC_ACQUIRE);
 if (__atomic_add_fetch(&state.data[0], 1, __ATOMIC_ACQ_REL) == parties) {
     __atomic_store_n(&state.data[0], 0, __ATOMIC_RELAXED);
-    __atomic_store_n(&state.data[1], generation + 1, __ATOMIC_RELEASE);
+    __atomic_store_n(&state.data[1], generation + 1, __ATOMIC_SEQ_CST);
+    if (futex != 0 && __atomic_load_n(&state.data[3], __ATOMIC_SEQ_CST) != 0) {
+        ((syscall_t)os_fn)((long)futex, (long)&state.data[1], (long)wake_op, (long)0x7fffffff);
+    }
     return;
 }
 for (long spins = 0; __atomic_load_n(&state.data[1], __ATOMIC_ACQUIRE) == generation
                      && __atomic_load_n(&state.data[2], __ATOMIC_ACQUIRE) == 0; ++spins) {
-    if (spins < spins_before_yield) {
+    if (spins < spins_before_sleep) {
 #if defined(__x86_64__) || defined(__i386__)
         __builtin_ia32_pause();
 #elif defined(__aarch64__)
         __asm__ __volatile__("yield");
 #endif
+    } else if (futex != 0) {
+        __atomic_add_fetch(&state.data[3], 1, __ATOMIC_SEQ_CST);
+        ((syscall_t)os_fn)((long)futex, (long)&state.data[1], (long)wait_op, (long)generation, (long)0);
+        __atomic_sub_fetch(&state.data[3], 1, __ATOMIC_SEQ_CST);
     } else {
-        ((void (*)())yield_fn)();
+        ((void (*)())os_fn)();
     }
 }
 #endif
 """
 )
-def barrier_wait(state: wp.array(dtype=wp.int32), parties: int, spins_before_yield: int, yield_fn: wp.uint64): ...
+def barrier_wait(
+    state: wp.array(dtype=wp.int32), parties: int, spins_before_sleep: int, futex: int, wait_op: int, wake_op: int, os_fn: wp.uint64
+): ...
 
 
 @wp.kernel
-def lane_barrier(state: wp.array(dtype=wp.int32), parties: int, spins_before_yield: int, yield_fn: wp.uint64):
+def lane_barrier(
+    state: wp.array(dtype=wp.int32), parties: int, spins_before_sleep: int, futex: int, wait_op: int, wake_op: int, os_fn: wp.uint64
+):
     """One thread: return once all ``parties`` lanes have arrived, or at once after an abort (state: [arrived,
-    generation, aborted], zeroed at start)."""
-    barrier_wait(state, parties, spins_before_yield, yield_fn)
+    generation, aborted, asleep], zeroed at start). A waiting lane spins ``spins_before_sleep`` times, then sleeps
+    on the futex system call ``futex`` (``os_fn``: libc's ``syscall``), or where ``futex`` is 0 yields its core on
+    every further check (``os_fn``: the OS's yield)."""
+    barrier_wait(state, parties, spins_before_sleep, futex, wait_op, wake_op, os_fn)
 
 
-def _yield_function() -> int:
-    """Address of the OS call that gives the core to another thread (sched_yield; SwitchToThread on Windows)."""
+def _futex_syscall() -> int:
+    """The futex system call's number here; 0 where there is none (not Linux, or an unknown machine)."""
+    return FUTEX_SYSCALL.get(platform.machine(), 0) if sys.platform.startswith("linux") else 0
+
+
+def _os_function(futex: int) -> int:
+    """Address of what a waiting lane calls after its spins: libc's ``syscall`` where it sleeps on a futex, else the
+    OS call that gives the core to another thread (sched_yield; SwitchToThread on Windows)."""
     if sys.platform == "win32":
         return ctypes.cast(ctypes.windll.kernel32.SwitchToThread, ctypes.c_void_p).value
-    return ctypes.cast(ctypes.CDLL(None).sched_yield, ctypes.c_void_p).value
+    libc = ctypes.CDLL(None)
+    return ctypes.cast(libc.syscall if futex else libc.sched_yield, ctypes.c_void_p).value
+
+
+def _wake_sleepers(generation_address: int, futex: int) -> None:
+    """Wake every lane asleep on the barrier's generation word (after an abort)."""
+    if futex:
+        ctypes.CDLL(None).syscall(ctypes.c_long(futex), ctypes.c_void_p(generation_address), ctypes.c_long(FUTEX_WAKE_PRIVATE), ctypes.c_long(0x7FFFFFFF))
 
 
 def available_cores() -> int:
@@ -220,16 +264,29 @@ def _stop_threads(threads: list[_LaneThread]) -> None:
         thread.stop()
 
 
+@dataclass(frozen=True)
+class LaneGraphs:
+    """A program captured for the lanes: ``parallel[L]`` lane L's graph (its operations, a barrier after every
+    stage), ``serial`` every lane's operations in lane order without barriers, for one thread."""
+
+    parallel: tuple
+    serial: object
+
+
 class Lanes:
-    """The lanes of one solver: their per-lane graphs of a program and the threads that replay them."""
+    """The lanes of one solver: their graphs of a program and the threads that replay them."""
 
     def __init__(self, count: int, device):
         self.count = count
         self.device = device
-        self._barrier_state = wp.zeros(3, dtype=wp.int32, device=device)
+        self._barrier_state = wp.zeros(4, dtype=wp.int32, device=device)
+        self._futex = _futex_syscall()
         self._barrier = None
         self._threads: list[_LaneThread] | None = None  # lanes 1.. (lane 0 runs on the caller's thread)
         self._aborted = False
+        self.choice = ReplayChoice()  # all lanes at once or one thread, interval by interval
+        self.substeps_at_once = 0  # substeps replayed by all lanes at once, and by one thread (more than one lane)
+        self.substeps_one_thread = 0
 
     def on_lane(self, lane: int, *ops: Callable[[], None]) -> Stage:
         """``ops`` on one lane (``lane`` taken modulo the lane count); the others only wait."""
@@ -240,7 +297,10 @@ class Lanes:
         if self._barrier is None:
             self._barrier = record_launch(
                 lane_barrier, 1, self.device,
-                dict(state=self._barrier_state, parties=self.count, spins_before_yield=SPINS_BEFORE_YIELD, yield_fn=wp.uint64(_yield_function())),
+                dict(
+                    state=self._barrier_state, parties=self.count, spins_before_sleep=SPINS_BEFORE_SLEEP, futex=self._futex,
+                    wait_op=FUTEX_WAIT_PRIVATE, wake_op=FUTEX_WAKE_PRIVATE, os_fn=wp.uint64(_os_function(self._futex)),
+                ),
             )
         self._barrier()
 
@@ -254,32 +314,46 @@ class Lanes:
                     op()
             self._wait()  # after a loop too: no lane may set the flag again before every lane has read it
 
-    def capture(self, program: Program) -> tuple:
-        """One graph per lane of ``program`` (capturing runs nothing); a single lane's without barriers."""
-        graphs = []
-        for lane in range(self.count):
-            with wp.ScopedCapture(device=self.device) as capture:
-                if self.count == 1:
-                    run_serial(program)
-                else:
-                    self.run_lane(program, lane)
-            graphs.append(capture.graph)
-        return tuple(graphs)
+    def capture(self, program: Program) -> LaneGraphs:
+        """``program`` captured for the lanes (capturing runs nothing): one graph per lane with the barriers, and one
+        graph of every lane's share in turn for one thread (a single lane's are the same graph)."""
+        serial = self._capture(lambda: run_serial(program))
+        if self.count == 1:
+            return LaneGraphs((serial,), serial)
+        return LaneGraphs(tuple(self._capture(lambda lane=lane: self.run_lane(program, lane)) for lane in range(self.count)), serial)
+
+    def _capture(self, record: Callable[[], None]):
+        with wp.ScopedCapture(device=self.device) as capture:
+            record()
+        return capture.graph
 
     @property
     def aborted(self) -> bool:
         """A replay was abandoned (an error or an interrupt in one lane): the particle state is undefined."""
         return self._aborted
 
-    def replay(self, schedules: Sequence[Sequence]) -> None:
+    def replay(self, substeps: Sequence[LaneGraphs]) -> None:
+        """The captured ``substeps`` in order, all lanes at once or every lane's share on the calling thread, as
+        :attr:`choice` says (the same results to the bit); it is told the wall time each way took."""
+        if self.count == 1:
+            self._replay_lane([graphs.serial for graphs in substeps])
+            return
+        parallel = self.choice.parallel()
+        start = time.perf_counter()
+        if parallel:
+            self._replay_at_once([[graphs.parallel[lane] for graphs in substeps] for lane in range(self.count)])
+        else:
+            self._replay_lane([graphs.serial for graphs in substeps])
+        self.choice.record(parallel, len(substeps), time.perf_counter() - start)
+        self.substeps_at_once += len(substeps) if parallel else 0
+        self.substeps_one_thread += 0 if parallel else len(substeps)
+
+    def _replay_at_once(self, schedules: Sequence[Sequence]) -> None:
         """Lane L replays the graphs ``schedules[L]`` in order, all lanes at once (lane 0 on the calling thread);
         returns when every lane has finished. Should a lane fail or the caller be interrupted (Ctrl-C), the barriers
         are opened for good so that no lane waits forever for it, every lane is waited for, and the first error is
         raised; :attr:`aborted` then stays true, also when the wait itself is interrupted (a lane may still be
         running, so no replay may follow)."""
-        if self.count == 1:
-            self._replay_lane(schedules[0])
-            return
         if self._threads is None:
             self._threads = [_LaneThread(f"cosim-fluid-lane-{k}") for k in range(1, self.count)]
             weakref.finalize(self, _stop_threads, self._threads)
@@ -312,4 +386,7 @@ class Lanes:
 
     def _abort(self) -> None:
         self._aborted = True
-        self._barrier_state.numpy()[2] = 1  # CPU memory: the spinning lanes see it
+        state = self._barrier_state.numpy()  # CPU memory: the waiting lanes see it
+        state[2] = 1
+        state[1] += 1  # a lane about to sleep on the old generation returns at once
+        _wake_sleepers(self._barrier_state.ptr + state.itemsize, self._futex)

@@ -6,8 +6,8 @@ operations one by one (which compiles the kernels and sizes the sort's scratch m
 of each parity is captured and every later interval replays them: a CUDA graph on a CUDA device (DFSPH's solve
 loops become conditional nodes; the same results to the bit as the launches), on the CPU warp's operation stream
 (APIC), which replays the launches in C++ without Python's per-launch argument handling, one graph per lane, each
-lane's thread replaying its own share with barriers between the stages (``cosim.fluid.lanes``; the same results
-to the bit). Where capture fails the operations keep running one by one (:attr:`SubstepRunner.capture_error`).
+lane's thread replaying its own share with barriers between the stages, or, where the cores are busy, one graph of
+every lane's share replayed by one thread (``cosim.fluid.lanes``; the same results to the bit either way). Where capture fails the operations keep running one by one (:attr:`SubstepRunner.capture_error`).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from __future__ import annotations
 from typing import Callable
 
 from cosim.errors import SimulationError
-from cosim.fluid.lanes import Lanes, Program, run_serial
+from cosim.fluid.lanes import LaneGraphs, Lanes, Program, run_serial
 from cosim.fluid.model import FluidState
 from cosim.fluid.program import Recorder, record_program
 
@@ -40,7 +40,7 @@ class SubstepRunner:
         self.capture_error: str | None = None
         self.operation_hook: Callable[[Callable[[], None]], None] | None = None
         self._programs: tuple[Program, Program] | None = None  # substeps from buffer 0 and from buffer 1
-        self._graphs: tuple | None = None  # per lane: (from buffer 0, from buffer 1)
+        self._graphs: tuple[LaneGraphs, LaneGraphs] | None = None  # from buffer 0, from buffer 1
 
     @property
     def state(self) -> FluidState:
@@ -69,21 +69,21 @@ class SubstepRunner:
             )
         parities = [(self._parity + k) % 2 for k in range(count)]
         if self._graphs is not None:
-            self.lanes.replay([[graphs[p] for p in parities] for graphs in self._graphs])
+            self.lanes.replay([self._graphs[p] for p in parities])
         else:
             for p in parities:
                 run_serial(self._programs[p], self.operation_hook)
         self._parity = (self._parity + count) % 2
 
     def capture_if_due(self) -> None:
-        """After the first run: each lane's graphs of both parities, or, where warp or the driver cannot capture
+        """After the first run: the lanes' graphs of both parities, or, where warp or the driver cannot capture
         them, the reason in :attr:`capture_error` (and the operations one by one from then on)."""
         if not self._capture or self._graphs is not None or self._programs is None:
             return
         try:
-            by_parity = [self.lanes.capture(program) for program in self._programs]
+            graphs = tuple(self.lanes.capture(program) for program in self._programs)
         except Exception as exc:  # warp raises RuntimeError and others (e.g. no conditional nodes before CUDA 12.4)
             self._capture = False
             self.capture_error = f"{type(exc).__name__}: {exc}"
             return
-        self._graphs = tuple(zip(*by_parity))
+        self._graphs = graphs

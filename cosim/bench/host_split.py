@@ -1,0 +1,133 @@
+"""Where the host's share of each MuJoCo step goes: the wall time of each part of the co-simulation step.
+
+``python -m cosim.bench.host_overhead`` splits a pour's wall time into the liquid's substeps and the rest (the host's
+share). This tool splits the rest: it builds the default pour, steps it through a warm-up, then wraps named parts of
+the step (the controller, the arms' trajectory generators, the exchange, ``mj_step``, the liquid's host work around
+its substeps, the arms' load monitor) with wall-clock timers around each call, steps ``--duration`` simulated seconds
+and prints each part's ms per MuJoCo step. The timers change no result; each costs about a microsecond a call, so
+the parts sum to slightly more than they cost unwrapped. Parts nest where the table says so.
+
+    python -m cosim.bench.host_split [--duration 1] [--threads 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import dataclasses
+import os
+import statistics
+import sys
+import time
+from collections import defaultdict
+from collections.abc import Iterator
+
+import mujoco
+
+from cosim.bench.fluid_throughput import machine_description
+from cosim.bench.host_overhead import POUR_WARM_UP, time_steps
+from cosim.coupling import loop
+from cosim.coupling.loop import CoupledPour
+from cosim.errors import InputError
+from cosim.fluid.config import MAX_CPU_THREADS
+from cosim.pour_run import prepare
+from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene
+
+SUBSTEPS = "the liquid's substeps (replay)"
+ADVANCE = "liquid: advance (its substeps included)"
+
+
+@contextlib.contextmanager
+def timed(owner, name: str, label: str, calls: dict[str, list[float]]) -> Iterator[None]:
+    """``owner.name`` (a method of an object, or a function of a module) wrapped so that each call's wall time (s)
+    is appended to ``calls[label]``; the original is put back on exit."""
+    original = getattr(owner, name)
+
+    def wrapper(*args, **kwargs):
+        start = time.perf_counter()
+        try:
+            return original(*args, **kwargs)
+        finally:
+            calls[label].append(time.perf_counter() - start)
+
+    setattr(owner, name, wrapper)
+    try:
+        yield
+    finally:
+        setattr(owner, name, original)
+
+
+def parts(pour: CoupledPour) -> list[tuple[object, str, str]]:
+    """(owner, attribute, label) of every timed part of ``pour``'s step."""
+    fluid = pour.fluid
+    return [
+        (pour, "_control", "controller, every control period (measurement, IK, filters, generator targets)"),
+        *((generator, "step", "trajectory generators' step") for generator in pour.generators.values()),
+        (pour.recorder, "record", "trajectory recorder"),
+        (loop, "wrench_at_body_com", "exchange: wrench to the body's centre of mass"),
+        (loop, "compensation_torque", "exchange: compensation torque"),
+        (loop, "vessel_poses", "exchange: vessel poses from MuJoCo"),
+        (fluid, "set_vessel_poses", "exchange: vessel poses to the liquid"),
+        (mujoco, "mj_step", "mj_step (the live arms and the load monitor's twin)"),
+        (pour.arm_load, "step", "arm load monitor (its twin's mj_step included)"),
+        (fluid, "advance", ADVANCE),
+        (fluid.lanes, "replay", SUBSTEPS),
+        (fluid.scratch.diagnostics, "read", "liquid: diagnostics read back (in advance)"),
+        (fluid.energy_account, "update", "liquid: energy account (in advance)"),
+    ]
+
+
+def default_scene(threads: int) -> PourScene:
+    """The default pour on ``threads`` solver threads, without its recording."""
+    return PourScene(fluid=dataclasses.replace(FluidSettings(), cpu_threads=threads), logging=LoggingSettings(enabled=False))
+
+
+def split_pour(scene: PourScene, duration: float) -> tuple[dict[str, list[float]], int, float, float]:
+    """``scene`` stepped through the warm-up, then ``duration`` s with its parts timed: (each part's call times, s;
+    steps, wall s, substep wall s)."""
+    scene = dataclasses.replace(scene, coupling=dataclasses.replace(scene.coupling, max_duration=POUR_WARM_UP + duration))
+    pour = prepare(scene)
+    time_steps(pour, POUR_WARM_UP)
+    calls: dict[str, list[float]] = defaultdict(list)
+    with contextlib.ExitStack() as stack:
+        for owner, name, label in parts(pour):
+            stack.enter_context(timed(owner, name, label, calls))
+        split = time_steps(pour, duration)
+    return dict(calls), split.steps, split.wall_s, split.substep_s
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m cosim.bench.host_split", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--duration", type=float, default=1.0, help="simulated s timed after the warm-up (default 1)")
+    ap.add_argument("--threads", type=int, default=1, help="the liquid solver's CPU threads, 0: one per core (default 1)")
+    args = ap.parse_args(argv)
+    try:
+        if not 0.0 < args.duration <= 60.0:
+            raise InputError(f"--duration: must be in (0, 60] s, got {args.duration:g}")
+        if not 0 <= args.threads <= MAX_CPU_THREADS:
+            raise InputError(f"--threads: must be in [0, {MAX_CPU_THREADS}], got {args.threads}")
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    calls, steps, wall, substeps = split_pour(default_scene(args.threads), args.duration)
+    host = wall - substeps
+    command = "python -m cosim.bench.host_split " + " ".join(argv if argv is not None else sys.argv[1:])
+    print(f"Machine: {machine_description()}, 1-minute load average {os.getloadavg()[0]:.1f} at the end. Command: `{command.strip()}`.")
+    print(f"{steps} MuJoCo steps; wall {1e3 * wall / steps:.3f} ms a step, of which the substeps {1e3 * substeps / steps:.3f} "
+          f"and the host {1e3 * host / steps:.3f}. Mean: each part's total time per step; median: its median call times "
+          "its calls per step (less the moments the OS gave the core to another process, which a busy machine adds to "
+          "whatever part runs then).\n")
+    print("| part | calls per step | ms per step, mean | ms per step, median | share of the host's time (mean) |")
+    print("|---|---|---|---|---|")
+    nested = (SUBSTEPS, ADVANCE)
+    for label, times in sorted(calls.items(), key=lambda item: -sum(item[1])):
+        share = "" if label in nested else f"{100 * sum(times) / host:.0f} %"
+        per_step = len(times) / steps
+        print(f"| {label} | {per_step:.2f} | {1e3 * sum(times) / steps:.3f} | {1e3 * statistics.median(times) * per_step:.3f} | {share} |")
+    advance = sum(calls[ADVANCE]) - sum(calls[SUBSTEPS])
+    print(f"| liquid: advance less its substeps (host work) | 1.00 | {1e3 * advance / steps:.3f} | | {100 * advance / host:.0f} % |")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

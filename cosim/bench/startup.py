@@ -1,0 +1,78 @@
+"""How long `cosim --help` and refused input take to come back: wall time of new processes, median of several.
+
+Each command runs as a new ``python -m cosim ...`` process, the commands in turn round after round, beside the bare
+interpreter's start (``python -c pass``) as the floor no command can go under. A bad scene file is written to a
+temporary folder (an unknown key), so that its refusal, which needs the scene's schema, is timed too.
+
+    python -m cosim.bench.startup [--repeats 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from cosim.bench.fluid_throughput import machine_description
+from cosim.errors import InputError
+
+BAD_SCENE = "[fluid]\nparticles_acros = 32\n"
+
+
+def commands(bad_scene: Path) -> dict[str, list[str]]:
+    """Label -> command line (the label is what a user types)."""
+    cosim = [sys.executable, "-m", "cosim"]
+    return {
+        "python -c pass (the interpreter alone)": [sys.executable, "-c", "pass"],
+        "cosim --help": [*cosim, "--help"],
+        "cosim pour --help": [*cosim, "pour", "--help"],
+        "cosim pour --duration -1": [*cosim, "pour", "--duration", "-1"],
+        "cosim pour --threads -1": [*cosim, "pour", "--threads", "-1"],
+        "cosim pour BAD.toml (an unknown key)": [*cosim, "pour", str(bad_scene)],
+    }
+
+
+def time_commands(lines: dict[str, list[str]], repeats: int) -> dict[str, list[float]]:
+    """Wall s of every run of each command, the commands in turn each round; each run's exit status must be 0 or 2."""
+    times: dict[str, list[float]] = {label: [] for label in lines}
+    for _ in range(repeats):
+        for label, line in lines.items():
+            start = time.perf_counter()
+            done = subprocess.run(line, capture_output=True)
+            times[label].append(time.perf_counter() - start)
+            if done.returncode not in (0, 2):
+                raise RuntimeError(f"{label}: exit status {done.returncode}: {done.stderr.decode()[-2000:]}")
+    return times
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m cosim.bench.startup", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeats", type=int, default=5, help="runs of each command; the median is printed (default 5)")
+    args = ap.parse_args(argv)
+    try:
+        if not 1 <= args.repeats <= 50:
+            raise InputError(f"--repeats: must be in [1, 50], got {args.repeats}")
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    with tempfile.TemporaryDirectory(prefix="cosim-startup-") as tmp:
+        bad_scene = Path(tmp) / "BAD.toml"
+        bad_scene.write_text(BAD_SCENE)
+        times = time_commands(commands(bad_scene), args.repeats)
+    command = "python -m cosim.bench.startup " + " ".join(argv if argv is not None else sys.argv[1:])
+    print(f"Machine: {machine_description()}, 1-minute load average {os.getloadavg()[0]:.1f} at the end. "
+          f"Command: `{command.strip()}`. Wall s of a new process, median of {args.repeats} (every run in order).\n")
+    print("| command | wall s, median | runs |")
+    print("|---|---|---|")
+    for label, runs in times.items():
+        print(f"| `{label}` | {statistics.median(runs):.3f} | {', '.join(f'{t:.3f}' for t in runs)} |")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,28 @@
+"""The host-time split (cosim.bench.host_split): every part timed inside the steps, the originals put back, bad
+input refused."""
+
+import dataclasses
+
+import mujoco
+
+from cosim.bench import host_split
+from cosim.coupling import loop
+
+
+def test_the_parts_are_timed_within_the_steps_and_put_back():
+    scene = host_split.default_scene(1)
+    scene = dataclasses.replace(scene, fluid=dataclasses.replace(scene.fluid, particles_across=12))
+    original_step, original_poses = mujoco.mj_step, loop.vessel_poses
+    calls, steps, wall, substeps = host_split.split_pour(scene, 0.02)
+    assert steps == 10
+    assert mujoco.mj_step is original_step and loop.vessel_poses is original_poses
+    assert len(calls[host_split.ADVANCE]) == 10 and len(calls["trajectory generators' step"]) == 20  # two arms
+    assert len(calls["mj_step (the live arms and the load monitor's twin)"]) == 20  # the live arms and the twin
+    assert len(calls["controller, every control period (measurement, IK, filters, generator targets)"]) == 2  # every 10 ms
+    assert 0.0 < sum(calls[host_split.SUBSTEPS]) <= substeps < sum(calls[host_split.ADVANCE]) < wall
+
+
+def test_bad_input_is_refused(capsys):
+    assert host_split.main(["--duration", "0"]) == 2
+    assert capsys.readouterr().err.strip() == "error: --duration: must be in (0, 60] s, got 0"
+    assert host_split.main(["--threads", "-1"]) == 2
