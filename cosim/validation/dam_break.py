@@ -32,7 +32,7 @@ from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
 from cosim.fluid.wall_sampling import numerical_wall_thickness
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
-from cosim.validation.dam_gate import MAX_GATE_SPEED, LiftedGate, lifted_gate
+from cosim.validation.dam_gate import MAX_GATE_SPEED, lauber_hager_speed, lifted_gate
 from cosim.vessel import VesselSpec
 
 # Acceptance (issue "Fluid core"): surge front within 10 % of Martin & Moyce at every point with T <= 3.
@@ -154,6 +154,7 @@ def run(p: Params) -> CaseResult:
         "Z": Z.tolist(),
         "reference_points": points,
         "gate_lift": lifts if gate is not None else None,
+        "lauber_hager_speed": lauber_hager_speed(height, GRAVITY),  # the slowest gate that counts as an instantaneous release
         "particles": solver.n_particles,
         "steps": solver.step_count,
     }
