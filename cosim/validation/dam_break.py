@@ -184,13 +184,15 @@ def compare_with_martin_moyce(T: np.ndarray, Z: np.ndarray) -> tuple[list[Metric
 
 def plot(result: CaseResult, path) -> None:
     fig, ax, plt = new_figure(f"Dam break ({result.parameters['dim']}-D, a = {result.raw['a']:.4f} m): surge front")
-    ax.plot(result.raw["T"], result.raw["Z"], "-", label="SPH")
+    speed = result.parameters["gate_speed"]
+    release = f"gate lifted at {speed:g} m/s" if speed is not None else "instantaneous release"
+    ax.plot(result.raw["T"], result.raw["Z"], "-", label=f"SPH, {release}")
     ref_T, ref_Z = martin_moyce()
     ax.plot(ref_T, ref_Z, "ks", ms=5, label="Martin & Moyce (1952)")
     ax.fill_between(ref_T, ref_Z * (1 - FRONT_TOLERANCE), ref_Z * (1 + FRONT_TOLERANCE), color="0.85", label="+-10 %")
     ax.axvline(ACCEPTANCE_T_MAX, color="0.5", ls=":", lw=1)
     ax.set_xlim(0, max(result.raw["T"][-1], 1.0) * 1.05)
-    ax.set_ylim(0.8, max(max(result.raw["Z"]), 2.0) * 1.1)
+    ax.set_ylim(0.8, max(max(result.raw["Z"]), float(ref_Z[ref_T <= result.raw["T"][-1]].max(initial=2.0))) * 1.1)
     ax.set_xlabel("T = t sqrt(2 g / a)")
     ax.set_ylabel("Z = front / a")
     ax.legend(loc="upper left")
