@@ -29,6 +29,16 @@ def test_json_contract_of_each_case(capsys, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dam-break-2d.png", "hydrostatic-2d.png", "slosh-A0.060-2d.png"]
 
 
+def test_gate_speed_reaches_the_dam_break(capsys):
+    assert main(["validate", "dam-break", "--spacing", "0.0125", "--width", "0.1", "--gate-speed", "1.0", "--json", "--no-plot"]) == 0
+    case = json.loads(capsys.readouterr().out)["cases"][0]
+    assert case["parameters"]["gate_speed"] == 1.0
+    assert case["gate_lift"][:5] == pytest.approx([1.0 * t for t in case["t"][:5]])  # rising at 1 m/s from the release
+    assert case["gate_lift"][-1] < case["t"][-1]  # then stopped clear of the liquid
+    assert len(case["tip_height"]) == len(case["front"]) == len(case["t"])
+    assert case["lauber_hager_speed"] == pytest.approx((9.81 * 0.1 / 2) ** 0.5, rel=1e-3)  # sqrt(g a / 2), a = 0.1 m
+
+
 def test_table_output(capsys, tmp_path):
     assert main(["validate", "hydrostatic", "--spacing", "0.0125", "--width", "0.1", "--fill", "0.05", "--no-plot"]) == 0
     out = capsys.readouterr().out
@@ -57,7 +67,8 @@ def test_a_tank_rounded_to_whole_spacings_says_so(capsys):
 
 @pytest.mark.parametrize("argv", [["validate", "nope"], ["validate", "slosh", "--width", "-1"], ["validate", "--spacing", "nan"],
                                   ["validate", "hydrostatic", "--device", "tpu"], ["validate", "--density-tolerance", "-1"],
-                                  ["validate", "slosh-plant", "--shape", "cylinder"], ["validate", "slosh-plant", "--spacing", "0.05"]])
+                                  ["validate", "slosh-plant", "--shape", "cylinder"], ["validate", "slosh-plant", "--spacing", "0.05"],
+                                  ["validate", "dam-break", "--gate-speed", "0"], ["validate", "dam-break", "--gate-speed", "inf"]])
 def test_bad_input_exits_2_with_one_line(argv, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()

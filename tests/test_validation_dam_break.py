@@ -33,3 +33,26 @@ def test_every_reference_point_is_reported_without_a_time_shift() -> None:
         assert pt["error"] == pytest.approx((pt["Z"] - zr) / zr)
         if math.isfinite(pt["time_lead"]):  # a front ahead of the experiment reached its Z earlier
             assert (pt["time_lead"] > 0) == (pt["error"] > 0)
+
+
+def test_surge_front_ends_at_the_connected_liquid_and_keeps_its_tip_height() -> None:
+    dx = 0.01
+    run = [(0.005 + k * dx, 0.0, 0.015 if k == 9 else 0.005 + 0.01 * (k % 3)) for k in range(10)]  # x 0.005 .. 0.095
+    detached = [(0.2, 0.0, 0.005)]  # a drop ahead of an empty bin is not the front
+    front, tip = dam_break.surge_front(np.array(run + detached), 0.0, dx)
+    assert front == pytest.approx(0.095 + 0.5 * dx)
+    assert tip == pytest.approx(0.015)
+
+
+def test_comparison_reads_every_point_at_its_own_time() -> None:
+    ref_T, ref_Z = dam_break.martin_moyce()
+    T = np.linspace(0.0, 10.0, 2001)
+    Z = np.interp(T + 0.3, ref_T, ref_Z)  # the experiment's curve run 0.3 earlier (flat before its first point)
+    metrics, points = dam_break.compare_with_martin_moyce(T, Z)
+    assert len(points) == len(metrics) == len(ref_T)  # every point, none dropped
+    for pt, m, tr, zr in zip(points, metrics, ref_T, ref_Z):
+        assert pt["T"] == tr and pt["Z_reference"] == zr
+        assert pt["Z"] == pytest.approx(np.interp(tr + 0.3, ref_T, ref_Z))  # read at the experiment's T, not shifted back
+        assert m.error == pt["error"] == pytest.approx((pt["Z"] - zr) / zr)
+        assert m.tolerance == (dam_break.FRONT_TOLERANCE if tr <= dam_break.ACCEPTANCE_T_MAX else math.inf)
+    assert [pt["time_lead"] for pt in points[1:-1]] == pytest.approx([0.3] * (len(points) - 2), abs=0.01)  # the lead is reported

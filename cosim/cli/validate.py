@@ -4,7 +4,8 @@ Human output is a table (case, quantity, measured, reference, error, tolerance, 
 case run; ``--json`` prints a machine-readable document instead (the contract for outside checks):
 ``{"passed": bool, "cases": [{"case", "passed", "wall_time_s", "parameters", "metrics": [...], <raw values>}]}``
 with the raw values of each case (slosh ``frequency_hz``; hydrostatic ``z``, ``pressure``, ``leaked``;
-dam-break ``a``, ``t``, ``front``, ``reference_points`` (each ``T``, ``Z_reference``, ``Z``, ``error``, ``time_lead``);
+dam-break ``a``, ``t``, ``front``, ``tip_height``, ``gate_lift`` (m; null without a gate), ``lauber_hager_speed``
+(m/s), ``reference_points`` (each ``T``, ``Z_reference``, ``Z``, ``error``, ``time_lead``);
 slosh-plant ``omega1_sph``, ``omega1_model`` (rad/s), ``hinge_height_sph``, ``hinge_height_model`` (m above the inner
 floor), ``damping_ratio_sph``, ``pivots``, ``signed_amplitudes``, ``identified_model``, ``t``, ``sigma``; outflow
 ``coefficient``, ``rehbock``, ``discharge`` (m^2/s), ``head`` (m), ``t``, ``passed_area``, ``head_series``). A failed
@@ -40,6 +41,9 @@ def register(subparsers, summary: str) -> None:
                    "diameter) or column width a (dam-break), m")
     p.add_argument("--fill", type=float, help="fill depth A (hydrostatic, slosh, slosh-plant) or column height (dam-break), m; "
                    "slosh without --fill runs the fills 0.054, 0.108, 0.162 m of Camporredondo et al. (2019)")
+    p.add_argument("--gate-speed", type=float, metavar="M/S",
+                   help="dam-break: release the column by a gate lifted at this speed, m/s (default: released instantaneously; "
+                   "0.53 m/s lifts it off Martin & Moyce's column in Lauber & Hager's time sqrt(2 a / g), the JSON's lauber_hager_speed)")
     p.add_argument("--shape", choices=("box", "cylinder"), help="slosh-plant's vessel: box or cylinder (3-D only) (default box)")
     p.add_argument("--scene", help="a scene file whose pourer (a box, cylinder or mesh) is the vessel (hydrostatic, tilt, shake)")
     p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
@@ -75,6 +79,8 @@ def _case_params(name: str, args) -> list:
         geometry.pop("width", None)  # the scene's pouring vessel
     if name == "outflow":
         return [params(**common, head=head) for head in weir.HEADS]  # the weir's own channel, at two heads
+    if name == "dam-break" and args.gate_speed is not None:
+        geometry["gate_speed"] = args.gate_speed
     if name == "slosh-plant" and args.shape is not None:
         geometry["shape"] = args.shape
     if args.scene is not None and name in ("hydrostatic", "tilt", "shake"):
