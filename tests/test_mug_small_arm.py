@@ -5,6 +5,7 @@ weighs the mesh, the 2-D and 3-D scenes pass the checks `cosim pour` runs, and a
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -78,11 +79,15 @@ def test_the_mug_on_the_small_arm_passes_the_pours_checks(name, dim):
     assert plan.robots.arms[ArmRole.POUR].vessel.is_mesh
 
 
-def test_a_short_coarse_mug_pour_on_the_small_arm_runs(tmp_path):
+@pytest.mark.parametrize("name", ["mug_small_arm", "mug_small_arm_3d"])
+def test_a_short_coarse_mug_pour_on_the_small_arm_runs(name, tmp_path):
     scene = tmp_path / "short.toml"
-    scene.write_text(_absolute(MUG_ARM.read_text()).replace("particles_across = 16", "particles_across = 8"))
+    text = _absolute((EXAMPLES / f"{name}.toml").read_text())
+    scene.write_text(re.sub(r"(?m)^particles_across = .*$", "particles_across = 8", text))
     assert main(["pour", str(scene), "--out", str(tmp_path / "run"), "--duration", "0.3", "--no-log", "--quiet"]) == 0
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     exported = json.loads((tmp_path / "run" / "trajectory.json").read_text())["arms"]
     assert exported["pour_arm"]["arm_model"] == "small_arm"
-    assert summary["sim_time"] == pytest.approx(0.3, abs=0.01)
+    assert summary["dim"] == load_scene(EXAMPLES / f"{name}.toml").fluid.dim
+    assert summary["particle_spacing"] == pytest.approx(0.01) and summary["sim_time"] == pytest.approx(0.3, abs=0.01)
+    assert summary["volume_left_in_pourer"] == pytest.approx(summary["initial_volume"])  # still upright: all in the mug
