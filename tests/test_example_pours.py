@@ -1,6 +1,7 @@
-"""A mesh vessel held by a user's arm (examples/mug_small_arm.toml, and its 3-D variant): the mug from
-examples/meshes/mug.obj on examples/arms/small_arm.xml. The mount plate rests on the mug's handle, the payload check
-weighs the mesh, the 2-D and 3-D scenes pass the checks `cosim pour` runs, and a short coarse pour runs."""
+"""The example scenes that pour at a coarse resolution in CI. The mesh mug held by a user's arm
+(examples/mug_small_arm.toml and its 3-D variant: examples/meshes/mug.obj on examples/arms/small_arm.xml): the mount
+plate rests on the mug's handle, the payload check weighs the mesh, both scenes pass the checks `cosim pour` runs. A
+short coarse pour of each, and of the 3-D cylinder cup (examples/cylinder_cup.toml), runs."""
 
 from __future__ import annotations
 
@@ -79,15 +80,17 @@ def test_the_mug_on_the_small_arm_passes_the_pours_checks(name, dim):
     assert plan.robots.arms[ArmRole.POUR].vessel.is_mesh
 
 
-@pytest.mark.parametrize("name", ["mug_small_arm", "mug_small_arm_3d"])
-def test_a_short_coarse_mug_pour_on_the_small_arm_runs(name, tmp_path):
+@pytest.mark.parametrize("name, arm_model", [("mug_small_arm", "small_arm"), ("mug_small_arm_3d", "small_arm"),
+                                             ("cylinder_cup", "UR10e")])
+def test_a_short_coarse_example_pour_runs(name, arm_model, tmp_path):
     scene = tmp_path / "short.toml"
     text = _absolute((EXAMPLES / f"{name}.toml").read_text())
     scene.write_text(re.sub(r"(?m)^particles_across = .*$", "particles_across = 8", text))
     assert main(["pour", str(scene), "--out", str(tmp_path / "run"), "--duration", "0.3", "--no-log", "--quiet"]) == 0
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     exported = json.loads((tmp_path / "run" / "trajectory.json").read_text())["arms"]
-    assert exported["pour_arm"]["arm_model"] == "small_arm"
+    assert exported["pour_arm"]["arm_model"] == exported["catch_arm"]["arm_model"] == arm_model
     assert summary["dim"] == load_scene(EXAMPLES / f"{name}.toml").fluid.dim
-    assert summary["particle_spacing"] == pytest.approx(0.01) and summary["sim_time"] == pytest.approx(0.3, abs=0.01)
-    assert summary["volume_left_in_pourer"] == pytest.approx(summary["initial_volume"])  # still upright: all in the mug
+    spacing = load_scene(scene).vessels.pourer.spec("pourer").inner_width / 8
+    assert summary["particle_spacing"] == pytest.approx(spacing) and summary["sim_time"] == pytest.approx(0.3, abs=0.01)
+    assert summary["volume_left_in_pourer"] == pytest.approx(summary["initial_volume"])  # still upright: all inside
