@@ -68,8 +68,9 @@ class ArmSettings:
       branch: elbow up or down); []: the UR10e's seed for the UR10e, zeros (the file's reference posture) for a
       user's arm.
     grasp_pos: m, where the vessel sits on the flange: its frame's origin (the centre of its inner floor) in the
-      flange site's frame [x, y, z]; []: the held wall's outer face on the 10 mm mount plate, the flange at half the
-      wall height (the pour arm holds the back wall, the catch arm the front wall).
+      flange site's frame [x, y, z]; []: the held wall's outer face (a mesh vessel's outermost point on that side: a
+      mug's handle) on the 10 mm mount plate, the flange at half the wall height (the pour arm holds the back wall,
+      the catch arm the front wall).
     grasp_quat: the vessel frame's orientation in the flange site's frame [w, x, y, z]; []: the flange's z axis
       into the held wall, the vessel's axis along the site's x.
     """

@@ -57,15 +57,24 @@ _VESSEL_IN_SITE_ROT = {
 def vessel_in_site(vessel: VesselSpec, side: MountSide, mount_thickness: float) -> tuple[np.ndarray, np.ndarray]:
     """Pose of the vessel frame in the flange-site frame: (pos (3,) m, quat (4,) [w, x, y, z]).
 
-    The held wall's outer face lies on the plate's far face (site z = ``mount_thickness``), the flange centre at half
-    the wall height, in the vessel's mid plane y = 0.
+    The held wall's outer face (:func:`held_side_reach`) lies on the plate's far face (site z = ``mount_thickness``),
+    the flange centre at half the wall height, in the vessel's mid plane y = 0.
     """
     rot = _VESSEL_IN_SITE_ROT[side]
     quat = np.empty(4)
     mujoco.mju_mat2Quat(quat, rot.ravel())
-    half_outer = 0.5 * vessel.inner_width + vessel.wall_thickness
-    pos = np.array([-0.5 * vessel.inner_height, 0.0, mount_thickness + half_outer])
+    pos = np.array([-0.5 * vessel.inner_height, 0.0, mount_thickness + held_side_reach(vessel, side)])
     return pos, quat
+
+
+def held_side_reach(vessel: VesselSpec, side: MountSide) -> float:
+    """m, from the vessel's axis to its outermost point on the held side (-x for BACK, +x for FRONT): the wall's outer
+    face, B / 2 + wall; a mesh vessel's farthest vertex that way, so that the mount plate rests on whatever sticks
+    out of the wall there (a mug's handle) instead of passing through it."""
+    if vessel.is_mesh:
+        lo, hi = vessel.mesh.bounds[:, 0]
+        return float(-lo if side is MountSide.BACK else hi)
+    return 0.5 * vessel.inner_width + vessel.wall_thickness
 
 
 def _base_quat(placement: ArmPlacement) -> list[float]:

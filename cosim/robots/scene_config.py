@@ -158,8 +158,9 @@ class ArmPlacement:
     mount_side: :class:`MountSide`, the wall the flange holds.
     home_seed: (n,) rad, the joint configuration the home posture is solved from (picks the IK branch).
     base_quat: (4,) [w, x, y, z], the base frame's orientation in the world, instead of ``base_yaw``; None: the yaw.
-    grasp_pos: (3,) m, the vessel frame's origin in the flange site's frame; None: the held wall's outer face on the
-        mount plate, the flange at half the wall height (:func:`cosim.robots.scene_builder.vessel_in_site`).
+    grasp_pos: (3,) m, the vessel frame's origin in the flange site's frame; None: the held wall's outer face (a mesh
+        vessel's outermost point on that side) on the mount plate, the flange at half the wall height
+        (:func:`cosim.robots.scene_builder.vessel_in_site`).
     grasp_quat: (4,) [w, x, y, z], the vessel frame's orientation in the flange site's frame; None: the mount side's
         (the flange's z axis into the held wall, the vessel's z along the site's x).
     home_field: the setting a home posture out of reach is blamed on in the message (a scene file's
