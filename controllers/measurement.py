@@ -25,12 +25,14 @@ class LiquidMeasurement:
     tilt: rad, the pourer's actual tilt theta = atan2(e_z.x, e_z.z), e_z = the pourer's +z axis in world.
     theta1: rad, free-surface angle of the liquid in the pourer, in the POURER'S VESSEL FRAME, positive when the
       surface stands higher at the lip wall. Measured as: take the liquid particles inside the pourer's inner box
-      (vessel x in [-B/2, B/2], z in [0, L]); express them in the vessel frame; split x in
-      [-B/2 + h, B/2 - h] (h = SPH smoothing length) into equal columns of width h; in each column with
-      particles keep the particle with the largest vessel z (of several at that height, the one with the largest
-      vessel x); fit z = c + m x to those by least squares;
-      theta1 = atan(m). Fewer than three columns: theta1 = tilt (nothing to fit). A liquid at rest gives
-      theta1 = tilt; equivalently theta1 = tilt + atan(dz/dx) of the same surface fitted in world x-z.
+      (vessel x in [-B/2, B/2], z in [0, L]); express them in the vessel frame; the liquid's height at the
+      columns x_k = k w, k = -K..K, w = 2 dx (dx = particle spacing), K = floor((B/2 - 2 w) / w), is
+      H_k = (dx^dim / w) sum_i B((x_i - x_k) / w) / D(x_i)^(dim - 2), B the cubic B-spline (support +-2 in its
+      argument, unit integral), D(x) in 3-D the section's extent across the pour plane at x (a box's depth, a
+      cylinder's chord); fit z = c + m x to the columns with H_k > 0 by least squares; theta1 = atan(m). Fewer
+      than three such columns: theta1 = tilt (nothing to fit). A liquid at rest gives theta1 = tilt; equivalently
+      theta1 = tilt + atan(dz/dx) of the same surface fitted in world x-z. Smooth in the particle positions
+      (:mod:`cosim.coupling.free_surface`): no jump when another particle becomes a column's highest.
     h_q: m, height of the free surface over the crest point, along world z, read from the liquid's volume over the
       crest level: each particle spread as the cubic B-spline B (support +-2 in its argument) over x (and y in 3-D)
       with width w = 2 dx (dx = particle spacing) and over z with width dx, the volume over the crest's z per unit

@@ -1,18 +1,18 @@
 """What the pour controller reads from the SPH liquid each control step (``controllers.LiquidMeasurement``).
 
 Implements the measurement contract written in :class:`controllers.measurement.LiquidMeasurement` exactly
-(free-surface angle theta1 from a least-squares line through the top particle of each column of width h in the
-pourer's frame; h_q from the liquid's volume over the crest, :mod:`cosim.coupling.crest_head`; v_q through the
+(free-surface angle theta1 from a least-squares line through the liquid's column heights in the pourer's frame,
+:mod:`cosim.coupling.free_surface`; h_q from the liquid's volume over the crest, :mod:`cosim.coupling.crest_head`; v_q through the
 lip plane; volumes; lip and catcher-rim positions). The pour lip used here is where the simulated liquid leaves the
 vessel: the outer top edge of the wall as the liquid sees it (``FluidModel.wall_thickness``, at least the
 dummy-particle layers), which is also the wall thickness given to the controller, so that its jet launch point is
 the simulated one.
 
 Computed on the fluid's device, from its particle arrays as they are (any order): warp kernels reduce the
-particles to per-column maxima, fixed-order chunk sums of the liquid over the crest and of the stream leaving the
+particles to fixed-order chunk sums of the column heights, of the liquid over the crest and of the stream leaving the
 lip and the few particles crossing vessel B's rim plane; the host reads back only those, so its work per control
-step does not grow with the particle count. Every reduction is order-independent (maxima, a median of a set) or
-summed in a fixed order (chunks), so the measurement is deterministic on any device.
+step does not grow with the particle count. Every reduction is order-independent (a median of a set) or summed in
+a fixed order (chunks), so the measurement is deterministic on any device.
 """
 
 from __future__ import annotations
@@ -25,14 +25,15 @@ import warp as wp
 
 from controllers.geometry import height_above
 from controllers.measurement import LiquidMeasurement
-from cosim.coupling.crest_head import WINDOW_WIDTH, head_from_volume, head_window, sum_crest_head, volume_over_crest
+from cosim.coupling.crest_head import REACH, WINDOW_WIDTH, head_from_volume, head_window, sum_crest_head, volume_over_crest
+from cosim.coupling.free_surface import (LAYER_SPACINGS, MIN_FIT_COLUMNS, add_column_chunks, column_count, column_scale, layer_levels,
+                                         sum_columns, surface_heights, surface_line)
 from cosim.coupling.landing import BAND_SPACINGS, MIN_FALL_SPEED_FRACTION
+from cosim.coupling.pourer_frame import PourerFrame, inner_local
 from cosim.frames import Pose, tilt_about_y
-from cosim.vessel import VesselSpec
+from cosim.vessel import VesselShape, VesselSpec
 
-MIN_FIT_COLUMNS = 3  # the contract: fewer columns than this and theta1 = tilt
-CHUNKS = 64  # fixed-order reduction of the leaving stream: per-chunk sums, then the chunks in order
-LOWEST = -1.0e30  # "no particle" for the maxima
+CHUNKS = 64  # fixed-order reductions: per-chunk sums, then the chunks in order
 STREAM_SUM_COLUMNS = 5  # per chunk: count, sum vx, sum vz, sum x, sum z of the leaving particles
 
 
@@ -58,95 +59,9 @@ class MeasurementGeometry:
         return np.array([0.5 * self.pourer.inner_width + self.wall_thickness, 0.0, self.pourer.inner_height])
 
     @property
-    def column_start(self) -> float:
-        """Vessel x (m) where the surface columns start: -B/2 + h."""
-        return -0.5 * self.pourer.inner_width + self.smoothing_length
-
-    @property
     def columns(self) -> int:
-        """Number of surface columns of width h over [-B/2 + h, B/2 - h]."""
-        span = self.pourer.inner_width - 2.0 * self.smoothing_length
-        return max(int(math.floor(span / self.smoothing_length + 1e-9)), 0)
-
-
-@wp.struct
-class PourerFrame:
-    """The pourer at the measurement (world frame): origin (m) and rotation; inner half width b, half depth d and
-    height (m); 3 when the y extent counts (3-D); the surface columns' start (m, vessel x), width h (m) and count."""
-
-    origin: wp.vec3
-    rotation: wp.mat33
-    half_width: float
-    half_depth: float
-    height: float
-    dim: int
-    column_start: float
-    column_width: float
-    columns: int
-
-
-@wp.func
-def inner_local(f: PourerFrame, x: wp.vec3) -> wp.vec4:
-    """(vessel x, y, z, 1 if inside the inner box else 0) of a world point."""
-    q = wp.transpose(f.rotation) @ (x - f.origin)
-    inside = wp.abs(q[0]) <= f.half_width and q[2] >= 0.0 and q[2] <= f.height
-    if f.dim == 3 and wp.abs(q[1]) > f.half_depth:
-        inside = False
-    flag = float(0.0)
-    if inside:
-        flag = 1.0
-    return wp.vec4(q[0], q[1], q[2], flag)
-
-
-@wp.func
-def column_of(f: PourerFrame, qx: float) -> int:
-    """Surface column of a vessel x, or -1 outside the columns."""
-    if qx < f.column_start or qx >= f.column_start + float(f.columns) * f.column_width:
-        return -1
-    return wp.min(int(wp.floor((qx - f.column_start) / f.column_width)), f.columns - 1)
-
-
-@wp.kernel
-def find_column_tops(
-    # Model
-    f: PourerFrame,
-    # State in
-    x: wp.array(dtype=wp.vec3),
-    active: wp.array(dtype=wp.int32),
-    # Out
-    column_top: wp.array(dtype=float),
-):
-    """The highest vessel z of each surface column (inner particles)."""
-    i = wp.tid()
-    if active[i] == 0:
-        return
-    q = inner_local(f, x[i])
-    if q[3] > 0.0:
-        c = column_of(f, q[0])
-        if c >= 0:
-            wp.atomic_max(column_top, c, q[2])
-
-
-@wp.kernel
-def find_column_top_x(
-    # Model
-    f: PourerFrame,
-    # State in
-    x: wp.array(dtype=wp.vec3),
-    active: wp.array(dtype=wp.int32),
-    column_top: wp.array(dtype=float),
-    # Out
-    column_top_x: wp.array(dtype=float),
-):
-    """The vessel x of each column's top particle (of several at the same height: the largest x)."""
-    i = wp.tid()
-    if active[i] == 0:
-        return
-    q = inner_local(f, x[i])
-    if q[3] > 0.0:
-        c = column_of(f, q[0])
-        if c >= 0 and q[2] == column_top[c]:
-            wp.atomic_max(column_top_x, c, q[0])
+        """Number of free-surface columns (:func:`cosim.coupling.free_surface.column_count`)."""
+        return column_count(self.pourer.inner_width, self.spacing)
 
 
 @wp.kernel
@@ -219,17 +134,6 @@ def collect_rim_crossing(
         crossing_x[slot] = xi[0]
 
 
-def free_surface_line(top_x: np.ndarray, top_z: np.ndarray) -> tuple[float, float, int]:
-    """(c, slope, columns): least-squares line z = c + slope x through the columns' top particles (vessel frame;
-    a column without particles has top z = :data:`LOWEST`); (0, 0, columns) with fewer than MIN_FIT_COLUMNS."""
-    used = top_z > 0.5 * LOWEST
-    columns = int(used.sum())
-    if columns < MIN_FIT_COLUMNS:
-        return 0.0, 0.0, columns
-    slope, c = np.polyfit(top_x[used], top_z[used], 1)
-    return float(c), float(slope), columns
-
-
 class LiquidProbe:
     """The controller's measurement of a liquid of ``n_particles`` on ``device`` (scratch arrays allocated once).
 
@@ -241,8 +145,10 @@ class LiquidProbe:
         self.n = n_particles
         self.device = device
         cols = max(geo.columns, 1)
-        self._column_top = wp.zeros(cols, dtype=float, device=device)
-        self._column_top_x = wp.zeros(cols, dtype=float, device=device)
+        self._column_sums = wp.zeros((CHUNKS, cols), dtype=float, device=device)
+        self._column_heights = wp.zeros(cols, dtype=float, device=device)  # M_k (m)
+        self._column_levels = wp.zeros(cols, dtype=float, device=device)  # z_k (m)
+        self._column_volumes = wp.zeros(cols, dtype=float, device=device)  # m_k (m)
         self._head_sums = wp.zeros(CHUNKS, dtype=float, device=device)
         self._sums = wp.zeros((CHUNKS, STREAM_SUM_COLUMNS), dtype=float, device=device)
         self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
@@ -254,9 +160,7 @@ class LiquidProbe:
         self._pourer_frame.half_depth = 0.5 * spec.section_depth
         self._pourer_frame.height = spec.inner_height
         self._pourer_frame.dim = geo.dim
-        self._pourer_frame.column_start = geo.column_start
-        self._pourer_frame.column_width = geo.smoothing_length
-        self._pourer_frame.columns = geo.columns
+        self._pourer_frame.round_section = int(geo.dim == 3 and spec.shape is VesselShape.CYLINDER)
 
     def _launch(self, kernel, dim: int, inputs: list, outputs: list) -> None:
         """``wp.launch(kernel, dim, inputs, outputs)`` through a recorded launch kept per kernel and array set (the
@@ -290,17 +194,20 @@ class LiquidProbe:
         frame = self._frame(pourer_pose)
         tilt = tilt_about_y(pourer_pose.rotation)
         crest = pourer_pose.transform(geo.crest_local[None, :])[0]
-        self._column_top.fill_(LOWEST)
-        self._column_top_x.fill_(LOWEST)
         chunk = max(math.ceil(self.n / CHUNKS), 1)
-        if self.n:
-            self._launch(find_column_tops, self.n, [frame, x, active], [self._column_top])
-            self._launch(find_column_top_x, self.n, [frame, x, active, self._column_top], [self._column_top_x])
+        if geo.columns:
+            scale, sums = column_scale(dx, geo.dim), self._column_sums
+            columns = [frame, WINDOW_WIDTH * dx, dx, geo.columns, self.n, chunk, x, active, self._column_levels]
+            self._launch(sum_columns, CHUNKS, [*columns, 0], [sums])
+            self._launch(add_column_chunks, geo.columns, [sums, CHUNKS, scale], [self._column_heights])
+            self._launch(layer_levels, geo.columns, [self._column_heights, LAYER_SPACINGS * dx, float(REACH) * dx], [self._column_levels])
+            self._launch(sum_columns, CHUNKS, [*columns, 1], [sums])
+            self._launch(add_column_chunks, geo.columns, [sums, CHUNKS, scale], [self._column_volumes])
         window = wp.vec3(*head_window(crest, dx))
         self._launch(sum_crest_head, CHUNKS, [window, dx, WINDOW_WIDTH * dx, geo.dim, self.n, chunk, x, active], [self._head_sums])
-        top_z = self._column_top.numpy().astype(np.float64)[: geo.columns]
-        top_x = self._column_top_x.numpy().astype(np.float64)[: geo.columns]
-        c, slope, columns = free_surface_line(top_x, top_z)
+        levels = self._column_levels.numpy().astype(np.float64)[: geo.columns]
+        heights = surface_heights(levels, self._column_volumes.numpy().astype(np.float64)[: geo.columns], dx)
+        c, slope, columns = surface_line(heights, dx)
         theta1 = math.atan(slope) if columns >= MIN_FIT_COLUMNS else tilt
 
         volume = volume_over_crest(self._head_sums.numpy(), dx, geo.dim)

@@ -4,7 +4,7 @@ A box (inner width B) or cylindrical cup (inner diameter D, 3-D only) filled to 
 tilted by :data:`TILT_ANGLE` over :data:`TILT_DURATION` (theta = angle (1 - cos(pi t / T)) / 2) about a pivot on
 its axis, then held for ``hold`` seconds. The pivots sit at :data:`PIVOT_FRACTIONS` of the potential-flow hinge H
 above the inner floor, on both sides of it. The slosh angle sigma = theta1 - theta is what the pour controller
-reads (:class:`cosim.coupling.measure.LiquidProbe`: the free-surface line through the columns' top particles),
+reads (:class:`cosim.coupling.measure.LiquidProbe`: the free-surface line through the liquid's column heights),
 sampled every 2 ms. :mod:`cosim.validation.plant_fit` fits the ring-downs jointly (one omega1 and damping ratio,
 one phasor per run) and identifies the hinge (the zero of the residual amplitude, a line in the pivot height); the potential-flow model is
 evaluated for the liquid's actual depth (its volume over the floor area: the lattice holds whole layers).

@@ -10,32 +10,36 @@ import numpy as np
 
 from controllers.geometry import height_above
 from cosim.coupling.landing import BAND_SPACINGS, MIN_FALL_SPEED_FRACTION
-from cosim.coupling.measure import MIN_FIT_COLUMNS, MeasurementGeometry
+from cosim.coupling.free_surface import MIN_FIT_COLUMNS
+from cosim.coupling.measure import MeasurementGeometry
 from cosim.frames import Pose, tilt_about_y
+from cosim.vessel import VesselShape
 
 
 def reference_measure(geo: MeasurementGeometry, pourer: Pose, catcher: Pose, x: np.ndarray, v: np.ndarray) -> dict:
     """theta1, h_q, v_q, v_q_z, jet_dx, jet_dz, lip_x, lip_z, catcher_rim_z of the active particles x, v (N, 3)."""
-    spec, dx, h = geo.pourer, geo.spacing, geo.smoothing_length
+    spec, dx = geo.pourer, geo.spacing
     b, d, height = 0.5 * spec.inner_width, 0.5 * spec.section_depth, spec.inner_height
     tilt = tilt_about_y(pourer.rotation)
     local = pourer.inverse_transform(x)
     inner = (np.abs(local[:, 0]) <= b) & (local[:, 2] >= 0.0) & (local[:, 2] <= height)
     if geo.dim == 3:
         inner &= np.abs(local[:, 1]) <= d
-    lo, n_cols = -b + h, geo.columns
     q = local[inner]
-    sel = (q[:, 0] >= lo) & (q[:, 0] < lo + n_cols * h)
-    col = np.minimum(np.floor((q[sel, 0] - lo) / h).astype(int), n_cols - 1)
-    qx, qz = q[sel, 0], q[sel, 2]
-    top = np.full(n_cols, -np.inf)
-    np.maximum.at(top, col, qz)
-    top_x = np.full(n_cols, -np.inf)
-    is_top = qz == top[col]
-    np.maximum.at(top_x, col[is_top], qx[is_top])
-    used = np.isfinite(top)
+    across = np.ones(len(q))
+    if geo.dim == 3:
+        across = 2.0 * (np.sqrt(np.maximum(b * b - q[:, 0] ** 2, 0.0)) if spec.shape is VesselShape.CYLINDER else np.full(len(q), d))
+        q, across = q[across > 0.0], across[across > 0.0]
+    w = 2.0 * dx  # the columns' B-spline width and spacing
+    n_cols = geo.columns
+    xs = (np.arange(n_cols) - n_cols // 2) * w
+    weights = [_bspline((q[:, 0] - xk) / w) / across ** (geo.dim - 2) * dx**geo.dim / w for xk in xs]
+    levels = [max(weight.sum() - 3.0 * dx, 2.0 * dx) for weight in weights]  # z_k: three spacings under M_k
+    volumes = np.array([(weight * _bspline_integral((q[:, 2] - z) / dx)).sum() for weight, z in zip(weights, levels)])
+    used = volumes > 0.0
+    heights = np.array([z + dx * _level_for_volume(m / dx) if m > 0.0 else np.nan for z, m in zip(levels, volumes)])
     if used.sum() >= MIN_FIT_COLUMNS:
-        slope, c = np.polyfit(top_x[used], top[used], 1)
+        slope, c = np.polyfit(xs[used], heights[used], 1)
         theta1 = math.atan(slope)
     else:
         c, theta1 = 0.0, tilt
