@@ -29,8 +29,9 @@ from cosim.bench.host_overhead import POUR_WARM_UP, time_steps
 from cosim.coupling import loop
 from cosim.coupling.loop import CoupledPour
 from cosim.errors import InputError
-from cosim.fluid.config import MAX_CPU_THREADS
+from cosim.fluid.config import FluidConfig
 from cosim.pour_run import prepare
+from cosim.setting import declared
 from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene
 
 SUBSTEPS = "the liquid's substeps (replay)"
@@ -104,8 +105,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if not 0.0 < args.duration <= 60.0:
             raise InputError(f"--duration: must be in (0, 60] s, got {args.duration:g}")
-        if not 0 <= args.threads <= MAX_CPU_THREADS:
-            raise InputError(f"--threads: must be in [0, {MAX_CPU_THREADS}], got {args.threads}")
+        declared(FluidConfig, "cpu_threads").check("--threads", args.threads)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
