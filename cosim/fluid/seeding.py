@@ -11,7 +11,9 @@ lies half a ring spacing inside the wall, whose first layer of dummy particles l
 holds 8-15 % less liquid than pi R^2 times its layers at 32-16 particles across, so the liquid's depth at rest
 would depend on how far it spreads into the gap. The rings do not start exactly at rest density: each ring's count is
 rounded, so its particles' kernel sums differ from the lattice's by up to about 2 % (the three-particle centre ring
-and the rings over the floor most), which the pressure solver removes in its first steps.
+and the rings over the floor most). The pressure solver removes that error in its first substep as a velocity that
+the liquid keeps (a lasting agitation), so a run that needs the liquid at rest relaxes it first
+(:meth:`cosim.fluid.solver.FluidSolver.relax`).
 """
 
 from __future__ import annotations

@@ -167,20 +167,29 @@ def run_scripted(
     device: str = "cpu",
     can_spill: bool = True,
     observer: RunObserver | None = None,
+    settle: float = 0.0,
 ) -> ScriptedRun:
     """Fill ``spec`` to ``fill`` (m), move it along ``pose_at`` for ``duration`` (s) in intervals of
     :data:`SAMPLE_INTERVAL`, checking leaks after each; a :class:`FluidInstabilityError` ends the run and is
-    returned as ``failure``. ``can_spill`` False counts any particle out of the vessel as a leak."""
+    returned as ``failure``. ``can_spill`` False counts any particle out of the vessel as a leak. ``settle`` > 0
+    (s): the seeded liquid first relaxes at the first pose (:meth:`FluidSolver.relax`), and the script starts from
+    the relaxed liquid at rest."""
     pose0 = pose_at(0.0)
     solver = FluidSolver(cfg, [spec], [pose0], fill_vessel(spec, fill, cfg, pose0), device=device)
+    failure = ""
+    if settle > 0.0:
+        try:
+            solver.relax(settle, SAMPLE_INTERVAL)
+        except FluidInstabilityError as exc:
+            failure = str(exc)
     regions = WallRegions.of(spec, solver)
     leaks = LeakMonitor.start(regions, cfg.spacing, pose0.inverse_transform(solver.positions()), can_spill)
-    run = ScriptedRun(solver, leaks, "", 0.0)
+    run = ScriptedRun(solver, leaks, failure, 0.0)
     if observer is not None:
         observer.start(solver)
     start = time.perf_counter()
     try:
-        while solver.time < duration - 1e-9:
+        while not run.failure and solver.time < duration - 1e-9:
             before = solver.vessel_poses()[0]
             solver.set_vessel_poses([pose_at(solver.time + SAMPLE_INTERVAL)])
             solver.advance(SAMPLE_INTERVAL)
