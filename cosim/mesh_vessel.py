@@ -101,6 +101,10 @@ class VesselMesh:
         area_z = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])[:, 2]
         return float(np.sum((height - tri[:, :, 2].mean(axis=1)) * area_z))
 
+    def section_segments(self) -> np.ndarray:
+        """(k, 2, 3) m: the liquid-facing faces' section by the pour plane y = 0, the walls the 2-D liquid sees."""
+        return _plane_section(self.vertices, self.faces[self.liquid_facing])[0]
+
     def section_area(self, height: float) -> float:
         """m^2 of the cavity's pour-plane section (y = 0) below ``height`` (m): S(z) = sum_s L_s (z - z_s) n_s,z over
         the section's segments clipped at z (n_s: the wall's outward normal in the plane)."""

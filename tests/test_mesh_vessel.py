@@ -20,7 +20,7 @@ from cosim.fluid.config import FluidConfig
 from cosim.fluid.mesh_boundary import mesh_guard
 from cosim.fluid.mesh_sampling import MeshQueries, warp_mesh
 from cosim.fluid.seeding import fill_vessel
-from cosim.fluid.wall_sampling import sample_vessel_walls, wetted_layer
+from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls, wetted_layer
 from cosim.mesh_vessel import load_vessel_mesh
 from cosim.pour_scene import load_scene
 from cosim.robots.vessel_mjcf import vessel_mjcf
@@ -175,6 +175,21 @@ def test_the_box_mesh_gives_the_box_liquid_and_walls():
         assert wetted_layer(beaker(), walls, cfg.spacing, dim).sum() == wetted_layer(BEAKER_BOX, box_walls, cfg.spacing, dim).sum()
         # the same layers but for the outer corners more than the layers' thickness from the cavity
         assert 0.9 * len(box_walls) < len(walls) <= len(box_walls)
+
+
+@pytest.mark.parametrize("across", [24, 40])
+def test_the_2d_mug_holds_the_liquid_and_floor_of_the_box_of_its_section(across):
+    """In the pour plane the mug is an 80 mm box (the 48-gon has a corner there): the 2-D liquid fills its section as
+    the box's fills the box (a column short, it settles with a partial top layer), and the floor's wall samples hold
+    the box floor's volume, 2 b t per unit depth."""
+    mug = mesh_vessel_spec("pourer", load_vessel_mesh(MUG))
+    box = VesselSpec("pourer", VesselShape.BOX, 0.08, mug.section_depth, 0.10, 0.004, 1000.0)
+    cfg = FluidConfig(dim=2, spacing=0.08 / across)
+    np.testing.assert_array_equal(fill_vessel(mug, 0.07, cfg).positions, fill_vessel(box, 0.07, cfg).positions)
+    walls, volumes = sample_vessel_walls(mug, cfg.spacing, cfg.support_radius, 2)
+    floor = (walls[:, 2] < 0.0) & (np.abs(walls[:, 0]) < 0.04)
+    thickness = numerical_wall_thickness(mug, cfg.spacing, cfg.support_radius)
+    assert volumes[floor].sum() == pytest.approx(0.08 * thickness, rel=1e-12)
 
 
 def test_the_mujoco_body_weighs_the_mesh_and_collides_by_convex_parts():

@@ -10,7 +10,11 @@ layers that cover the kernel support behind every wetted face (Adami, Hu & Adams
 than t they reach beyond its outer face, as the box's do. Each particle's volume is dx^dim; in 2-D only y = 0.
 
 Liquid (:func:`fill_mesh_vessel`): the lattice of :func:`cosim.fluid.seeding.liquid_block` over the cavity's
-bounding box, kept where it is in the cavity and at least dx/2 from the liquid-facing faces.
+bounding box, kept where it is in the cavity and at least dx/2 from the liquid-facing faces, as the box's lattice
+lies dx/2 inside its walls. In 2-D the distance is taken in the pour plane, to the faces' section by it (the walls
+the 2-D liquid sees): the distance in space to a face inclined to the plane is shorter, and would leave out lattice
+points the 2-D walls leave room for (the outermost column in a revolved vessel whose polygon has a corner in the
+plane), a gap the liquid fills as it settles, leaving a disordered surface with a partial top layer.
 """
 
 from __future__ import annotations
@@ -129,9 +133,21 @@ def mesh_wetted_layer(spec: VesselSpec, points: np.ndarray, spacing: float) -> n
     return classify(spec, points, 2.0 * spacing)[1] < spacing
 
 
-def fill_mesh_vessel(spec: VesselSpec, local: np.ndarray, spacing: float) -> np.ndarray:
+def pour_plane_distance(segments: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(n,) m: the distance in the pour plane (x, z) from each of ``points`` (n, 3) to the nearest of the section's
+    ``segments`` (k, 2, 3) (:meth:`cosim.mesh_vessel.VesselMesh.section_segments`)."""
+    p = points[:, None, [0, 2]]
+    a, b = segments[None, :, 0, [0, 2]], segments[None, :, 1, [0, 2]]
+    ab = b - a
+    f = np.clip(np.sum((p - a) * ab, axis=2) / np.maximum(np.sum(ab * ab, axis=2), 1e-300), 0.0, 1.0)
+    return np.linalg.norm(p - (a + f[:, :, None] * ab), axis=2).min(axis=1)
+
+
+def fill_mesh_vessel(spec: VesselSpec, local: np.ndarray, spacing: float, dim: int) -> np.ndarray:
     """(n,) bool: which lattice points ``local`` (vessel frame) the liquid filling the mesh vessel keeps: those in its
-    cavity at least half a ``spacing`` from its liquid-facing faces (a thousandth of a spacing spared for the
-    queries' float32 rounding)."""
+    cavity at least half a ``spacing`` from its liquid-facing faces, in 2-D from their section by the pour plane
+    (module doc; a thousandth of a spacing spared for the queries' float32 rounding)."""
     inside, distance, _, _ = classify(spec, local, spacing)
+    if dim == 2:
+        distance = pour_plane_distance(spec.mesh.section_segments(), local)
     return inside & (distance >= (0.5 - 1e-3) * spacing)

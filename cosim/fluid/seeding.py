@@ -136,7 +136,7 @@ def fill_vessel(spec: VesselSpec, fill_depth: float, cfg: FluidConfig, pose: Pos
     if spec.is_mesh:
         (lo_x, lo_y, _), (hi_x, hi_y, _) = cavity_bounds(spec)
         local = liquid_block((lo_x, lo_y, 0.0), (hi_x, hi_y, fill_depth), cfg, None).positions
-        local = local[fill_mesh_vessel(spec, local, dx)]
+        local = local[fill_mesh_vessel(spec, local, dx, cfg.dim)]
         local = local[local[:, 2] < n_z * dx]
     elif spec.is_box or cfg.dim == 2:
         b = 0.5 * spec.inner_width
