@@ -40,7 +40,7 @@ GIGA = 1e9
 
 @dataclass(frozen=True)
 class TargetSizes:
-    """What the measurements run: the issue's sizes by default (tests use small ones, whose numbers mean nothing).
+    """What the measurements run: the targets' sizes by default (tests use small ones, whose numbers mean nothing).
 
     throughput_3d / throughput_2d: particles of the resting block (:func:`cosim.bench.fluid_throughput.resting_block`).
     steps: WCSPH substeps per timed interval; repeats: timed intervals (medians). pour_3d_across: particles across
@@ -60,7 +60,7 @@ class TargetSizes:
 
 @dataclass(frozen=True)
 class Target:
-    """name: the target as the issue states it. device: 'cuda' or 'cpu', where it is set. threshold, unit: the
+    """name: the target as the report states it. device: 'cuda' or 'cpu', where it is set. threshold, unit: the
     figure to reach; at_least: True if the figure must be at least the threshold, False if at most."""
 
     name: str
