@@ -51,7 +51,7 @@ constraints' gradient, so the solve is stable; with the wall term carrying the p
 previous form, as SPlisHSPlasH's Akinci boundary) the constant part of the pressure pushed the rows next to a wall
 onto it (the bottom row 1.1 mm above the floor instead of dx/2, at twice the hydrostatic pressure) and the column
 settled 1 mm low (hydrostatic validation -3.8 %). Mirroring the particle's pressure onto the wall instead is not a
-constraint gradient and blew the resting column up (README, Known limitations). The deeper layers lack the layers
+constraint gradient and blew the resting column up (docs/physics-and-validation.md, Design notes). The deeper layers lack the layers
 beyond the last in their kernel support, so they only contribute density. The stiffness each particle applied
 over both solves, kappa_i, is kept: it gives the reported pressure p_i = rho_i kappa_i (the pressure whose impulse
 acted over dt; reported as its average over the interval), the wall reaction, and the warm start of the next
