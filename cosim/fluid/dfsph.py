@@ -47,11 +47,10 @@ constraint form): the layer of dummy wall particles that faces the liquid (``Flu
 density like liquid that does not move, each wall particle b with its own stiffness k_b (its density rate
 sum_j m_j (v_b - v_j) . grad W_bj from the liquid moving against the wall, its factor from the density change its
 push on the liquid causes, warm-started as the liquid's). The force on the liquid stays the transpose of the
-constraints' gradient, so the solve is stable; with the wall term carrying the particle's own stiffness only (the
-previous form, as SPlisHSPlasH's Akinci boundary) the constant part of the pressure pushed the rows next to a wall
-onto it (the bottom row 1.1 mm above the floor instead of dx/2, at twice the hydrostatic pressure) and the column
-settled 1 mm low (hydrostatic validation -3.8 %). Mirroring the particle's pressure onto the wall instead is not a
-constraint gradient and blew the resting column up (docs/physics-and-validation.md, Design notes). The deeper layers lack the layers
+constraints' gradient, so the solve is stable. A wall term carrying only the particle's own stiffness (as
+SPlisHSPlasH's Akinci boundary) lets the constant part of the pressure push the rows next to a wall onto it, and the
+column settles low; mirroring the particle's pressure onto the wall is not a constraint gradient and blows a resting
+column up (the measurements: docs/physics-and-validation.md, Design notes). The deeper layers lack the layers
 beyond the last in their kernel support, so they only contribute density. The stiffness each particle applied
 over both solves, kappa_i, is kept: it gives the reported pressure p_i = rho_i kappa_i (the pressure whose impulse
 acted over dt; reported as its average over the interval), the wall reaction, and the warm start of the next
