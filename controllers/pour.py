@@ -8,9 +8,8 @@ A partial pour ends with CFS_FINAL: CFS holding ``cfs.final_head_fraction`` of h
 still to pour before the predicted after-flow would leave within ``cfs.final_stage_time`` at the current rate. The
 stop has to predict the after-flow (what still leaves while the vessel turns back,
 :func:`controllers.cfs.after_flow_volume`, with the vessel's lag behind its command fitted over the last
-LAG_WINDOW s). In seven coupled partial pours it came out -18 to +23 % off the actual after-flow; the smaller
-outflow at the stop makes that error a smaller share of the target (at the full head the after-flow was 19 % of a
-50 % pour, from the final stage 4-8 %).
+LAG_WINDOW s). That prediction is uncertain by about a fifth of the after-flow (docs/tuning.md); the smaller
+outflow at the stop makes that error a smaller share of the target.
 
 Call :meth:`PourController.step` once per control period (``config.dt``, 10 ms by default) with a
 :class:`controllers.measurement.LiquidMeasurement`; it returns a :class:`controllers.measurement.PourCommand`.
@@ -53,14 +52,15 @@ OUTFLOW_FILTER_STAGES = 2
 DEEPEST_TILT_FILTER_TIME = 0.5
 # CFS has stalled when, over the last cfs.max_tilt_hold s, less than this fraction of the initial volume left and
 # the tilt rose by less than STALL_TILT: near 90 deg the crest's lever degenerates and the last wedge of liquid
-# only drips (default scene: 139 mL left, about 5 mL/s, for 26 s at 89 deg).
+# only drips, for tens of seconds, at a few mL/s.
 STALL_FRACTION = 0.005
 STALL_TILT = 0.01  # rad
 # Tilt (rad) within which a rate-limited tilt counts as arrived (approach target, upright): 0.006 deg.
 ARRIVAL_TOLERANCE = 1e-4
 # The vessel's lag behind its commanded tilt, for the after-flow prediction: fitted as a pure delay
 # (controllers.motion.fitted_delay) over the last LAG_WINDOW s of commanded and measured tilt, between 0 and
-# MAX_FOLLOWER_LAG s in steps of half a control period. The coupled pour's task-space filter and arm fit 0.08-0.1 s.
+# MAX_FOLLOWER_LAG s in steps of half a control period; the bound leaves room above the coupled pour's task-space
+# filter and arm (docs/tuning.md).
 LAG_WINDOW = 0.5  # s, about one slosh period of the vessel of Camporredondo et al. (2019)
 MAX_FOLLOWER_LAG = 0.3  # s
 

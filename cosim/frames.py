@@ -69,8 +69,8 @@ def tilt_about_y(r: np.ndarray) -> float:
 def rotation_vector(r: np.ndarray) -> np.ndarray:
     """Axis-angle vector (rad) of a rotation matrix: the log map, angle in [0, pi].
 
-    On plain floats (the step loop calls it twice per MuJoCo step; numpy's per-call cost on nine numbers was most of
-    it), with the operations and their order of the array expressions it replaced: the same bits."""
+    On plain floats (the step loop calls it twice per MuJoCo step, and on nine numbers numpy's per-call overhead would
+    outweigh the arithmetic), with the operations and their order of the equivalent array expressions: the same bits."""
     (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = np.asarray(r, dtype=float).tolist()
     angle = math.acos(min(max(0.5 * (r00 + r11 + r22 - 1.0), -1.0), 1.0))
     axis = (r21 - r12, r02 - r20, r10 - r01)

@@ -192,7 +192,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
     recorder = None
     try:
         # imported here: prepare() needs neither rerun-sdk nor tqdm, and a pour without its recording needs no
-        # rerun-sdk (the GPU machine has none; README, Speed)
+        # rerun-sdk (a headless machine may not have it installed)
         from tqdm import tqdm
 
         callbacks = []

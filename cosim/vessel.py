@@ -29,8 +29,8 @@ ACRYLIC_DENSITY = 1180.0
 def _left_to_right_sum(values) -> float:
     """The floats added left to right, whatever the Python version. Python 3.12's built-in sum() compensates its
     rounding (Neumaier) and 3.11's does not: the two gave the default vessels' wall volumes one ulp apart, so the
-    vessels' masses in MuJoCo differed and, the pour being chaotic, so did the whole default pour (README, Known
-    limitations, reproducibility)."""
+    vessels' masses in MuJoCo differed and, the pour being chaotic, so did the whole default pour
+    (docs/reproducibility.md, Across machines)."""
     return functools.reduce(operator.add, values, 0.0)
 
 

@@ -46,7 +46,7 @@ def test_pour_rows_split_the_wall_time_into_substeps_and_the_rest():
 
 def test_a_check_past_its_limit_is_reported_with_what_it_printed(tmp_path, monkeypatch):
     # a limit far below the child's start-up (Python, numpy, warp): the check is stopped, the report says so, and its
-    # log is written (what it printed before the limit: the device tool returns only what lies under $OUT)
+    # log is written (what it printed before the limit, in the output folder, which is all a remote run may return)
     monkeypatch.setitem(device_check.TIME_LIMITS, "agreement", 0.01)
     assert device_check.main(["--device", "cpu", "--quick", "--only", "agreement", "--out", str(tmp_path)]) == 1
     assert "timed out after" in (tmp_path / "device_check.md").read_text()

@@ -149,10 +149,10 @@ def test_partial_pour_reaches_its_target_and_holds_h_q() -> None:
 
 
 def test_partial_pour_does_not_stop_as_the_head_first_rises() -> None:
-    """Regression, from a coupled SPH pour (50 %, start delay 0.35 s; its measurements in tests/data) with the
-    paper's crest hand-over: CFS began as the slosh spilled over the crest. The head's filter had been fed the negative heads before, so it stood just
-    above zero while the filtered outflow rate did not, and the after-flow, which scales that rate by (head /
-    filtered head)^(3/2), came out as the whole vessel (3064 mL): the pour stopped with 14 mL poured. Replayed
+    """A coupled SPH pour's measurements (50 %, start delay 0.35 s; in tests/data) with the paper's crest hand-over:
+    CFS begins as the slosh spills over the crest. A head filter fed the negative heads before would stand just
+    above zero while the filtered outflow rate does not, and the after-flow, which scales that rate by (head /
+    filtered head)^(3/2), would come out as the whole vessel (3064 mL) and stop the pour with 14 mL poured. Replayed
     from those measurements the controller must still be in CFS."""
     config = PourConfig(
         vessel=VesselGeometry(0.191, 0.191, 0.01790625, 0.1), fill_depth=0.16115624999999997,

@@ -1,8 +1,8 @@
 """Every warp kernel module of the project compiles for the GPU machines' architecture (NVRTC, ahead of time).
 
-This machine and CI have no GPU, so nothing else checks the CUDA build: a CPU-only construct in a kernel module (the
-lanes' barrier was one, GCC atomics in native code) would otherwise surface only in a GPU session. Skipped where
-warp has no NVRTC for that architecture."""
+A CPU-only test run (CI has no GPU) checks nothing else of the CUDA build: a CPU-only construct in a kernel module
+(such as GCC atomics in native code, which the lanes' barrier uses) would otherwise surface only on a GPU. Skipped
+where warp has no NVRTC for that architecture."""
 
 from __future__ import annotations
 

@@ -70,7 +70,8 @@ def _packed_block_kick(free_liquid: bool, density_of_the_packing: bool) -> float
 
 def test_packed_liquid_leaving_a_vessel_keeps_its_pressure():
     # free liquid starts where the liquid has separated: a packed particle switched to its summation density's
-    # Tait pressure (what the packing's density gives, second run) flew off the pourer's lip at ~1 m/s (README)
+    # Tait pressure (what the packing's density gives, second run) flies off the pourer's lip at ~1 m/s
+    # (docs/physics-and-validation.md, Free once separated)
     assert _packed_block_kick(free_liquid=True, density_of_the_packing=False) <= BALLISTIC_TOLERANCE
     assert _packed_block_kick(free_liquid=False, density_of_the_packing=True) > 100 * BALLISTIC_TOLERANCE
 
@@ -120,7 +121,8 @@ def test_outflow_falls_on_its_parabola_as_free_liquid():
 
 @pytest.mark.slow
 def test_outflow_under_the_continuity_density_lands_short():
-    # the validation can fail: the continuity density's tension decelerates the falling stream (README)
+    # the validation can fail: the continuity density's tension decelerates the falling stream
+    # (docs/physics-and-validation.md, The falling stream)
     r = free_fall.run(free_fall.Params(particles_across=16, solver="wcsph", numerics=(("free_liquid", False),)))
     assert r.raw["median_abs_error"] > free_fall.LANDING_TOLERANCE and r.raw["mean_error"] < 0.0
     assert not r.passed

@@ -101,9 +101,8 @@ def test_guard_leaves_free_paths_alone():
 @pytest.mark.parametrize("dim", [2, 3])
 def test_guard_lets_a_particle_leave_a_wall_face_it_rests_on(dim):
     # A particle resting exactly on a face (bitwise, as liquid lying on a wall does now and then in float32) and
-    # moving off it touches the slab only at the start of its path. Before this test the guard took that for an
-    # entry and put the particle on the wall's far side: the default pour at start delay 0.25 s stopped with a
-    # "breach" one wall thickness deep (README, Pour results).
+    # moving off it touches the slab only at the start of its path. The guard must not take that for an entry and
+    # put the particle on the wall's far side (a "breach" one wall thickness deep, which stops a pour).
     inner, outer = float(B), float(B + T)
     paths = [
         ((inner, 0.0, 0.1), (inner - 4e-7, 0.0, 0.1)),  # on the inner face, back into the liquid
@@ -149,9 +148,9 @@ def test_guard_against_sampled_paths_near_the_walls(shape, dim):
     # zero with probability 0.3 (paths lying in a face's plane). Every path that ends inside the walls is caught and
     # none is left inside; a path that never enters (sampled at 2000 points in float64) is left where it went. (A
     # path that clips a corner within one step and ends outside is not asserted on: the cylinder's guard tests end
-    # points and lets it be.) Before 911fb23 a path leaving a face it started on was thrown through the wall; before
-    # the slabs overlapped, a path lying in the plane of a face two slabs shared (along the floor's plane under a
-    # side wall) passed into the wall, and an edge start could end inside the neighbouring slab.
+    # points and lets it be.) The cases this covers: a path leaving a face it started on (not to be thrown through the
+    # wall), a path lying in the plane of a face two slabs share (along the floor's plane under a side wall: the
+    # slabs overlap so that it cannot pass into the wall), and an edge start (not to end inside the neighbouring slab).
     rng = np.random.default_rng(7)
     n = 20000
     z = rng.uniform(-0.025, 0.215, n)

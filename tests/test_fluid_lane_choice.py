@@ -22,7 +22,7 @@ def _run(choice: ReplayChoice, cost_ms, intervals: int = INTERVALS) -> float:
 
 
 def test_busy_cores_run_on_one_thread_at_most_a_few_percent_slower():
-    # a competing process: the lanes at once 3.6 x slower than one thread (measured on the default pour)
+    # a competing process makes the lanes at once several times slower than one thread
     choice = ReplayChoice()
     total = _run(choice, lambda parallel, _: 7.2 if parallel else 2.0)
     assert not choice.current

@@ -144,7 +144,7 @@ def test_instability_is_raised_naming_the_step_and_the_cause():
 
 
 def test_instability_messages_count_in_words():
-    # the pour at start delay 0.25 s stopped with "1 particles inside a vessel wall" (README, Pour results)
+    # an instability message names its counts in words: "1 particle inside a vessel wall", not "1 particles"
     assert count_of(1, "particle") == "1 particle"
     assert count_of(0, "particle") == "0 particles" and count_of(40, "particle") == "40 particles"
 

@@ -210,7 +210,7 @@ def test_unreadable_scene_file_and_busy_output_folder(tmp_path, capsys):
 
 
 def test_a_recording_without_rerun_sdk_is_one_line_exit_2_and_writes_nothing(tmp_path, capsys, monkeypatch):
-    # as on the GPU machine, which has no rerun-sdk: the pour with its recording is refused before anything runs,
+    # as on a machine without rerun-sdk: the pour with its recording is refused before anything runs,
     # the message saying how to run it without the recording (which needs no rerun-sdk)
     import cosim.pour_checks
 
@@ -315,7 +315,7 @@ def test_a_partial_pour_reports_its_target_and_error(tmp_path):
 
 
 def test_coarsest_resolution_pours_with_the_head_floor_capped_at_the_cfs_limit(tmp_path):
-    # 8 across: 2.5 spacings of 23.9 mm would be a 60 mm head, over cfs.h_q_ref's 0.05 m limit (the pour used to
-    # stop there with an error about cfs.h_q_ref, a key the scene did not set)
+    # 8 across: 2.5 spacings of 23.9 mm would be a 60 mm head, over cfs.h_q_ref's 0.05 m limit (uncapped, the pour
+    # would stop with an error about cfs.h_q_ref, a key the scene did not set)
     summary = _tiny_pour(tmp_path, "coarse", "")
     assert summary["cfs_head_reference"] == CFS_MAX_HEAD < 2.5 * summary["particle_spacing"]

@@ -52,13 +52,13 @@ AGREEMENT_INTERVAL = 0.004  # s
 # s simulated and timed per pour, by dimension (after the warm-up): the 3-D pour at 112k particles plans 30,000
 # WCSPH substeps per simulated second (3,000 DFSPH), 15 s at 1 ms a substep
 POUR_SECONDS = {2: 2.0, 3: 0.5}
-# slosh periods run (the frequency is measured from a quarter period after the pulse: at 2 the window held too few
-# zero crossings and gave nan)
+# slosh periods run (the frequency is measured from a quarter period after the pulse: 2 periods leave the window
+# too few zero crossings to give one)
 SLOSH_PERIODS = 3.0
 HOST_PROFILE_SECONDS = 0.5  # s of the 2-D pour simulated under cProfile (its host side: pour_host_profile.txt)
 HOST_PROFILE_LINES = 30  # functions listed
 POUR_3D_ACROSS = 64  # particles across the pourer of the 3-D pour: 111,936 particles
-# seconds each check may take on the device machine: together within one 600 s call of the device tool
+# seconds each check may take: together within 600 s, so that all of them fit one time-limited run on a GPU machine
 TIME_LIMITS = {"agreement": 90, "validation": 90, "throughput": 120, "pour": 180, "profile": 90}
 CHECKS = tuple(TIME_LIMITS)
 

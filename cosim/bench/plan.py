@@ -23,8 +23,8 @@ from cosim.pour_scene import STREAM_PARTICLES, FluidSettings
 POUR_SECONDS = 3.0  # s simulated per pour row
 REFERENCE_ACROSS = 48  # particles across the pourer of the reference pour (1.5 x the default scene's 32)
 # The reference pour's pressure solver: WCSPH whatever the default scene's solver is. A reference computed with the
-# default's own solver would favour the default in the equal-error comparison of the two solvers; WCSPH, the
-# solver every earlier table was referenced to, favours the solver the default does not use.
+# default's own solver would favour the default in the equal-error comparison of the two solvers; a WCSPH
+# reference favours, if anything, the solver the default does not use.
 REFERENCE_SOLVER = PressureSolver.WCSPH
 CFL_LEVELS = (0.15, 0.4)  # besides the default 0.25 (the stress matrix goes to twice the default)
 # DFSPH's density-solve tolerance besides the default (Gauss-Seidel's 1.5e-4), at each case's default resolution: its

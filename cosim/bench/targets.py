@@ -40,7 +40,7 @@ GIGA = 1e9
 
 @dataclass(frozen=True)
 class TargetSizes:
-    """What the measurements run: the issue's sizes by default (tests use small ones, whose numbers mean nothing).
+    """What the measurements run: the targets' sizes by default (tests use small ones, whose numbers mean nothing).
 
     throughput_3d / throughput_2d: particles of the resting block (:func:`cosim.bench.fluid_throughput.resting_block`).
     steps: WCSPH substeps per timed interval; repeats: timed intervals (medians). pour_3d_across: particles across
@@ -60,7 +60,7 @@ class TargetSizes:
 
 @dataclass(frozen=True)
 class Target:
-    """name: the target as the issue states it. device: 'cuda' or 'cpu', where it is set. threshold, unit: the
+    """name: the target as the report states it. device: 'cuda' or 'cpu', where it is set. threshold, unit: the
     figure to reach; at_least: True if the figure must be at least the threshold, False if at most."""
 
     name: str
@@ -74,7 +74,7 @@ class Target:
 class Measurement:
     """value: the measured figure in the target's unit (None: not measured or failed); detail: what else the same run
     measured, or why nothing was measured; failed: the measurement raised (detail holds its error); took_s: wall
-    seconds the measurement took, set-up and warm-up included (what it costs on a lent GPU machine)."""
+    seconds the measurement took, set-up and warm-up included (what it costs on a GPU machine held by the minute)."""
 
     target: Target
     value: float | None
@@ -198,7 +198,7 @@ def measure_all(sizes: TargetSizes = TargetSizes(), cuda: str | None = None,
                 on_row: Callable[[list[Measurement]], None] | None = None) -> list[Measurement]:
     """Every target: the CUDA ones on ``cuda`` (None: not measured), the CPU one on the CPU. ``on_row`` is called
     with the rows so far after each one (the command rewrites its report, so that a run stopped part-way, e.g. at
-    the device tool's time limit, leaves the targets it measured)."""
+    a time limit, leaves the targets it measured)."""
     out: list[Measurement] = []
     for target in TARGETS:
         out.append(_measure(target, cuda if target.device == "cuda" else "cpu", sizes))

@@ -48,8 +48,8 @@ def recording_path(run_arg: str) -> Path:
             raise InputError(f"RUN: {path.parent} is a run without its recording (made with --no-log or logging.enabled "
                              "= false); run the pour again with logging on to view it")
         raise InputError(f"RUN: no recording at {path} (expected a run folder with {RECORDING_NAME}, or a .rrd file)")
-    # imported here, once the file exists: the other subcommands run where rerun-sdk is not installed (the GPU
-    # machine, README), and a wrong path is reported without loading it
+    # imported here, once the file exists: the other subcommands run where rerun-sdk is not installed (a headless
+    # machine), and a wrong path is reported without loading it
     from rerun.chunk import RrdReader
 
     try:

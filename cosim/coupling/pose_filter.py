@@ -49,15 +49,13 @@ SMOOTHING_STAGES = 3
 # the blend of a difference d peaks at 1.9 d / HANDOVER_TIME in rate and 5.8 d / HANDOVER_TIME^2 in acceleration
 # (d = 36 ms x 0.1 rad/s = 3.6 mrad, a slosh damping's rate: 0.03 rad/s, 0.5 rad/s^2).
 HANDOVER_TIME = 0.2
-# rad/s: the closed-loop bandwidth of the tracking filter that follows a moving target (in CFS). Replaying the CFS
-# targets of the default, partial and low-fill pours recorded with the filter that re-plans to rest
-# (cosim.bench.pose_filter_replay), 35 rad/s follows the tilt command 80 ms late (117 ms with the smoothing stages;
-# re-planned to rest: 114-118 ms, 151-155 ms), with a third to a half of the translations' and up to a third less of
-# the tilt's acceleration content above 10 Hz.
+# rad/s: the closed-loop bandwidth of the tracking filter that follows a moving target (in CFS). On recorded CFS
+# targets (cosim.bench.pose_filter_replay), 35 rad/s follows the tilt command with less lag and less acceleration
+# content above 10 Hz than a filter that re-plans to rest every period (the figures: docs/tuning.md).
 TRACKING_BANDWIDTH = 35.0
 # How far beyond the jerk limit the tracking filter's linear law may ask (clipped to the limits) before the
 # jerk-limited generator moves the path instead: a linear law clipped far beyond its limits winds up (0.02-1 rad steps
-# overshot by 13 % to several times the step, see cosim.coupling.tracking_filter).
+# overshoot by 13 % to several times the step, see cosim.coupling.tracking_filter).
 TRACKING_SATURATION = 1.5
 
 

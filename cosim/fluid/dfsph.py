@@ -47,11 +47,10 @@ constraint form): the layer of dummy wall particles that faces the liquid (``Flu
 density like liquid that does not move, each wall particle b with its own stiffness k_b (its density rate
 sum_j m_j (v_b - v_j) . grad W_bj from the liquid moving against the wall, its factor from the density change its
 push on the liquid causes, warm-started as the liquid's). The force on the liquid stays the transpose of the
-constraints' gradient, so the solve is stable; with the wall term carrying the particle's own stiffness only (the
-previous form, as SPlisHSPlasH's Akinci boundary) the constant part of the pressure pushed the rows next to a wall
-onto it (the bottom row 1.1 mm above the floor instead of dx/2, at twice the hydrostatic pressure) and the column
-settled 1 mm low (hydrostatic validation -3.8 %). Mirroring the particle's pressure onto the wall instead is not a
-constraint gradient and blew the resting column up (README, Known limitations). The deeper layers lack the layers
+constraints' gradient, so the solve is stable. A wall term carrying only the particle's own stiffness (as
+SPlisHSPlasH's Akinci boundary) lets the constant part of the pressure push the rows next to a wall onto it, and the
+column settles low; mirroring the particle's pressure onto the wall is not a constraint gradient and blows a resting
+column up (the measurements: docs/physics-and-validation.md, Design notes). The deeper layers lack the layers
 beyond the last in their kernel support, so they only contribute density. The stiffness each particle applied
 over both solves, kappa_i, is kept: it gives the reported pressure p_i = rho_i kappa_i (the pressure whose impulse
 acted over dt; reported as its average over the interval), the wall reaction, and the warm start of the next
@@ -106,11 +105,10 @@ from cosim.fluid.sph_kernels import kernel_w
 # Warm starts (Bender & Koschier 2017, Sec. 4.3): each solve starts from a fraction of the stiffness it applied in
 # the previous substep. Only compression is corrected, so a warm start can never be taken back within a substep:
 # a large fraction ratchets the pressure up (density 0.8: a shaken tank splashes over its rim; 0.95 and 1.0: it
-# blows up), a small one leaves the whole hydrostatic load to the Jacobi iterations. Measured: density 0.5 leaves the
-# least motion in a resting column (max speed after 1 s at 12 particles across 0.069 m/s; 0.25 / 0.75: 0.046 /
-# 0.108 with no divergence warm start); the divergence warm start trades that motion against the shallow slosh
-# frequency (A = 54 mm, Eq. 17 of Camporredondo et al. 2019): 0.5 gives -2.3 % and 0.069 m/s, 0.25 -6.4 % and 0.059 m/s, 0 -10.2 % and
-# 0.032 m/s. 0.5 for both, as SPlisHSPlasH.
+# blows up), a small one leaves the whole hydrostatic load to the Jacobi iterations. The divergence warm start trades
+# the motion left in a resting column against the error of the shallow slosh frequency (Eq. 17 of Camporredondo et
+# al. 2019): a smaller fraction calms the column and lowers the frequency. 0.5 for both, as SPlisHSPlasH (the
+# fractions compared: docs/tuning.md).
 WARM_START_DENSITY = wp.constant(0.5)
 WARM_START_DIVERGENCE = wp.constant(0.5)
 # Relative errors are summed as integers of this size (deterministic order-free sum; 1e-9 of rho0 resolves a
@@ -118,20 +116,19 @@ WARM_START_DIVERGENCE = wp.constant(0.5)
 ERROR_QUANTUM = wp.constant(1.0e-9)
 MAX_PARTICLE_ERROR = wp.constant(1.0)
 # Besides the average (Bender & Koschier's criterion), no particle may keep more than this relative error: an
-# impact compresses a few particles among many, which the average alone lets through (measured: a jet landing in the
-# catcher at 4 m/s, the solve stopped after one iteration and the landing particles blew up). 1 % is the density
+# impact compresses a few particles among many, which the average alone lets through (a jet landing in the catcher
+# at 4 m/s: the solve stops after one iteration and the landing particles blow up). 1 % is the density
 # error the weakly compressible solver is held to.
 MAX_PARTICLE_RESIDUAL = wp.constant(0.01)
 # The factor's denominator is kept above this fraction of that of a particle inside a resting lattice: with few
 # neighbours (spray, a particle landing on another: the kernel gradient vanishes as r -> 0) it tends to zero, the
-# linearised factor to infinity, and a tiny compression would give a kick that blows the pair apart (measured: the
-# pour's jet landing in the catcher). Such particles get a softer, under-relaxed push instead.
+# linearised factor to infinity, and a tiny compression would give a kick that blows the pair apart (as the pour's
+# jet landing in the catcher does). Such particles get a softer, under-relaxed push instead.
 MIN_FACTOR_DENOMINATOR = wp.constant(0.25)
 
 # The wall layer's Jacobi increments are halved: a liquid particle's constraint and its wall neighbours' measure the
-# same approach, and both correcting it in full overshoots (measured: the device check's tilted and shaken tanks
-# created 0.25-0.36 M g L of energy within 16 ms in 3-D and at 12 across in 2-D, and the default pour spilled
-# 1.2-1.4 %; halved: all three tanks pass, the pour spills 0 %, every validation's error is unchanged to 0.2 points).
+# same approach, and both correcting it in full overshoots: tilted and shaken tanks create energy and the pour
+# spills; halved, neither does and the validation errors stay as they are (docs/tuning.md).
 WALL_RELAXATION = wp.constant(0.5)
 # rest_offset of a particle whose first substep has not run yet (kg/m^3; any real offset is >= 0)
 UNSEEDED_OFFSET = wp.constant(-1.0)
@@ -148,8 +145,7 @@ STAT_ITERATIONS = wp.constant(2)
 STAT_MAX_ERROR = wp.constant(3)
 # Each lane's row of solve_stats holds those 4 fields padded to this many int64 (128 bytes: two cache lines, as the
 # CPU's adjacent-line prefetch fetches them): every particle adds to its lane's row atomically, and two lanes' rows in
-# one cache line would pass it back and forth between the cores on every add (measured: the default pour's
-# substeps 4-6 % faster padded, two pours side by side in one process).
+# one cache line would pass it back and forth between the cores on every add (false sharing; docs/tuning.md).
 STATS_ROW_STRIDE = 16
 
 
@@ -176,8 +172,8 @@ def bound_or_free_density(
     """The density the solves hold particle i to (kg/m^3), from its summation density ``summation`` (over a resting
     lattice's). A particle's first substep stores the kernel deficiency it was seeded with, max(rho0 - summation, 0),
     as its ``rest_offset``: the seeded liquid is at rest, so its surface rows, short of neighbours above, are held
-    at the spacing they were seeded with instead of sinking until their sums reach rho0 (measured: the resting
-    column's top two rows merged 2.3 mm low without it). Bound liquid is held to summation + offset; free liquid
+    at the spacing they were seeded with instead of sinking until their sums reach rho0 (without
+    it a resting column's top rows merge below their spacing). Bound liquid is held to summation + offset; free liquid
     (WCSPH's rules, ``cosim.fluid.wcsph.update_free_liquid``; ``free_liquid`` 0: all liquid stays bound) to its
     plain summation density: a bound particle outside every vessel becomes free once separated (summation below
     rho0), a free one bound again, with no offset, when packed (summation >= rho0) inside a vessel. (Only
@@ -752,7 +748,7 @@ def list_sweep_cells(
     """The cells each of the ``threads`` threads of :func:`gauss_seidel_density_sweep` relaxes in this substep, with
     their colours (:func:`cell_color`): the thread takes every threads-th of the ``items`` items and the cells they
     start (:func:`task_cell`). Listed once per substep, so that each colour's launch visits its own cells instead of
-    testing every item (measured on the default pour: the test was most of an empty colour's 10 us)."""
+    testing every item (for a colour with few cells, the test would be most of its launch)."""
     thread = lane_item(wp.tid(), lane)
     count = int(0)
     for t in range(thread, items, threads):

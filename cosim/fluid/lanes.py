@@ -35,18 +35,17 @@ import warp as wp
 from cosim.fluid.lane_choice import ReplayChoice
 from cosim.fluid.launch import record_launch
 
-# Fewest particles per lane the automatic thread count gives a lane. Measured on the 2-core CPU (a resting 2-D tank,
-# `python -m cosim.bench.fluid_throughput --counts2d 400 800 1600 --solvers dfsph wcsph --threads 1 2`): 2 lanes run 1.57,
-# 1.52 and 1.79 x the particle-steps of one under DFSPH at 400, 784 and 1600 particles, 1.58, 1.74 and 1.84 x under
-# WCSPH; smaller liquids were not measured (the benchmark's tank needs 400), so 400 particles get 2 lanes, fewer one.
+# Fewest particles per lane the automatic thread count gives a lane: 400 particles get 2 lanes, fewer one. A resting
+# 2-D tank of 400 particles, the smallest the throughput benchmark builds, already runs more particle-steps per
+# second on 2 lanes than on one under both solvers (docs/tuning.md); nothing smaller is known to gain.
 MIN_PARTICLES_PER_LANE = 200
 # Spins (x86 ``pause`` / arm ``yield`` hints) before a waiting lane goes to sleep until the barrier opens: about
 # 40-100 us, several stages' worth, so a lane that is running is waited for on the spot, while one whose core the OS
 # gave to another process is waited for asleep, its core left to that lane or process instead of spun on.
 SPINS_BEFORE_SLEEP = 4000
 # Items are dealt out to the lanes in chunks of this many, in turn: the particles are in cell order, so contiguous
-# halves would give one lane the bulk and the other the sparse stream (measured on the default pour: 10 to 17 % more
-# neighbour pairs in one half, and every wall sample that touches liquid in one half of the walls). 16 float32 or
+# halves would give one lane the bulk and the other the sparse stream (more neighbour pairs in one half, and every
+# wall sample that touches liquid in one half of the walls; docs/tuning.md). 16 float32 or
 # int32 values fill one 64-byte cache line and 16 vec3 three, so two lanes do not write into one line.
 LANE_CHUNK = wp.constant(16)
 
@@ -217,8 +216,7 @@ def run_serial(program: Program, call: Callable[[Callable[[], None]], None] | No
 
 class _LaneThread:
     """A thread that runs one job at a time when asked: two locks hand each job over and back, cheaper than a thread
-    pool's futures (measured: the pool's submit and wait were 8 % of the default pour's host time under py-spy, and
-    the substep loop runs 0.966 x the time without them, two pours side by side in one process)."""
+    pool's futures, whose submit and wait per stage are a visible share of a pour's host time (docs/tuning.md)."""
 
     _STOP = object()
 

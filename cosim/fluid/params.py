@@ -8,8 +8,7 @@ from cosim.fluid.config import FluidConfig
 from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma, lattice_gradient_square_sum, lattice_jacobi_gain, lattice_kernel_sum
 
 # DFSPH's Jacobi solves diverge once one step's gain (cosim.fluid.sph_kernels.lattice_jacobi_gain) exceeds about 4
-# (measured, 2-D Wendland C2 hydrostatic tank at 40 across: stable at h = 1.6 dx, gain 3.74; blown up within 1 s at
-# 1.7 dx, gain 4.17; 3-D at h = 1.5 dx, gain 6.25: blown up within 0.5 s at 12 across). Only compression is
+# (a hydrostatic tank is stable at gain 3.74 and blows up at 4.17; docs/tuning.md). Only compression is
 # corrected, which halves the gain of an oscillating mode: hence 4, not the 2 of a linear Jacobi iteration. The
 # increments are scaled down so that the scaled gain stays at this limit (a margin below 4); at or below it they are
 # not scaled, so the 2-D default (gain 3.34) is unchanged.

@@ -110,8 +110,7 @@ def viscous_pair(
     (scaled by the configured c0) plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the
     neighbour's, or a wall's no-slip, velocity)."""
     # min(vr, 0) instead of a branch on the approach: about half the pairs approach, so the branch is mispredicted
-    # about half the time (measured on the default pour's 2-D non-pressure stage: 165 against 219 us per launch of
-    # this term alone); a receding pair adds exactly zero, as the branch skipped it
+    # about half the time (docs/tuning.md); a receding pair adds exactly zero, as the branch would skip it
     mu = prm.h * wp.min(wp.dot(v_rel, r), 0.0) / (r2 + prm.eta2)
     a = (mass_j * alpha * prm.sound_speed * mu / (0.5 * (rho_i + rho_j))) * gw
     a += (mass_j * prm.nu * (1.0 / rho_i + 1.0 / rho_j) * wp.dot(r, gw) / (r2 + prm.eta2)) * v_rel_laminar

@@ -31,7 +31,7 @@ TIME_TOLERANCE = 1e-9
 # rad: slack of the joint-range check (round-off of positions of order 10 rad).
 POSITION_TOLERANCE = 1e-9
 # Relative slack of the velocity, acceleration, jerk and continuity bounds, for round-off: ruckig holds its limits up
-# to round-off (largest measured excess on a 10 s pour: 1.3e-15 relative, on the jerk differenced from accelerations).
+# to round-off (of order 1e-15 relative, largest on the jerk differenced from accelerations), far below this slack.
 LIMIT_RTOL = 1e-9
 
 

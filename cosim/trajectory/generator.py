@@ -414,9 +414,9 @@ class TrajectoryGenerator:
         and acceleration clamped to the limits, the acceleration then to what the velocity limit leaves
         (:func:`_admissible_acceleration`), positions clamped to the joint range (those joints then at rest).
 
-        Plain Python floats, one joint at a time (the interception search calls this up to a dozen times per target;
-        numpy's per-call cost on six numbers was most of it), with the operations, their order and the clamps'
-        tie-breaking of numpy's ``clip`` (``_clip``): the same bits as the array expressions."""
+        Plain Python floats, one joint at a time (the interception search calls this up to a dozen times per target,
+        and on six numbers numpy's per-call overhead would outweigh the arithmetic), with the operations, their order
+        and the clamps' tie-breaking of numpy's ``clip`` (``_clip``): the same bits as the array expressions."""
         pos, vel, acc = [], [], []
         limits = zip(self._lo_floats, self._hi_floats, self._vmax_floats, self._jmax_floats)
         tau = tau - self._path_lead

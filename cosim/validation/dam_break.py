@@ -35,7 +35,7 @@ from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fl
 from cosim.validation.dam_gate import MAX_GATE_SPEED, lauber_hager_speed, lifted_gate
 from cosim.vessel import VesselSpec
 
-# Acceptance (issue "Fluid core"): surge front within 10 % of Martin & Moyce at every point with T <= 3.
+# Acceptance: surge front within 10 % of Martin & Moyce at every point with T <= 3.
 FRONT_TOLERANCE = 0.10
 ACCEPTANCE_T_MAX = 3.0
 MARTIN_MOYCE_COLUMN = 0.05715  # m, the experiment's a = 2.25 in

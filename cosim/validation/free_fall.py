@@ -11,7 +11,8 @@ g t^2 / 2, x = x0 + v_x t; the ballistic jet of Camporredondo et al. 2019, Eqs. 
 
 This isolates the liquid's physics from the controller's measurement of the jet (``cosim pour``'s landing
 prediction from the mean outflow velocity at the lip): a stream that the liquid's own forces pull back while it
-falls (continuity WCSPH's tension, README) lands short of every particle's parabola.
+falls (continuity WCSPH's tension; docs/physics-and-validation.md, The falling stream) lands short of every
+particle's parabola.
 """
 
 from __future__ import annotations
