@@ -1,8 +1,9 @@
 """How long `cosim --help` and refused input take to come back: wall time of new processes, median of several.
 
 Each command runs as a new ``python -m cosim ...`` process, the commands in turn round after round, beside the bare
-interpreter's start (``python -c pass``) as the floor no command can go under. A bad scene file is written to a
-temporary folder (an unknown key), so that its refusal, which needs the scene's schema, is timed too.
+interpreter's start (``python -c pass``) as the floor no command can go under. Bad scene files are written to a
+temporary folder (:data:`BAD_SCENES`: an unknown key, and a value out of range in each of four sections), so that
+their refusal by ``cosim pour`` and ``cosim scene --check``, which needs the scene's schema, is timed too.
 
     python -m cosim.bench.startup [--repeats 5]
 """
@@ -21,20 +22,39 @@ from pathlib import Path
 from cosim.bench.fluid_throughput import machine_description
 from cosim.errors import InputError
 
-BAD_SCENE = "[fluid]\nparticles_acros = 32\n"
+# What is wrong with each bad scene file -> its text.
+BAD_SCENES = {
+    "an unknown key": "[fluid]\nparticles_acros = 32\n",
+    "fluid.cfl out of range": "[fluid]\ncfl = 0.9\n",
+    "controller.sim.trigger_angle out of range": "[controller.sim]\ntrigger_angle = 5.0\n",
+    "vessels.pourer.inner_width out of range": "[vessels.pourer]\ninner_width = 5.0\n",
+    "arms.pour.base_yaw out of range": "[arms.pour]\nbase_yaw = 10.0\n",
+}
 
 
-def commands(bad_scene: Path) -> dict[str, list[str]]:
-    """Label -> command line (the label is what a user types)."""
+def write_bad_scenes(folder: Path) -> dict[str, Path]:
+    """Each of :data:`BAD_SCENES` written to ``folder``: what is wrong -> its file."""
+    paths = {}
+    for number, (wrong, text) in enumerate(BAD_SCENES.items()):
+        paths[wrong] = folder / f"BAD{number}.toml"
+        paths[wrong].write_text(text)
+    return paths
+
+
+def commands(bad_scenes: dict[str, Path]) -> dict[str, list[str]]:
+    """Label -> command line (the label is what a user types); ``bad_scenes`` from :func:`write_bad_scenes`."""
     cosim = [sys.executable, "-m", "cosim"]
-    return {
+    lines = {
         "python -c pass (the interpreter alone)": [sys.executable, "-c", "pass"],
         "cosim --help": [*cosim, "--help"],
         "cosim pour --help": [*cosim, "pour", "--help"],
         "cosim pour --duration -1": [*cosim, "pour", "--duration", "-1"],
         "cosim pour --threads -1": [*cosim, "pour", "--threads", "-1"],
-        "cosim pour BAD.toml (an unknown key)": [*cosim, "pour", str(bad_scene)],
     }
+    for wrong, path in bad_scenes.items():
+        lines[f"cosim pour BAD.toml ({wrong})"] = [*cosim, "pour", str(path)]
+        lines[f"cosim scene --check BAD.toml ({wrong})"] = [*cosim, "scene", "--check", str(path)]
+    return lines
 
 
 def time_commands(lines: dict[str, list[str]], repeats: int) -> dict[str, list[float]]:
@@ -61,9 +81,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     with tempfile.TemporaryDirectory(prefix="cosim-startup-") as tmp:
-        bad_scene = Path(tmp) / "BAD.toml"
-        bad_scene.write_text(BAD_SCENE)
-        times = time_commands(commands(bad_scene), args.repeats)
+        times = time_commands(commands(write_bad_scenes(Path(tmp))), args.repeats)
     command = "python -m cosim.bench.startup " + " ".join(argv if argv is not None else sys.argv[1:])
     print(f"Machine: {machine_description()}, 1-minute load average {os.getloadavg()[0]:.1f} at the end. "
           f"Command: `{command.strip()}`. Wall s of a new process, median of {args.repeats} (every run in order).\n")
