@@ -20,8 +20,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from controllers.checks import check_choice, check_range
 from controllers.slosh import VesselShape
 
@@ -183,4 +181,6 @@ def vector_step(a: tuple[float, float], dh: float) -> float:
     beta = math.atan2(az, ax)
     s = min(max((az - dh) / r, -1.0), 1.0)
     beta_new = math.asin(s) if ax >= 0.0 else math.pi - math.asin(s)
+    import numpy as np
+
     return float(np.angle(np.exp(1j * (beta - beta_new))))

@@ -33,13 +33,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from cosim.checks import check_positive, check_range
 from cosim.errors import InputError
 from cosim.robots.scene_config import ArmRole
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from cosim.robots.scene import RobotScene
 
 DEFAULT_MAX_ACCELERATION = 5.0  # rad/s^2, see the module docstring
@@ -125,6 +125,8 @@ class ArmLimits:
         """(n,) values of one limit field (one of :data:`LIMIT_FIELDS`), base to tip."""
         if field not in LIMIT_FIELDS:
             raise ValueError(f"unknown limit field {field!r}; one of {LIMIT_FIELDS}")
+        import numpy as np
+
         return np.array([getattr(j, field) for j in self.joints])
 
 
@@ -153,6 +155,8 @@ def _model_torque(scene: RobotScene, joint: str) -> float:
     jid = model.joint(joint).id
     if not model.jnt_actfrclimited[jid]:
         return math.inf
+    import numpy as np
+
     return float(np.max(np.abs(model.jnt_actfrcrange[jid])))
 
 
