@@ -1,6 +1,7 @@
 """The start-up benchmark (cosim.bench.startup): its commands come back with status 0 or 2, a failing one is an
 error, bad input is refused."""
 
+import subprocess
 import sys
 from pathlib import Path
 
@@ -37,3 +38,14 @@ def test_each_bad_scene_is_refused_by_both_commands(wrong, tmp_path: Path, capsy
 def test_bad_input_is_refused(capsys):
     assert startup.main(["--repeats", "0"]) == 2
     assert capsys.readouterr().err.strip() == "error: --repeats: must be in [1, 50], got 0"
+
+
+def test_a_command_from_another_tree_runs_there_and_imports_from_there(tmp_path: Path):
+    line = startup.from_tree([sys.executable, "-c", "import os, sys; print(os.getcwd(), sys.path[1])"], tmp_path)
+    done = subprocess.run(line, capture_output=True, text=True, check=True)
+    assert done.stdout.split() == [str(tmp_path), str(tmp_path)]
+
+
+def test_a_before_tree_that_is_no_checkout_is_refused(tmp_path: Path, capsys):
+    assert startup.main(["--before", str(tmp_path)]) == 2
+    assert capsys.readouterr().err.strip() == f"error: --before: must be a checkout of cosim (with cosim/__main__.py), got {tmp_path}"

@@ -5,7 +5,10 @@ interpreter's start (``python -c pass``) as the floor no command can go under. B
 temporary folder (:data:`BAD_SCENES`: an unknown key, and a value out of range in each of four sections), so that
 their refusal by ``cosim pour`` and ``cosim scene --check``, which needs the scene's schema, is timed too.
 
-    python -m cosim.bench.startup [--repeats 5]
+    python -m cosim.bench.startup [--repeats 5] [--before DIR]
+
+``--before DIR`` times another checkout (e.g. the revision before a change) side by side: each command runs from
+DIR and from this checkout in turn, every round, so that both see the same load, and the table gives their ratio.
 """
 
 from __future__ import annotations
@@ -17,10 +20,13 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Hashable
 from pathlib import Path
 
 from cosim.bench.fluid_throughput import machine_description
 from cosim.errors import InputError
+
+THIS_TREE = Path(__file__).resolve().parents[2]  # the checkout this module is in
 
 # What is wrong with each bad scene file -> its text.
 BAD_SCENES = {
@@ -57,9 +63,15 @@ def commands(bad_scenes: dict[str, Path]) -> dict[str, list[str]]:
     return lines
 
 
-def time_commands(lines: dict[str, list[str]], repeats: int) -> dict[str, list[float]]:
+def from_tree(line: list[str], root: Path) -> list[str]:
+    """``line`` run in the checkout ``root``, its folder and import path first, so that ``python -m cosim`` is that
+    checkout's."""
+    return ["env", "-C", str(root), f"PYTHONPATH={root}", *line]
+
+
+def time_commands(lines: dict[Hashable, list[str]], repeats: int) -> dict[Hashable, list[float]]:
     """Wall s of every run of each command, the commands in turn each round; each run's exit status must be 0 or 2."""
-    times: dict[str, list[float]] = {label: [] for label in lines}
+    times: dict[Hashable, list[float]] = {label: [] for label in lines}
     for _ in range(repeats):
         for label, line in lines.items():
             start = time.perf_counter()
@@ -73,22 +85,37 @@ def time_commands(lines: dict[str, list[str]], repeats: int) -> dict[str, list[f
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m cosim.bench.startup", description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=int, default=5, help="runs of each command; the median is printed (default 5)")
+    ap.add_argument("--before", type=Path, metavar="DIR", help="another checkout of cosim, timed in turn with this one")
     args = ap.parse_args(argv)
     try:
         if not 1 <= args.repeats <= 50:
             raise InputError(f"--repeats: must be in [1, 50], got {args.repeats}")
+        if args.before is not None and not (args.before / "cosim" / "__main__.py").is_file():
+            raise InputError(f"--before: must be a checkout of cosim (with cosim/__main__.py), got {args.before}")
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     with tempfile.TemporaryDirectory(prefix="cosim-startup-") as tmp:
-        times = time_commands(commands(write_bad_scenes(Path(tmp))), args.repeats)
+        lines = commands(write_bad_scenes(Path(tmp)))
+        trees = {} if args.before is None else {"before": args.before.resolve(), "this": THIS_TREE}
+        timed = {(label, tree): from_tree(line, root) for label, line in lines.items() for tree, root in trees.items()}
+        times = time_commands(timed or {(label, ""): line for label, line in lines.items()}, args.repeats)
     command = "python -m cosim.bench.startup " + " ".join(argv if argv is not None else sys.argv[1:])
     print(f"Machine: {machine_description()}, 1-minute load average {os.getloadavg()[0]:.1f} at the end. "
           f"Command: `{command.strip()}`. Wall s of a new process, median of {args.repeats} (every run in order).\n")
-    print("| command | wall s, median | runs |")
-    print("|---|---|---|")
-    for label, runs in times.items():
-        print(f"| `{label}` | {statistics.median(runs):.3f} | {', '.join(f'{t:.3f}' for t in runs)} |")
+
+    def runs(key: tuple[str, str]) -> str:
+        return ", ".join(f"{t:.3f}" for t in times[key])
+
+    if not trees:
+        print("| command | wall s, median | runs |\n|---|---|---|")
+        for label in lines:
+            print(f"| `{label}` | {statistics.median(times[label, '']):.3f} | {runs((label, ''))} |")
+        return 0
+    print("| command | before, s | this, s | before / this | runs before; this |\n|---|---|---|---|---|")
+    for label in lines:
+        before, this = statistics.median(times[label, "before"]), statistics.median(times[label, "this"])
+        print(f"| `{label}` | {before:.3f} | {this:.3f} | {before / this:.1f}x | {runs((label, 'before'))}; {runs((label, 'this'))} |")
     return 0
 
 
