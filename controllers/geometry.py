@@ -176,11 +176,11 @@ def vector_step(a: tuple[float, float], dh: float) -> float:
     This returns the rotation (in the tilt sense) that brings the tip of a exactly to the height of c, i.e. down
     by dh, as the paper's text asks. dh < 0 raises the point. A dh beyond the reach of the circle is clipped.
     """
+    import numpy as np
+
     ax, az = a
     r = math.hypot(ax, az)
     beta = math.atan2(az, ax)
     s = min(max((az - dh) / r, -1.0), 1.0)
     beta_new = math.asin(s) if ax >= 0.0 else math.pi - math.asin(s)
-    import numpy as np
-
     return float(np.angle(np.exp(1j * (beta - beta_new))))

@@ -22,9 +22,10 @@ class PidDesignSpec:
     bandwidth chosen for the loop with the actuation delay.
 
     damping: zeta of the complex pair, [0.3, 0.95] (1 would make a fourfold pole, which floating point cannot
-      verify to better than 1e-4); not set: searched with the bandwidth over :data:`controllers.pid.DAMPING_RATIOS`.
-    bandwidth_ratio: wn / omega1, [0.3, 3]; not set: searched over :data:`controllers.pid.BANDWIDTH_RATIOS`. The search keeps the
-      pair whose sampled loop with the delay decays fastest within the margins.
+      verify to better than 1e-4); not set: searched with the bandwidth over
+      :data:`controllers.pid.DAMPING_RATIOS`.
+    bandwidth_ratio: wn / omega1, [0.3, 3]; not set: searched over :data:`controllers.pid.BANDWIDTH_RATIOS`. The
+      search keeps the pair whose sampled loop with the delay decays fastest within the margins.
     smoothing_bandwidth: rad/s, of the linear smoother between the PID and the arm
       (:class:`controllers.motion.CriticallyDampedSmoother`; its delay 2 / bandwidth). It keeps the arm's path
       smooth (no step-to-step jerk from the sampled PID) with a known transfer function that the design includes.

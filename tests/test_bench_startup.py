@@ -48,4 +48,5 @@ def test_a_command_from_another_tree_runs_there_and_imports_from_there(tmp_path:
 
 def test_a_before_tree_that_is_no_checkout_is_refused(tmp_path: Path, capsys):
     assert startup.main(["--before", str(tmp_path)]) == 2
-    assert capsys.readouterr().err.strip() == f"error: --before: must be a checkout of cosim (with cosim/__main__.py), got {tmp_path}"
+    expected = f"error: --before: must be a checkout of cosim (with cosim/__main__.py), got {tmp_path}"
+    assert capsys.readouterr().err.strip() == expected

@@ -115,7 +115,8 @@ def main(argv: list[str] | None = None) -> int:
     print("| command | before, s | this, s | before / this | runs before; this |\n|---|---|---|---|---|")
     for label in lines:
         before, this = statistics.median(times[label, "before"]), statistics.median(times[label, "this"])
-        print(f"| `{label}` | {before:.3f} | {this:.3f} | {before / this:.1f}x | {runs((label, 'before'))}; {runs((label, 'this'))} |")
+        print(f"| `{label}` | {before:.3f} | {this:.3f} | {before / this:.1f}x | "
+              f"{runs((label, 'before'))}; {runs((label, 'this'))} |")
     return 0
 
 

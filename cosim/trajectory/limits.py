@@ -123,10 +123,10 @@ class ArmLimits:
 
     def array(self, field: str) -> np.ndarray:
         """(n,) values of one limit field (one of :data:`LIMIT_FIELDS`), base to tip."""
-        if field not in LIMIT_FIELDS:
-            raise ValueError(f"unknown limit field {field!r}; one of {LIMIT_FIELDS}")
         import numpy as np
 
+        if field not in LIMIT_FIELDS:
+            raise ValueError(f"unknown limit field {field!r}; one of {LIMIT_FIELDS}")
         return np.array([getattr(j, field) for j in self.joints])
 
 
@@ -151,12 +151,12 @@ class JointLimitOverride:
 
 def _model_torque(scene: RobotScene, joint: str) -> float:
     """N m, the largest torque the model's actuators may put on ``joint`` (its actuator force range), inf if unlimited."""
+    import numpy as np
+
     model = scene.model
     jid = model.joint(joint).id
     if not model.jnt_actfrclimited[jid]:
         return math.inf
-    import numpy as np
-
     return float(np.max(np.abs(model.jnt_actfrcrange[jid])))
 
 
