@@ -11,43 +11,36 @@ The coupling's entry point: build a :class:`PourConfig`, a :class:`PourControlle
 theta1 measurement, signs) are in :mod:`controllers.measurement` and :mod:`controllers.slosh`.
 """
 
-from controllers.config import (
-    ApproachConfig,
-    CatcherConfig,
-    CfsConfig,
-    Damping,
-    Handover,
-    PourConfig,
-    ReturnConfig,
-    SimConfig,
-    SimMode,
-)
-from controllers.errors import ControllerInputError, MeasurementError
-from controllers.geometry import PlanarPose, VesselGeometry
-from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
-from controllers.pid import PidDesignSpec
-from controllers.pour import PourController
-from controllers.slosh import SloshModel
+import importlib
 
-__all__ = [
-    "ApproachConfig",
-    "CatcherConfig",
-    "CfsConfig",
-    "ControllerInputError",
-    "Damping",
-    "Handover",
-    "LiquidMeasurement",
-    "MeasurementError",
-    "Phase",
-    "PhaseTransition",
-    "PidDesignSpec",
-    "PlanarPose",
-    "PourCommand",
-    "PourConfig",
-    "PourController",
-    "ReturnConfig",
-    "SimConfig",
-    "SimMode",
-    "SloshModel",
-    "VesselGeometry",
-]
+# Each public name -> the module defining it, imported when the name is first used (PEP 562): reading a
+# configuration (``controllers.config``) loads no NumPy, ruckig or python-control.
+_MODULES = {
+    "ApproachConfig": "controllers.config",
+    "CatcherConfig": "controllers.config",
+    "CfsConfig": "controllers.config",
+    "Damping": "controllers.config",
+    "Handover": "controllers.config",
+    "PourConfig": "controllers.config",
+    "ReturnConfig": "controllers.config",
+    "SimConfig": "controllers.config",
+    "SimMode": "controllers.config",
+    "ControllerInputError": "controllers.errors",
+    "MeasurementError": "controllers.errors",
+    "PlanarPose": "controllers.geometry",
+    "VesselGeometry": "controllers.geometry",
+    "LiquidMeasurement": "controllers.measurement",
+    "Phase": "controllers.measurement",
+    "PhaseTransition": "controllers.measurement",
+    "PourCommand": "controllers.measurement",
+    "PidDesignSpec": "controllers.pid_spec",
+    "PourController": "controllers.pour",
+    "SloshModel": "controllers.slosh",
+}
+__all__ = sorted(_MODULES)
+
+
+def __getattr__(name: str) -> object:
+    if name not in _MODULES:
+        raise AttributeError(f"module 'controllers' has no attribute {name!r}")
+    return getattr(importlib.import_module(_MODULES[name]), name)

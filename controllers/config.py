@@ -13,7 +13,7 @@ from enum import Enum
 from controllers.checks import check_choice, check_range
 from controllers.errors import ControllerInputError
 from controllers.geometry import VesselGeometry
-from controllers.pid import PidDesignSpec
+from controllers.pid_spec import PidDesignSpec
 from controllers.slosh import GRAVITY, SloshModel, potential_flow_model
 
 

@@ -20,8 +20,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from controllers.checks import check_choice, check_range
 from controllers.slosh import VesselShape
 
@@ -178,6 +176,8 @@ def vector_step(a: tuple[float, float], dh: float) -> float:
     This returns the rotation (in the tilt sense) that brings the tip of a exactly to the height of c, i.e. down
     by dh, as the paper's text asks. dh < 0 raises the point. A dh beyond the reach of the circle is clipped.
     """
+    import numpy as np
+
     ax, az = a
     r = math.hypot(ax, az)
     beta = math.atan2(az, ax)

@@ -35,6 +35,7 @@ import numpy as np
 from controllers.checks import check_range
 from controllers.errors import ControllerInputError
 from controllers.motion import CriticallyDampedSmoother
+from controllers.pid_spec import PidDesignSpec
 from controllers.slosh import SloshModel
 
 if TYPE_CHECKING:  # python-control (and scipy) take seconds to load: imported by the functions that use them,
@@ -98,50 +99,6 @@ SEARCH_PENALTY = 100.0  # 1/s of decay rate per dB (or per 10 deg) of margin sho
 # verification, which the design must pass.
 SEARCH_SLACK_DB, SEARCH_SLACK_DEG = 0.1, 1.0
 SEARCH_ITERATIONS = 2000  # Nelder-Mead iterations of the design search's refinement
-
-
-@dataclass(frozen=True)
-class PidDesignSpec:
-    """Closed-loop target: poles of (s^2 + 2 zeta wn s + wn^2)(s + wn)^2 with wn = bandwidth_ratio * omega1, the
-    bandwidth chosen for the loop with the actuation delay.
-
-    damping: zeta of the complex pair, [0.3, 0.95] (1 would make a fourfold pole, which floating point cannot
-      verify to better than 1e-4); not set: searched with the bandwidth over :data:`DAMPING_RATIOS`.
-    bandwidth_ratio: wn / omega1, [0.3, 3]; not set: searched over :data:`BANDWIDTH_RATIOS`. The search keeps the
-      pair whose sampled loop with the delay decays fastest within the margins.
-    smoothing_bandwidth: rad/s, of the linear smoother between the PID and the arm
-      (:class:`controllers.motion.CriticallyDampedSmoother`; its delay 2 / bandwidth). It keeps the arm's path
-      smooth (no step-to-step jerk from the sampled PID) with a known transfer function that the design includes.
-      [5, 1000]
-    actuation_delay: s, from the smoothed tilt command to the vessel's tilt (the arms' joint generators and servos),
-      rounded up to whole control periods in the design. [0, 0.5] The default is the coupled pour's, fitted from
-      its series (docs/controller.md).
-    min_gain_margin: dB. [0, 40]   min_phase_margin: deg. [0, 90]
-    """
-
-    damping: float | None = None
-    bandwidth_ratio: float | None = None
-    smoothing_bandwidth: float = 60.0
-    actuation_delay: float = 0.04
-    min_gain_margin: float = 6.0
-    min_phase_margin: float = 45.0
-
-    def __post_init__(self) -> None:
-        if self.damping is not None:
-            check_range("pid.damping", self.damping, 0.3, 0.95)
-        if self.bandwidth_ratio is not None:
-            check_range("pid.bandwidth_ratio", self.bandwidth_ratio, 0.3, 3.0)
-        check_range("pid.smoothing_bandwidth", self.smoothing_bandwidth, 5.0, 1000.0, "rad/s")
-        check_range("pid.actuation_delay", self.actuation_delay, 0.0, 0.5, "s")
-        check_range("pid.min_gain_margin", self.min_gain_margin, 0.0, 40.0, "dB")
-        check_range("pid.min_phase_margin", self.min_phase_margin, 0.0, 90.0, "deg")
-
-    def target_poles(self, omega1: float, damping: float, bandwidth_ratio: float) -> np.ndarray:
-        """The four target poles (rad/s) for a slosh frequency ``omega1`` (rad/s)."""
-        wn = bandwidth_ratio * omega1
-        wd = wn * math.sqrt(1.0 - damping**2)
-        sr = -damping * wn
-        return np.array([complex(sr, wd), complex(sr, -wd), -wn, -wn])
 
 
 @dataclass(frozen=True)

@@ -63,12 +63,11 @@ from enum import Enum
 from functools import cached_property
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from controllers.checks import check_choice, check_range
 
-if TYPE_CHECKING:  # python-control (and scipy) take seconds to load: imported by the functions that use them,
-    import control as ct  # so that reading a configuration stays fast
+if TYPE_CHECKING:  # python-control (and scipy) take seconds to load, NumPy a fraction of one: imported by the
+    import control as ct  # functions that use them, so that reading a configuration stays fast
+    import numpy as np
 
 GRAVITY = 9.81  # m/s^2
 J1_PRIME_FIRST_ROOT = 1.8411837813406593  # first positive root of J1'(x), the cylinder's first antisymmetric mode
@@ -171,6 +170,8 @@ class SloshModel:
         """Signed theta1/theta of the undamped forced response to theta = phi sin(alpha t) about the floor centre
         (paper Eq. 13, written there for theta_n = -theta1), alpha in rad/s: (g - b2 alpha^2) / (g - l1 alpha^2).
         """
+        import numpy as np
+
         a2 = np.asarray(alpha, dtype=float) ** 2
         return (self.gravity - self.b2 * a2) / (self.gravity - self.l1 * a2)
 

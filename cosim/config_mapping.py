@@ -23,8 +23,6 @@ import typing
 from pathlib import Path
 from typing import Any
 
-import tomlkit
-
 from cosim.errors import InputError
 from cosim.setting import SETTING, Setting
 
@@ -150,6 +148,8 @@ def _setting_comment(spec: Setting) -> str:
 
 
 def _fill_table(table, obj: Any) -> None:
+    import tomlkit  # only to write a document: reading one (and refusing it) does without
+
     docs = field_docs(type(obj))
     nested = []
     group = None
@@ -206,6 +206,8 @@ def _fill_table(table, obj: Any) -> None:
 
 def to_toml(obj: Any, header: str = "") -> str:
     """The TOML document of the configuration ``obj`` (a dataclass), every field commented with its docs."""
+    import tomlkit
+
     doc = tomlkit.document()
     for line in header.splitlines():
         doc.add(tomlkit.comment(line))

@@ -19,8 +19,7 @@ from typing import ClassVar
 from controllers.config import ApproachConfig, CfsConfig, ReturnConfig, SimConfig
 from cosim.checks import check_device, check_positive, check_range
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
-from cosim.coupling.pose_filter import PoseFilterLimits
-from cosim.coupling.settings import CouplingSettings
+from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
 from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
 from cosim.io.recording_config import RecordingConfig
@@ -31,7 +30,6 @@ from cosim.robots.scene_config import (
     CATCHER_HOME_X, POUR_HEIGHT, POURER_FLOOR_ABOVE_TABLE, TABLE_TOP, SceneConfig, pour_cell_config,
 )
 from cosim.trajectory.limits import JointLimitOverride
-from cosim.mesh_vessel import load_vessel_mesh
 from cosim.vessel import VesselShape, VesselSpec, default_catching_vessel, mesh_vessel_spec, seed_pouring_vessel
 
 
@@ -264,6 +262,8 @@ class VesselSettings:
         """The :class:`VesselSpec` named ``name`` (a cylinder's depth is its diameter; a mesh's from its file, errors
         naming ``<prefix>.mesh``)."""
         if self.shape is VesselShape.MESH:
+            from cosim.mesh_vessel import load_vessel_mesh  # NumPy (and trimesh): only for a mesh vessel
+
             mesh = load_vessel_mesh(self.mesh, self.pour_direction, f"{prefix}.mesh")
             return mesh_vessel_spec(name, mesh, self.wall_density)
         depth = self.inner_depth if self.shape is VesselShape.BOX else self.inner_width

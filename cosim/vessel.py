@@ -16,11 +16,14 @@ import math
 import operator
 from dataclasses import dataclass, field
 from enum import Enum
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from cosim.checks import check_choice, check_positive, check_range
-from cosim.mesh_vessel import VesselMesh
+
+if TYPE_CHECKING:  # NumPy is imported by the methods that use it: a scene's settings are checked without it
+    import numpy as np
+
+    from cosim.mesh_vessel import VesselMesh
 
 # Poly(methyl methacrylate), a common lab vessel material (kg/m^3).
 ACRYLIC_DENSITY = 1180.0
@@ -148,11 +151,15 @@ class VesselSpec:
     @property
     def lip_local(self) -> np.ndarray:
         """Pour lip in the vessel frame (m): outer top edge of the +x wall, in the pour plane."""
+        import numpy as np
+
         return np.array([0.5 * self.inner_width + self.wall_thickness, 0.0, self.inner_height])
 
     @property
     def rim_inner_local(self) -> np.ndarray:
         """Inner top edge of the +x wall in the vessel frame (m): where liquid height over the crest begins."""
+        import numpy as np
+
         return np.array([0.5 * self.inner_width, 0.0, self.inner_height])
 
     def wall_boxes(self) -> list[WallBox]:
@@ -170,6 +177,8 @@ class VesselSpec:
 
     def _wall_parts(self) -> list[tuple[float, np.ndarray]]:
         """(volume m^3, centroid m) of each solid part of the walls."""
+        import numpy as np
+
         if self.is_mesh:
             return [(self.mesh.volume, np.array(self.mesh.centre_of_mass))]
         if self.is_box:
@@ -201,6 +210,8 @@ class VesselSpec:
     @property
     def outer_half_extents(self) -> np.ndarray:
         """Half sizes (m) of the vessel's outer bounding box, which spans z in [-wall_thickness, inner_height]."""
+        import numpy as np
+
         t = self.wall_thickness
         if self.is_mesh:
             lo, hi = self.mesh.bounds

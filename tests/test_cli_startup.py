@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from cosim.bench.startup import BAD_SCENES, write_bad_scenes
 from cosim.cli.main import SUBCOMMANDS
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -62,6 +63,28 @@ def test_a_refused_pour_option_loads_not_even_numpy(args):
     """An option's value is checked before the scene (and NumPy with it) is loaded."""
     status, *loaded = _probe(args, ("numpy",))
     assert status == "2" and loaded == []
+
+
+@pytest.mark.parametrize("command", [["pour"], ["scene", "--check"]], ids=" ".join)
+@pytest.mark.parametrize("wrong", list(BAD_SCENES))
+def test_a_refused_scene_file_loads_not_even_numpy(command, wrong, tmp_path):
+    """A scene file's settings (fluid, controller, vessels, arms) are checked by classes that import no numerics:
+    NumPy, ruckig and tomlkit load only for what comes after a good scene."""
+    path = write_bad_scenes(tmp_path)[wrong]
+    status, *loaded = _probe([*command, str(path)], ("numpy", "ruckig", "tomlkit"))
+    assert status == "2" and loaded == []
+
+
+def test_the_controllers_package_gives_each_public_name_from_its_module():
+    import importlib
+
+    import controllers
+
+    for name in controllers.__all__:
+        module = importlib.import_module(controllers._MODULES[name])
+        assert getattr(controllers, name) is getattr(module, name)
+    with pytest.raises(AttributeError, match="no attribute 'PourControler'"):
+        controllers.PourControler
 
 
 # Imports every module of cosim and controllers (the packages first, before anything loads numpy, so that a BLAS pin

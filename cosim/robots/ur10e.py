@@ -18,8 +18,10 @@ kinematics equals :func:`dh_forward_kinematics` (no MuJoCo here: numpy only).
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 # UR joint names, base to flange, as used in models/ur10e/ur10e.xml (joints and actuators).
 UR10E_JOINTS: tuple[str, ...] = ("shoulder_pan", "shoulder_lift", "elbow", "wrist_1", "wrist_2", "wrist_3")
@@ -55,6 +57,8 @@ def dh_forward_kinematics(
     Standard DH: ``T = prod_i Rz(q_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``; the result is DH frame 6 (tool flange, z out of
     the flange).
     """
+    import numpy as np
+
     q = np.asarray(q, dtype=float)
     if q.shape != (6,):
         raise ValueError(f"q must have shape (6,), got {q.shape}")

@@ -33,13 +33,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from cosim.checks import check_positive, check_range
 from cosim.errors import InputError
 from cosim.robots.scene_config import ArmRole
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from cosim.robots.scene import RobotScene
 
 DEFAULT_MAX_ACCELERATION = 5.0  # rad/s^2, see the module docstring
@@ -123,6 +123,8 @@ class ArmLimits:
 
     def array(self, field: str) -> np.ndarray:
         """(n,) values of one limit field (one of :data:`LIMIT_FIELDS`), base to tip."""
+        import numpy as np
+
         if field not in LIMIT_FIELDS:
             raise ValueError(f"unknown limit field {field!r}; one of {LIMIT_FIELDS}")
         return np.array([getattr(j, field) for j in self.joints])
@@ -149,6 +151,8 @@ class JointLimitOverride:
 
 def _model_torque(scene: RobotScene, joint: str) -> float:
     """N m, the largest torque the model's actuators may put on ``joint`` (its actuator force range), inf if unlimited."""
+    import numpy as np
+
     model = scene.model
     jid = model.joint(joint).id
     if not model.jnt_actfrclimited[jid]:
