@@ -194,6 +194,30 @@ def test_guard_pushes_a_particle_out_of_the_floor_and_a_cylinder_wall():
     assert hits[0] == 1 and q[0][1] < 0.1 and n[0][1] == pytest.approx(-1.0)
 
 
+def test_cylinder_guard_puts_a_particle_found_inside_its_walls_back_out():
+    # A particle resting on a face can start its step just inside the wall: the vessel frame is recomputed in float32
+    # from the moving pose at every substep. Before this test the cylinder's guard looked only at paths that cross a
+    # face, so such a particle sank unguarded among the floor's wall particles: in a coarse 3-D pour into a cylinder,
+    # a few percent of the caught liquid ended 3.4 mm below the inner floor and counted as spilled.
+    margin = 1e-4
+    b = float(B)
+    paths = [
+        ((0.03, 0.02, -1e-7), (0.03, 0.02, -0.002)),  # within rounding below the inner floor, sinking
+        ((0.0, 0.0, -0.0034), (0.0, 0.0, -0.0034)),  # at rest deep in the floor
+        ((b + 2e-6, 0.0, 0.1), (b + 0.003, 0.0, 0.1)),  # within rounding in the side wall, moving outwards
+        ((b + 0.001, 0.0, -0.002), (b + 0.001, 0.0, -0.002)),  # in the floor under the side wall, by the inner corner
+    ]
+    q, n, depth, hits = _guard(_box(SHAPE_CYLINDER), 3, [p[0] for p in paths], [p[1] for p in paths], margin)
+    assert np.all(hits >= 1)
+    assert not _in_walls(q.astype(np.float64), SHAPE_CYLINDER, 3).any()
+    np.testing.assert_allclose(q[0], [0.03, 0.02, margin], atol=1e-7)
+    np.testing.assert_allclose(q[1], [0.0, 0.0, margin], atol=1e-7)
+    np.testing.assert_allclose(q[2], [b - margin, 0.0, 0.1], atol=1e-7)
+    np.testing.assert_allclose(q[3], [b - margin, 0.0, margin], atol=1e-7)
+    np.testing.assert_allclose(n[:3], [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]], atol=1e-6)
+    np.testing.assert_allclose(depth[:3], [0.002, 0.0034, 0.003], atol=1e-6)
+
+
 def _periodic_jacobi_gain(kernel: KernelType, smoothing_ratio: float, n: int = 40) -> float:
     """Largest eigenvalue of D^-1 A of DFSPH's pressure system, assembled explicitly on an n x n periodic 2-D lattice
     (unit spacing, mass and density 1): kappa -> velocity change dv_i = -sum_j (kappa_i + kappa_j) grad W_ij -> density

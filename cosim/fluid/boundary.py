@@ -12,7 +12,9 @@ sum_f W_wf) is extrapolated for the viscous terms.
 The non-penetration guard (:func:`guard_vessel`) runs after every position update: a particle whose path from its
 old position (in the vessel frame at the old pose) to its new one (in the frame at the new pose) enters the wall
 solid is put back on the side it came from, just outside the face it crossed, and loses its velocity into that
-face relative to the wall. This also catches a particle that would pass through a thin wall within one step.
+face relative to the wall. This also catches a particle that would pass through a thin wall within one step. A
+particle found inside the wall solid at the start of its step (within float32 rounding of a face it rests on, or
+after a breach) leaves by the face nearest its new position.
 """
 
 from __future__ import annotations
@@ -274,11 +276,65 @@ def box_slab(index: int, geo: VesselGeometry):
 
 
 @wp.func
+def cylinder_exit(q: wp.vec3, r_in: float, t: float, h: float, margin: float):
+    """The nearest way out of a cylindrical cup's walls for a point q inside them (floor disc z in (-t, 0),
+    r < R + t, or side wall r in (R, R + t), z in [0, h)): onto the inner floor (z = 0, where r <= R), the inner
+    side wall (r = R, where z >= 0), the inner corner (r = R, z = 0) from under the side wall, the underside
+    (z = -t), the outer side (r = R + t) or the rim (z = h), plus ``margin`` beyond it. Returns (q moved out,
+    the outward normal there, the distance moved without the margin (m))."""
+    r = wp.sqrt(q[0] * q[0] + q[1] * q[1])
+    radial = wp.vec3(1.0, 0.0, 0.0)
+    if r > 1.0e-12:
+        radial = wp.vec3(q[0] / r, q[1] / r, 0.0)
+    up = wp.vec3(0.0, 0.0, 1.0)
+    # the underside
+    out = wp.vec3(q[0], q[1], -t - margin)
+    normal = -up
+    best = q[2] + t
+    # the outer side
+    if r_in + t - r < best:
+        best = r_in + t - r
+        out = wp.vec3(radial[0] * (r_in + t + margin), radial[1] * (r_in + t + margin), q[2])
+        normal = radial
+    # the rim's top
+    if r > r_in and h - q[2] < best:
+        best = h - q[2]
+        out = wp.vec3(q[0], q[1], h + margin)
+        normal = up
+    # the cavity: through the inner floor, the inner side wall, or from under the side wall the corner between them
+    inner = float(0.0)
+    inner_out = wp.vec3(q[0], q[1], margin)
+    inner_normal = up
+    if r <= r_in:
+        inner = -q[2]
+    elif q[2] >= 0.0:
+        inner = r - r_in
+        inner_out = wp.vec3(radial[0] * (r_in - margin), radial[1] * (r_in - margin), q[2])
+        inner_normal = -radial
+    else:
+        inner = wp.sqrt((r - r_in) * (r - r_in) + q[2] * q[2])
+        inner_out = wp.vec3(radial[0] * (r_in - margin), radial[1] * (r_in - margin), margin)
+        inner_normal = wp.normalize((r_in - r) * radial - q[2] * up)
+    if inner <= best:
+        best = inner
+        out = inner_out
+        normal = inner_normal
+    return out, normal, best
+
+
+@wp.func
 def cylinder_guard(q_old: wp.vec3, q_new: wp.vec3, geo: VesselGeometry, margin: float):
     """Guard against a cylindrical cup (3-D): floor disc z in [-t, 0], r <= R + t, then the side wall r in
     [R, R + t], z in [0, H]. Same returns as :func:`guard_vessel`. Relies on the CFL step moving a particle less
     than the wall thickness per step; a path from inside to outside (or back) below the rim counts as crossing
     the side wall.
+
+    A particle that starts inside the walls crossed no face this step, so the paths above do not see it. A particle
+    resting on a face starts inside now and then: the vessel frame is recomputed in float32 from the moving pose
+    at every substep, and a particle within rounding of the inner floor (about 1e-7 m a metre from the origin) is
+    found just below it at the next step. Such a particle, and whatever else ends inside the walls, leaves by the
+    nearest face (:func:`cylinder_exit`), as a box's slabs do (:func:`slab_entry`); left in the floor, it would sink
+    among the floor's wall particles, below the inner floor.
     """
     r_in = geo.half_width
     t = geo.thickness
@@ -318,6 +374,13 @@ def cylinder_guard(q_old: wp.vec3, q_new: wp.vec3, geo: VesselGeometry, margin: 
         depth = wp.max(depth, h - q[2])
         q[2] = h + margin
         normal = wp.vec3(0.0, 0.0, 1.0)
+        hits += 1
+    r_end = wp.sqrt(q[0] * q[0] + q[1] * q[1])
+    if r_end < r_in + t and q[2] > -t and q[2] < h and (r_end > r_in or q[2] < 0.0):
+        q_out, n_out, d_out = cylinder_exit(q, r_in, t, h, margin)
+        q = q_out
+        normal = n_out
+        depth = wp.max(depth, d_out)
         hits += 1
     return q, normal, depth, hits
 
