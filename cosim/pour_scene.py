@@ -59,7 +59,6 @@ class FluidSettings:
                                     "spacing dx = B / particles_across.", "", 8, 400)
     smoothing_ratio: float = like(FluidConfig, "smoothing_ratio")
     kernel: KernelType = like(FluidConfig, "kernel")
-    boundary_spacing_ratio: float = like(FluidConfig, "boundary_spacing_ratio")
     # ---- material
     rest_density: float = like(FluidConfig, "rest_density")
     kinematic_viscosity: float = like(FluidConfig, "kinematic_viscosity")

@@ -78,7 +78,6 @@ class FluidConfig:
     kernel: KernelType = setting(KernelType.WENDLAND_C2, DISCRETISATION, "SPH smoothing kernel, compact support 2h: "
                                  "Wendland (1995) C2 (no pairing instability at large neighbour counts) or Monaghan "
                                  "(1992)'s cubic spline.")
-    boundary_spacing_ratio: float = setting(0.75, DISCRETISATION, "Wall sample spacing over dx.", "", 0.3, 1.0)
     depth_2d: float = setting(0.1, DISCRETISATION, "2-D: the liquid's thickness across the pour plane as seeded (the "
                               "pourer's depth); a particle stands for the 3-D volume dx^2 depth_2d, spread over the depth "
                               "of any other vessel it enters (cosim.fluid.model). Volumes and wrenches reported outside "
