@@ -73,6 +73,7 @@ def test_outputs_and_summary(run):
     assert summary["cfs_head_reference"] == pytest.approx(2.5 * summary["particle_spacing"])  # 2-D, 10 across: 48 mm
     assert [p["phase"] for p in summary["phases"]][0] == "idle"
     assert "landing" in summary
+    assert type(summary["guard_corrections"]) is int and summary["guard_corrections"] >= 0  # the guard's count, reported
     series = read_series_csv(run / "series.csv")
     assert len(series["t"]) == round(0.8 / 0.01) and series["phase"][0] == "idle"
     assert series["volume_in_pourer"][0] == pytest.approx(summary["initial_volume"])

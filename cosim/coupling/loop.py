@@ -261,7 +261,9 @@ class CoupledPour:
     def summary(self) -> dict:
         """Volumes (m^3), phases (name, start s, end s), times (s) of the run so far; ``energy_created``: the most
         energy the SPH numerics had created at any time, over M g L (``cosim.fluid.energy``; the run stops with an
-        instability past ``fluid.max_energy_creation``).
+        instability past ``fluid.max_energy_creation``); ``guard_corrections``: how many times the non-penetration
+        guard put a particle back on a wall face it was entering (summed over the substeps; the guard is a last
+        resort, so this counts what the wall particles' pressure alone did not hold back).
 
         A partial pour (the controller's ``target_volume`` set) reports its ``target_volume`` (m^3) and how far the
         poured volume missed it: ``target_error`` = poured - target (m^3, > 0: poured too much) and
@@ -298,6 +300,7 @@ class CoupledPour:
             "sph_steps": self.fluid.step_count,
             "particles": self.fluid.n_particles,
             "energy_created": self.fluid.energy_account.peak_created,
+            "guard_corrections": int(self.fluid.history().get("wall_corrections", np.zeros(0, dtype=int)).sum()),
             "arm_load": {
                 role.value: {
                     "compensation": self.settings.compensation.value if self.settings.coupling is Coupling.TWO_WAY else "one_way",
