@@ -6,9 +6,9 @@ keeps the scene's ``max_duration``, not the section class's), enums are given by
 arrays, ``None`` fields are left out of the file. An unknown key, a wrong type or a value out of range is one
 :class:`InputError` line naming the dotted field (range checks are the dataclasses' own ``__post_init__``).
 ``to_toml(obj)`` writes the TOML document of a configuration with every field's documentation as a comment: a field
-declared as a :class:`cosim.setting.Setting` with its meaning and allowed values, under a comment naming its group
-(and a class's ``derived_settings``, the settings it does not set, as comments saying where they come from); other
-fields with their lines of the dataclass docstring (unit and range).
+declared as a :class:`declared_settings.setting.Setting` with its meaning and allowed values (under a comment
+naming its group where the table has several; a class's ``derived_settings``, the settings it does not set, as
+comments saying where they come from); other fields with their lines of the dataclass docstring (unit and range).
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from cosim.errors import InputError
-from cosim.setting import SETTING, Setting
+from declared_settings.setting import SETTING, Setting, groups_of
 
 _FIELD_DOC = re.compile(r"^\s*([a-z_][a-z0-9_]*)\s*:\s*(.*)$")
 
@@ -153,13 +153,14 @@ def _fill_table(table, obj: Any) -> None:
     docs = field_docs(type(obj))
     nested = []
     group = None
+    headed = len(groups_of(type(obj))) > 1  # a table of one group needs no heading
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
         spec = f.metadata.get(SETTING)
         if spec is not None:
-            if spec.group != group:
-                group = spec.group
-                table.add(tomlkit.comment(f"-- {group} --"))
+            if spec.group != group and headed:
+                table.add(tomlkit.comment(f"-- {spec.group} --"))
+            group = spec.group
             if value is None:
                 table.add(tomlkit.comment(f"{f.name} = (not set)  # {_setting_comment(spec)}"))
             else:

@@ -1,13 +1,12 @@
 """Error types shared by every layer.
 
-``InputError`` is bad user input (a scene field out of range, a corrupt file, an unreachable target): the CLI
-prints its one-line message and exits with status 2. ``SimulationError`` is a run that broke (a numerical
-instability): the CLI prints it and exits with status 1.
+``InputError`` is bad user input (a scene field out of range, a corrupt file, an unreachable target), the one
+error of :mod:`declared_settings.errors` that the settings' checks and the controllers raise too: the CLI prints its
+one-line message and exits with status 2. ``SimulationError`` is a run that broke (a numerical instability): the
+CLI prints it and exits with status 1.
 """
 
-
-class InputError(ValueError):
-    """Bad input. The message is one line naming the field (or file) and the allowed range."""
+from declared_settings.errors import InputError  # noqa: F401 (every cosim layer imports it from here)
 
 
 class SimulationError(RuntimeError):

@@ -24,7 +24,7 @@ from cosim.errors import InputError
 from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
-from cosim.setting import Derived, check_settings, declared_fields, derived, like, setting
+from declared_settings.setting import Derived, check_settings, declared_fields, derived, like, setting
 from cosim.trajectory.driver_names import JointPrefix
 from cosim.robots.scene_config import (
     CATCHER_HOME_X, POUR_HEIGHT, POURER_FLOOR_ABOVE_TABLE, TABLE_TOP, SceneConfig, pour_cell_config,

@@ -14,7 +14,7 @@ from cosim.cli.main import main
 from cosim.errors import InputError
 from cosim.fluid.config import GROUPS, FluidConfig
 from cosim.pour_scene import FluidSettings
-from cosim.setting import declared, declared_fields
+from declared_settings.setting import declared, declared_fields
 from cosim.validation.common import FluidCaseParams
 from tests.support.cli_refusal import refusal
 

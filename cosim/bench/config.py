@@ -14,7 +14,7 @@ from cosim.checks import check_choice, check_device, check_positive
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig, KernelType, PressureSolver
 from cosim.pour_scene import FluidSettings
-from cosim.setting import check_settings, declared, like
+from declared_settings.setting import check_settings, declared, like
 
 
 class BenchCase(Enum):

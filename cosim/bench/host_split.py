@@ -31,7 +31,7 @@ from cosim.coupling.loop import CoupledPour
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig
 from cosim.pour_run import prepare
-from cosim.setting import declared
+from declared_settings.setting import declared
 from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene
 
 SUBSTEPS = "the liquid's substeps (replay)"

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 from cosim.checks import check_device, check_positive
 from cosim.fluid.config import FluidConfig
-from cosim.setting import declared
+from declared_settings.setting import declared
 
 if TYPE_CHECKING:
     from cosim.pour_scene import PourScene

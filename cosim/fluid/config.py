@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 from cosim.errors import InputError
-from cosim.setting import check_settings, settings_reference, setting
+from declared_settings.setting import check_settings, settings_reference, setting
 
 GRAVITY = 9.81  # m/s^2, standard gravity magnitude used across the project
 
@@ -68,7 +68,7 @@ GROUPS = (DISCRETISATION, MATERIAL, PRESSURE, WCSPH, DFSPH, TIME_STEPPING, GUARD
 @dataclass(frozen=True)
 class FluidConfig:
     """Numerical and physical parameters of the SPH liquid (SI units); each field is declared once with its group,
-    unit, default and allowed values (:func:`cosim.setting.setting`), the reference below is generated from them."""
+    unit, default and allowed values (:func:`declared_settings.setting.setting`), the reference below is generated from them."""
 
     # ---- discretisation
     dim: int = setting(2, DISCRETISATION, "2: the liquid in the pour plane (world x-z at y = 0), per unit depth times "

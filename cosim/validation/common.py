@@ -11,7 +11,7 @@ import numpy as np
 from cosim.checks import check_device
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
-from cosim.setting import declared
+from declared_settings.setting import declared
 
 # FluidConfig fields a case's numerics may override (the rest is the case's geometry, physics and solver).
 NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "density_iteration", "density_tolerance")

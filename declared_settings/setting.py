@@ -2,37 +2,51 @@
 
 A frozen configuration dataclass declares each field as ``name: type = setting(default, group, meaning, ...)``: the
 default goes to the dataclass, the rest to the field's metadata as a :class:`Setting`. From that one declaration
-:func:`check_settings` checks a value (one :class:`cosim.errors.InputError` line naming the field and its allowed
-values), :func:`settings_reference` writes the class's reference (docstring) and :mod:`cosim.config_mapping` the
-scene file's comments. :func:`like` declares a field of another class as the same setting, with the same default.
+:func:`check_settings` checks a value (one :class:`declared_settings.errors.InputError` line naming the field and its
+allowed values), :func:`settings_reference` writes the class's reference (its docstring, :func:`documented`) and
+``cosim.config_mapping`` the scene file's comments. :func:`like` declares a field of another class as the same
+setting, with the same default. A bound may name another field (or a property) of the same object, e.g. a stop's
+deceleration at most the turn's acceleration: ``setting(0.9, ..., lo=0.0, hi="max_accel", lo_open=True)``.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
+import textwrap
 from dataclasses import dataclass
 from enum import Enum
+from operator import attrgetter
 from typing import Any
 
-from cosim.checks import check_choice, check_int, check_range, check_vector, interval_text
-from cosim.errors import InputError
+from declared_settings.checks import check_choice, check_int, check_range, check_vector, interval_text
+from declared_settings.errors import InputError
 
 SETTING = "setting"  # the metadata key of a field's Setting
+REQUIRED = dataclasses.MISSING  # the default of a setting that has none: every configuration must give it
+
+Bound = float | str | None  # a number, the name of another field (or property) of the same object, or unbounded
 
 
 @dataclass(frozen=True)
 class Bounds:
-    """The closed (or, with ``lo_open``/``hi_open``, open) interval ``[lo, hi]``; None: unbounded on that side."""
+    """The closed (or, with ``lo_open``/``hi_open``, open) interval ``[lo, hi]``; None: unbounded on that side; a
+    name: the value of that attribute (a dotted path) of the object the setting belongs to."""
 
-    lo: float | None = None
-    hi: float | None = None
+    lo: Bound = None
+    hi: Bound = None
     lo_open: bool = False
     hi_open: bool = False
 
     def text(self) -> str:
-        """The interval as written in messages and references, e.g. ``(0, 0.05]``."""
+        """The interval as written in references, e.g. ``(0, 0.05]`` or ``(0, max_accel]``."""
         return interval_text(self.lo, self.hi, self.lo_open, self.hi_open)
+
+    def of(self, owner: Any) -> "Bounds":
+        """These bounds with each named bound replaced by its value in ``owner``."""
+        def value(bound: Bound) -> float | None:
+            return attrgetter(bound)(owner) if isinstance(bound, str) else bound
+        return dataclasses.replace(self, lo=value(self.lo), hi=value(self.hi))
 
 
 @dataclass(frozen=True)
@@ -70,12 +84,13 @@ class Setting:
             text = (self.bounds or Bounds()).text() + unit
         return f"{text}; or not set: {self.none_means}" if self.optional else text
 
-    def check(self, name: str, value: Any) -> Any:
+    def check(self, name: str, value: Any, owner: Any = None) -> Any:
         """``value`` checked (and coerced: an enum from its value, a vector to a tuple of floats); an
-        :class:`InputError` line naming ``name`` and the allowed values where it is not allowed."""
+        :class:`InputError` line naming ``name`` and the allowed values where it is not allowed. ``owner``: the
+        object the setting belongs to, whose attributes a named bound reads."""
         if value is None and self.optional:
             return None
-        b = self.bounds or Bounds()
+        b = (self.bounds or Bounds()).of(owner)
         if self.kind == "bool":
             if not isinstance(value, bool):
                 raise InputError(f"{name}: must be true or false, got {value!r}")
@@ -95,12 +110,13 @@ class Setting:
 
 
 def setting(
-    default: Any, group: str, meaning: str, unit: str = "", lo: float | None = None, hi: float | None = None,
+    default: Any, group: str, meaning: str, unit: str = "", lo: Bound = None, hi: Bound = None,
     lo_open: bool = False, hi_open: bool = False, kind: str | None = None, none_means: str = "",
 ) -> Any:
     """A dataclass field with ``default`` declared as a :class:`Setting` (``kind`` from the default where not given:
     a bool, an Enum member, a tuple (vector), an int or a float; a None default makes it optional, ``none_means``
-    saying what None stands for)."""
+    saying what None stands for; :data:`REQUIRED`: no default, a float unless ``kind`` says otherwise). A bound
+    given as a name is that attribute of the object the setting belongs to (:meth:`Bounds.of`)."""
     if kind is None:
         kind = ("bool" if isinstance(default, bool) else "choice" if isinstance(default, Enum)
                 else "vector" if isinstance(default, tuple) else "int" if isinstance(default, int) else "float")
@@ -152,12 +168,14 @@ def check_settings(obj: Any, prefix: str = "") -> None:
     """Check every declared field of the frozen dataclass instance ``obj`` and store its coerced value; errors name
     the field as ``<prefix>.<name>`` (``<name>`` with no prefix)."""
     for name, spec in declared_fields(type(obj)):
-        value = spec.check(f"{prefix}.{name}" if prefix else name, getattr(obj, name))
+        value = spec.check(f"{prefix}.{name}" if prefix else name, getattr(obj, name), obj)
         object.__setattr__(obj, name, value)
 
 
 def default_text(value: Any) -> str:
     """A default as the reference writes it."""
+    if value is REQUIRED:
+        return "none, required"
     if isinstance(value, Enum):
         return repr(value.value)
     if isinstance(value, bool):
@@ -167,15 +185,30 @@ def default_text(value: Any) -> str:
     return "not set" if value is None else f"{value:g}" if isinstance(value, float) else str(value)
 
 
-def settings_reference(cls: type, groups: tuple[str, ...]) -> str:
-    """The reference of ``cls``'s declared fields, group by group in the order ``groups``: each field's name,
-    meaning, allowed values and default."""
+def groups_of(cls: type) -> tuple[str, ...]:
+    """The groups of ``cls``'s declared fields, in the order they first appear."""
+    return tuple(dict.fromkeys(spec.group for _, spec in declared_fields(cls)))
+
+
+def settings_reference(cls: type, groups: tuple[str, ...] | None = None) -> str:
+    """The reference of ``cls``'s declared fields, group by group in the order ``groups`` (None: as declared; a class
+    of one group is listed without its heading): each field's name, meaning, allowed values and default."""
+    groups = groups_of(cls) if groups is None else groups
     lines = []
     fields = declared_fields(cls)
     for group in groups:
-        lines.append(f"{group}:")
+        if len(groups) > 1:
+            lines.append(f"{group}:")
         for name, spec in fields:
             if spec.group == group:
                 default = cls.__dataclass_fields__[name].default
-                lines.append(f"    {name}: {spec.meaning} Allowed: {spec.allowed()}. Default: {default_text(default)}.")
+                entry = f"{name}: {spec.meaning} Allowed: {spec.allowed()}. Default: {default_text(default)}."
+                lines.append(f"    {entry}" if len(groups) > 1 else entry)
     return "\n".join(lines)
+
+
+def documented(cls: type) -> type:
+    """The configuration class ``cls`` with the reference of its declared settings (:func:`settings_reference`)
+    added to its docstring: the class decorator (over ``@dataclass``) of a class whose settings are declared."""
+    cls.__doc__ = (cls.__doc__ or "").rstrip() + "\n\n" + textwrap.indent(settings_reference(cls), "    ")
+    return cls
