@@ -16,35 +16,45 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import ClassVar
 
-from controllers.config import ApproachConfig, CfsConfig, ReturnConfig, SimConfig
-from cosim.checks import check_device, check_positive, check_range
+from controllers.config import CATCHER, POUR, ApproachConfig, CatcherConfig, CfsConfig, PourConfig, ReturnConfig, SimConfig
+from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
 from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
-from declared_settings.setting import Derived, check_settings, declared_fields, derived, like, setting
 from cosim.trajectory.driver_names import JointPrefix
 from cosim.robots.scene_config import (
     CATCHER_HOME_X, POUR_HEIGHT, POURER_FLOOR_ABOVE_TABLE, TABLE_TOP, SceneConfig, pour_cell_config,
 )
 from cosim.trajectory.limits import JointLimitOverride
+from cosim.trajectory.recorder import DEFAULT_SAMPLE_RATE_HZ, MAX_SAMPLE_RATE_HZ
 from cosim.vessel import VesselShape, VesselSpec, default_catching_vessel, mesh_vessel_spec, seed_pouring_vessel
+from declared_settings.setting import (
+    Derived, check_settings, declared, declared_fields, derived, documented, like, setting,
+)
 
 
+LIQUID = "liquid"
+TRAJECTORY = "trajectory"
+VESSEL = "vessel"
+PLACEMENT = "placement"
+
+
+@documented
 @dataclass(frozen=True)
 class LiquidSettings:
-    """fill_depth: m, liquid depth in the upright pourer; the paper's A = 0.1591 m. (0, pourer inner height)
-    pour_fraction: fraction of the liquid to pour; 1 pours until the pourer is empty. (0, 1]
-    """
+    """The liquid in the pourer and how much of it to pour."""
 
-    fill_depth: float = 0.1591
-    pour_fraction: float = 1.0
+    fill_depth: float = setting(PourConfig.fill_depth, LIQUID, "Liquid depth in the upright pourer (the paper's A); "
+                                "below the pourer's rim, which the pour checks once the vessels are built.", "m",
+                                0.0, 2.0, lo_open=True)
+    pour_fraction: float = setting(1.0, LIQUID, "Fraction of the liquid to pour; 1 pours until the pourer is empty.",
+                                   "", 0.0, 1.0, lo_open=True)
 
     def __post_init__(self) -> None:
-        check_positive("liquid.fill_depth", self.fill_depth, "m", 2.0)
-        check_range("liquid.pour_fraction", self.pour_fraction, 0.0, 1.0, lo_open=True)
+        check_settings(self, "liquid")
 
 
 @dataclass(frozen=True)
@@ -109,22 +119,20 @@ class FluidSettings:
         return FluidConfig(spacing=pourer_width / self.particles_across, **numerics)
 
 
+@documented
 @dataclass(frozen=True)
 class CatcherSettings:
-    """travel: m, how far vessel B may move each way along x from home (the robot scene verifies +-0.15 m). (0, 0.15]
-    max_speed: m/s. (0, 2]   max_accel: m/s^2. (0, 20]
-    discharge_coefficient: C_d of the weir estimate used to place vessel B before the outflow starts. (0, 1]
-    filter_time: s, low-pass time constant on vessel B's target, the predicted landing point. [0, 5]
-    """
+    """Vessel B's motion (:class:`controllers.config.CatcherConfig`, its home and travel from the scene)."""
 
-    travel: float = 0.15
-    max_speed: float = 0.4
-    max_accel: float = 1.0
-    discharge_coefficient: float = 0.6
-    filter_time: float = 0.2
+    travel: float = setting(0.15, CATCHER, "How far vessel B may move each way along x from home (the robot scene "
+                            "verifies +-0.15 m).", "m", 0.0, 0.15, lo_open=True)
+    max_speed: float = like(CatcherConfig, "max_speed")
+    max_accel: float = like(CatcherConfig, "max_accel")
+    discharge_coefficient: float = like(CatcherConfig, "discharge_coefficient")
+    filter_time: float = like(CatcherConfig, "filter_time")
 
     def __post_init__(self) -> None:
-        check_positive("controller.catcher.travel", self.travel, "m", 0.15)
+        check_settings(self, "controller.catcher")
 
 
 # The CFS head's floor in particle spacings, by dimension (ControllerSettings.stream_particles not set). In 2-D a
@@ -134,14 +142,10 @@ class CatcherSettings:
 STREAM_PARTICLES = {2: 2.5, 3: 1.0}
 
 
+@documented
 @dataclass(frozen=True)
 class ControllerSettings:
-    """control_rate: Hz, rate of the pour controller. [20, 500]
-    stream_particles: the CFS liquid height over the crest is at least this many particle spacings, so that the
-      stream is resolved (the paper holds it near the smoothing length), up to 0.05 m (cfs.h_q_ref's limit); a
-      partial pour's final stage holds cfs.final_head_fraction of it; not set: 2.5 in 2-D, 1.0 in 3-D (a 3-D sheet
-      spreads sideways off the lip under its head, :data:`STREAM_PARTICLES`). [0, 10]
-    sim: slosh induction (Camporredondo et al. 2019, Fig. 7).
+    """sim: slosh induction (Camporredondo et al. 2019, Fig. 7).
     approach: tilt toward the crest without SIM.
     cfs: constant-flow stage (Camporredondo et al. 2019, Sec. 3.2).
     returning: back upright after the pour.
@@ -149,8 +153,13 @@ class ControllerSettings:
     pose_filter: task-space limits of the vessel targets before inverse kinematics.
     """
 
-    control_rate: float = 100.0
-    stream_particles: float | None = None  # STREAM_PARTICLES[dim]
+    control_rate: float = like(PourConfig, "control_rate")
+    stream_particles: float | None = setting(
+        None, POUR, "The CFS liquid height over the crest is at least this many particle spacings, so that the "
+        "stream is resolved (the paper holds it near the smoothing length), up to cfs.h_q_ref's limit; a partial "
+        "pour's final stage holds cfs.final_head_fraction of it.", "", 0.0, 10.0,
+        none_means=f"{STREAM_PARTICLES[2]:g} in 2-D, {STREAM_PARTICLES[3]:g} in 3-D (a 3-D sheet spreads sideways off "
+        "the lip under its head)")
     sim: SimConfig = field(default_factory=SimConfig)
     approach: ApproachConfig = field(default_factory=ApproachConfig)
     cfs: CfsConfig = field(default_factory=CfsConfig)
@@ -159,31 +168,30 @@ class ControllerSettings:
     pose_filter: PoseFilterLimits = field(default_factory=PoseFilterLimits)
 
     def __post_init__(self) -> None:
-        check_range("controller.control_rate", self.control_rate, 20.0, 500.0, "Hz")
-        if self.stream_particles is not None:
-            check_range("controller.stream_particles", self.stream_particles, 0.0, 10.0)
+        check_settings(self, "controller")
 
     def stream_particles_in(self, dim: int) -> float:
         """``stream_particles`` as set, else its default for a ``dim``-D liquid (:data:`STREAM_PARTICLES`)."""
         return STREAM_PARTICLES[dim] if self.stream_particles is None else self.stream_particles
 
 
+@documented
 @dataclass(frozen=True)
 class TrajectorySettings:
-    """sample_rate_hz: Hz, rate of the exported joint trajectories. (0, 10000]
-    limits: per-joint overrides of the arms' limits, keyed '<arm>/<joint>' (e.g. 'pour_arm/elbow'), each with
+    """limits: per-joint overrides of the arms' limits, keyed '<arm>/<joint>' (e.g. 'pour_arm/elbow'), each with
       max_velocity (rad/s), max_acceleration (rad/s^2), max_jerk (rad/s^3), min_position, max_position (rad),
       rated_torque (N m).
     joint_prefix: per arm, the prefix of its joint names in trajectory.json and trajectory.mcap (the names its ROS 2
       driver uses, e.g. 'shoulder_pan_joint'), as the driver's tf_prefix.
     """
 
-    sample_rate_hz: float = 500.0
+    sample_rate_hz: float = setting(DEFAULT_SAMPLE_RATE_HZ, TRAJECTORY, "Rate of the exported joint trajectories.",
+                                    "Hz", 0.0, MAX_SAMPLE_RATE_HZ, lo_open=True)
     limits: dict[str, JointLimitOverride] = field(default_factory=dict)
     joint_prefix: JointPrefix = field(default_factory=JointPrefix)
 
     def __post_init__(self) -> None:
-        check_positive("trajectory.sample_rate_hz", self.sample_rate_hz, "Hz", 10000.0)
+        check_settings(self, "trajectory")
 
 
 @dataclass(frozen=True)
@@ -196,42 +204,34 @@ class LoggingSettings:
     recording: RecordingConfig = field(default_factory=lambda: RecordingConfig(particle_rate_hz=30.0))
 
 
-# Inner sizes of a scene's vessels, m: from a small beaker to the largest vessel the arm's 12.5 kg payload could hold.
-VESSEL_SIZE_RANGE = (0.02, 0.6)
-# Wall thickness, m: at least 1 mm (a thinner wall is not a vessel an arm can hold); at most 5 cm.
-WALL_THICKNESS_RANGE = (0.001, 0.05)
-# Wall material density, kg/m^3: from foamed plastics to tungsten.
-WALL_DENSITY_RANGE = (100.0, 25000.0)
-# A mesh's pour direction, deg about +z from the file's +x.
-POUR_DIRECTION_RANGE = (-180.0, 180.0)
-
-
+@documented
 @dataclass(frozen=True)
 class VesselSettings:
-    """shape: 'box' or 'cylinder', an open vessel standing on its floor; or 'mesh', the vessel's walls from the file
-      ``mesh`` (the sizes and the wall thickness then come from the mesh, docs/mesh_vessels.md).
-    inner_width: m, inner size along the pour direction (the vessel's x, toward its lip); a cylinder's inner
-      diameter. [0.02, 0.6]
-    inner_depth: m, a box's inner size across the pour plane (a cylinder's is its diameter: this key is not used).
-      [0.02, 0.6]
-    inner_height: m, inner floor to rim. [0.02, 0.6]
-    wall_thickness: m, floor and walls; less than the inner width (and a box's inner depth). [0.001, 0.05]
-    wall_density: kg/m^3, the wall material (acrylic 1180, glass 2500, steel 7850); with the walls' volume it sets
-      the empty vessel's mass. [100, 25000]
+    """An open vessel standing on its floor: a box, a cylinder or the walls of a mesh file.
+
     mesh: a 'mesh' vessel's file: OBJ or STL, one watertight solid of the walls, in metres, its opening up (+z);
       relative to the scene file. Its bounding box within [0.005, 2] m.
-    pour_direction: deg, a 'mesh' vessel's pour direction: the azimuth about +z, from the file's +x, of the wall the
-      liquid leaves over. [-180, 180]
     """
 
-    shape: VesselShape = VesselSpec.shape
-    inner_width: float = VesselSpec.inner_width
-    inner_depth: float = VesselSpec.inner_depth
-    inner_height: float = VesselSpec.inner_height
-    wall_thickness: float = VesselSpec.wall_thickness
-    wall_density: float = VesselSpec.wall_density
+    shape: VesselShape = setting(VesselSpec.shape, VESSEL, "'box' or 'cylinder', an open vessel standing on its floor; "
+                                 "or 'mesh', the vessel's walls from the file mesh (the sizes and the wall thickness "
+                                 "then come from the mesh, docs/mesh_vessels.md).")
+    # Inner sizes from a small beaker to the largest vessel the arm's 12.5 kg payload could hold.
+    inner_width: float = setting(VesselSpec.inner_width, VESSEL, "Inner size along the pour direction (the vessel's x, "
+                                 "toward its lip); a cylinder's inner diameter.", "m", 0.02, 0.6)
+    inner_depth: float = setting(VesselSpec.inner_depth, VESSEL, "A box's inner size across the pour plane (a "
+                                 "cylinder's is its diameter: this key is not used).", "m", 0.02, 0.6)
+    inner_height: float = setting(VesselSpec.inner_height, VESSEL, "Inner floor to rim.", "m", 0.02, 0.6)
+    # At least 1 mm: a thinner wall is not a vessel an arm can hold.
+    wall_thickness: float = setting(VesselSpec.wall_thickness, VESSEL, "Floor and walls; less than the inner width "
+                                    "(and a box's inner depth).", "m", 0.001, 0.05)
+    # From foamed plastics to tungsten.
+    wall_density: float = setting(VesselSpec.wall_density, VESSEL, "The wall material (acrylic 1180, glass 2500, steel "
+                                  "7850); with the walls' volume it sets the empty vessel's mass.", "kg/m^3",
+                                  100.0, 25000.0)
     mesh: str = ""
-    pour_direction: float = 0.0
+    pour_direction: float = setting(0.0, VESSEL, "A 'mesh' vessel's pour direction: the azimuth about +z, from the "
+                                    "file's +x, of the wall the liquid leaves over.", "deg", -180.0, 180.0)
 
     @classmethod
     def of(cls, spec: VesselSpec) -> "VesselSettings":
@@ -239,23 +239,19 @@ class VesselSettings:
         return cls(spec.shape, spec.inner_width, spec.inner_depth, spec.inner_height, spec.wall_thickness, spec.wall_density)
 
     def check(self, prefix: str) -> None:
-        """Range checks, each message naming the field as ``<prefix>.<field>``; a mesh is loaded and checked
-        (:func:`cosim.mesh_vessel.load_vessel_mesh`)."""
-        check_range(f"{prefix}.pour_direction", self.pour_direction, *POUR_DIRECTION_RANGE, "deg")
+        """Range checks, each message naming the field as ``<prefix>.<field>``: the declared ranges, and a wall
+        thinner than the vessel is narrow; a mesh is loaded and checked (:func:`cosim.mesh_vessel.load_vessel_mesh`)."""
+        check_settings(self, prefix)
         if (self.shape is VesselShape.MESH) != bool(self.mesh):
             raise InputError(f"{prefix}.mesh: a file for shape 'mesh' (and only for it), got shape {self.shape.value!r} "
                              f"and mesh {self.mesh!r}")
         if self.shape is VesselShape.MESH:
-            check_range(f"{prefix}.wall_density", self.wall_density, *WALL_DENSITY_RANGE, "kg/m^3")
             self.spec(prefix.rsplit(".", 1)[-1], prefix)
             return
-        lo, hi = VESSEL_SIZE_RANGE
-        for name in ("inner_width", "inner_depth", "inner_height"):
-            check_range(f"{prefix}.{name}", getattr(self, name), lo, hi, "m")
-        check_range(f"{prefix}.wall_density", self.wall_density, *WALL_DENSITY_RANGE, "kg/m^3")
         narrowest = min(self.inner_width, self.inner_depth) if self.shape is VesselShape.BOX else self.inner_width
-        hi = min(WALL_THICKNESS_RANGE[1], narrowest)
-        check_range(f"{prefix}.wall_thickness", self.wall_thickness, WALL_THICKNESS_RANGE[0], hi, "m", hi_open=hi < WALL_THICKNESS_RANGE[1])
+        if self.wall_thickness >= narrowest:
+            thinnest = declared(VesselSettings, "wall_thickness").bounds.lo
+            raise InputError(f"{prefix}.wall_thickness: must be in [{thinnest:g}, {narrowest:g}) m, got {self.wall_thickness:g}")
 
     def spec(self, name: str, prefix: str = "vessels") -> VesselSpec:
         """The :class:`VesselSpec` named ``name`` (a cylinder's depth is its diameter; a mesh's from its file, errors
@@ -283,26 +279,23 @@ class VesselsSettings:
         self.catcher.check("vessels.catcher")
 
 
+@documented
 @dataclass(frozen=True)
 class PlacementSettings:
-    """table_height: m, the top of the table both arms stand on (the height of their bases). [0.3, 1.2]
-    pourer_height: m, the pourer's inner floor above the table top at home. [0.1, 1.0]
-    catcher_home_x: m, where vessel B waits: its centre along the pour direction from the pourer's centre, at home
-      (the catcher moves controller.catcher.travel each way from there). [0, 0.6]
-    pour_height: m, the pourer's lip above the catcher's rim at home (the controller lowers the pourer from there
-      during the pour). [0.05, 1.0]
-    """
+    """Where the table, the pourer and the catcher stand."""
 
-    table_height: float = TABLE_TOP
-    pourer_height: float = POURER_FLOOR_ABOVE_TABLE
-    catcher_home_x: float = CATCHER_HOME_X
-    pour_height: float = POUR_HEIGHT
+    table_height: float = setting(TABLE_TOP, PLACEMENT, "The top of the table both arms stand on (the height of their "
+                                  "bases).", "m", 0.3, 1.2)
+    pourer_height: float = setting(POURER_FLOOR_ABOVE_TABLE, PLACEMENT, "The pourer's inner floor above the table top "
+                                   "at home.", "m", 0.1, 1.0)
+    catcher_home_x: float = setting(CATCHER_HOME_X, PLACEMENT, "Where vessel B waits: its centre along the pour "
+                                    "direction from the pourer's centre, at home (the catcher moves "
+                                    "controller.catcher.travel each way from there).", "m", 0.0, 0.6)
+    pour_height: float = setting(POUR_HEIGHT, PLACEMENT, "The pourer's lip above the catcher's rim at home (the "
+                                 "controller lowers the pourer from there during the pour).", "m", 0.05, 1.0)
 
     def __post_init__(self) -> None:
-        check_range("placement.table_height", self.table_height, 0.3, 1.2, "m")
-        check_range("placement.pourer_height", self.pourer_height, 0.1, 1.0, "m")
-        check_range("placement.catcher_home_x", self.catcher_home_x, 0.0, 0.6, "m")
-        check_range("placement.pour_height", self.pour_height, 0.05, 1.0, "m")
+        check_settings(self, "placement")
 
 
 @dataclass(frozen=True)

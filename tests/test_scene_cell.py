@@ -87,10 +87,14 @@ def test_the_controller_designs_on_the_slosh_mode_of_the_liquids_shape():
 def test_the_dump_lists_the_vessels_and_the_placement_with_their_ranges():
     from cosim.pour_scene import dump_scene
 
+    from cosim.pour_scene import PlacementSettings, VesselSettings
+    from declared_settings.setting import declared
+
     text = dump_scene(PourScene())
+    wall, height = declared(VesselSettings, "wall_thickness"), declared(PlacementSettings, "pour_height")
     for line in ("[vessels.pourer]", "[vessels.catcher]", "[placement]",
-                 "wall_thickness = 0.005 # m, floor and walls; less than the inner width (and a box's inner depth). [0.001, 0.05]",
-                 "pour_height = 0.401 # m, the pourer's lip above the catcher's rim at home"):
+                 f"wall_thickness = {VesselSettings().wall_thickness} # {wall.meaning} Allowed: [0.001, 0.05] m.",
+                 f"pour_height = {PlacementSettings().pour_height} # {height.meaning} Allowed: [0.05, 1] m."):
         assert line in text
 
 
