@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from cosim.checks import check_positive
+from controllers.config import PourConfig
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.liquid import scene_liquid
 from cosim.coupling.loop import coupled_step
@@ -28,6 +28,7 @@ from cosim.robots.scene import RobotScene
 from cosim.robots.scene_builder import build_scene_spec
 from cosim.robots.scene_config import ArmRole
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, new_figure
+from declared_settings.setting import check_settings, documented, setting
 
 # Acceptance: the reaction equals the liquid's weight within 1 %; the joint torques match the rigid-payload model
 # within 2 %.
@@ -37,17 +38,21 @@ AVERAGE_WINDOW = 0.1  # s at the end of the run over which forces and torques ar
 PARTICLES_ACROSS = 24
 
 
+COUPLING_STATIC = "coupling static"
+
+
+@documented
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
-    """fill: m, liquid depth in the pourer. duration: s held."""
+    """The pourer held still by its arm with the liquid at rest in it."""
 
-    fill: float = 0.1591
-    duration: float = 0.5
+    fill: float = setting(PourConfig.fill_depth, COUPLING_STATIC, "Liquid depth in the pourer.", "m", 0.0, 2.0,
+                          lo_open=True)
+    duration: float = setting(0.5, COUPLING_STATIC, "Time held.", "s", 0.0, 30.0, lo_open=True)
 
     def __post_init__(self) -> None:
         self.validate_common()
-        check_positive("fill", self.fill, "m", 2.0)
-        check_positive("duration", self.duration, "s", 30.0)
+        check_settings(self)
 
 
 def _hold(scene: RobotScene, steps: int, window: int, step_fn) -> np.ndarray:

@@ -25,7 +25,6 @@ from importlib import resources
 
 import numpy as np
 
-from cosim.checks import check_positive
 from cosim.fluid.config import GRAVITY
 from cosim.fluid.seeding import liquid_block
 from cosim.fluid.solver import FluidSolver
@@ -34,6 +33,7 @@ from cosim.fluid.wall_sampling import numerical_wall_thickness
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
 from cosim.validation.dam_gate import MAX_GATE_SPEED, lauber_hager_speed, lifted_gate
 from cosim.vessel import VesselSpec
+from declared_settings.setting import check_settings, documented, setting
 
 # Acceptance: surge front within 10 % of Martin & Moyce at every point with T <= 3.
 FRONT_TOLERANCE = 0.10
@@ -76,25 +76,26 @@ def first_reach(T: np.ndarray, Z: np.ndarray, z: float) -> float:
     return float(T[k - 1] + (z - Z[k - 1]) * (T[k] - T[k - 1]) / (Z[k] - Z[k - 1]))
 
 
+DAM_BREAK = "dam break"
+
+
+@documented
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
-    """width: m, column width a. fill: m, column height (None: a square column). t_max: largest T simulated.
-    gate_speed: m/s, the column is released by a gate lifted at this speed (:mod:`cosim.validation.dam_gate`);
-    None: released instantaneously."""
+    """A column of liquid released on a dry floor (Martin & Moyce 1952)."""
 
-    width: float = MARTIN_MOYCE_COLUMN
-    fill: float | None = None
-    t_max: float = 9.5  # past the last reference point (T = 9.24)
-    gate_speed: float | None = None
+    width: float = setting(MARTIN_MOYCE_COLUMN, DAM_BREAK, "Column width a.", "m", 0.0, 2.0, lo_open=True)
+    fill: float | None = setting(None, DAM_BREAK, "Column height.", "m", 0.0, 2.0, lo_open=True,
+                                 none_means="a square column")
+    t_max: float = setting(9.5, DAM_BREAK, "Largest dimensionless time T simulated (9.5: past the last reference "
+                           "point, T = 9.24).", "", 0.0, 10.0, lo_open=True)
+    gate_speed: float | None = setting(None, DAM_BREAK, "The column is released by a gate lifted at this speed "
+                                       "(cosim.validation.dam_gate).", "m/s", 0.0, MAX_GATE_SPEED, lo_open=True,
+                                       none_means="released instantaneously")
 
     def __post_init__(self) -> None:
         self.validate_common()
-        check_positive("width", self.width, "m", 2.0)
-        if self.fill is not None:
-            check_positive("fill", self.fill, "m", 2.0)
-        check_positive("t_max", self.t_max, "", 10.0)
-        if self.gate_speed is not None:
-            check_positive("gate_speed", self.gate_speed, "m/s", MAX_GATE_SPEED)
+        check_settings(self)
 
     @property
     def resolved_spacing(self) -> float:

@@ -22,13 +22,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cosim.checks import check_positive, check_range
 from cosim.fluid.config import GRAVITY
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
+from cosim.pour_scene import FluidSettings
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
 from cosim.validation.scripted import FALL_HEIGHT, domain_around, run_scripted, tilt_about_lip
 from cosim.vessel import VesselSpec, seed_pouring_vessel
+from declared_settings.setting import check_settings, documented, like, setting
 
 # Acceptance: the median landing error of the followed particles within 10 mm, the landing accuracy asked
 # of the pour (there measured against the controller's prediction, which adds the measurement of the jet).
@@ -36,29 +37,31 @@ LANDING_TOLERANCE = 0.010  # m
 MIN_FOLLOWED = 20  # particles that must land for the median to mean something
 
 
+FREE_FALL = "free fall"
+
+
+@documented
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
-    """fill: m. rate: deg/s. angle: deg. hold: s the tilted vessel is held while the liquid keeps pouring. drop: m
-    below the lip where particles land. launch_spacings: how far beyond the lip (in particle spacings) the launch
-    state is taken. particles_across: resolution across the vessel's inner width when ``spacing`` is not given
-    (the default scene's 32)."""
+    """The stream from the paper's vessel tilted about its lip, followed particle by particle to where it lands."""
 
-    fill: float = 0.159
-    rate: float = 57.3
-    angle: float = 75.0
-    hold: float = 1.0
-    drop: float = 0.25
-    launch_spacings: float = 1.0
-    particles_across: int = 32
+    fill: float = setting(0.159, FREE_FALL, "Liquid depth in the upright vessel.", "m", 0.0, "inner_height", lo_open=True)
+    rate: float = setting(57.3, FREE_FALL, "Tilt rate.", "deg/s", 0.0, 600.0, lo_open=True)
+    angle: float = setting(75.0, FREE_FALL, "Tilt.", "deg", 0.0, 120.0, lo_open=True)
+    hold: float = setting(1.0, FREE_FALL, "Time the tilted vessel is held while the liquid keeps pouring.", "s", 0.0, 60.0)
+    drop: float = setting(0.25, FREE_FALL, "Height below the lip where particles land.", "m", 0.05, FALL_HEIGHT)
+    launch_spacings: float = setting(1.0, FREE_FALL, "How far beyond the lip (in particle spacings) the launch state "
+                                     "is taken.", "", 0.0, 10.0)
+    particles_across: int = like(FluidSettings, "particles_across")
 
     def __post_init__(self) -> None:
         self.validate_common()
-        check_positive("fill", self.fill, "m", seed_pouring_vessel().inner_height)
-        check_positive("rate", self.rate, "deg/s", 600.0)
-        check_range("angle", self.angle, 0.0, 120.0, "deg", lo_open=True)
-        check_range("hold", self.hold, 0.0, 60.0, "s")
-        check_range("drop", self.drop, 0.05, FALL_HEIGHT, "m")
-        check_range("launch_spacings", self.launch_spacings, 0.0, 10.0)
+        check_settings(self)
+
+    @property
+    def inner_height(self) -> float:
+        """m, the vessel's inner height (the fill's limit)."""
+        return self.spec().inner_height
 
     def spec(self) -> VesselSpec:
         return seed_pouring_vessel()

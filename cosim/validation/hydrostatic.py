@@ -19,7 +19,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cosim.checks import check_positive
 from cosim.fluid.config import GRAVITY
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
@@ -27,6 +26,7 @@ from cosim.frames import Pose
 from cosim.pour_scene import load_scene
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
 from cosim.vessel import VesselSpec
+from declared_settings.setting import check_settings, documented, setting
 
 # Acceptance: pressure within 2 % of rho0 g (H - z) away from walls and surface, density error <= 1 % (the weakly
 # compressible bound (v_max / c0)^2 with c0 >= 10 v_max: Monaghan 1994, "Simulating free surface flows with SPH"),
@@ -39,21 +39,25 @@ PROBE_CLEARANCE = 2.0  # probes stay this many smoothing lengths h from walls, f
 INTERVAL = 0.02  # s, how often vessel poses are (re)set; the tank does not move
 
 
+HYDROSTATIC = "hydrostatic"
+
+
+@documented
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
-    """width: m, tank inner width (B). fill: m, fill depth. duration: s, simulated time before measuring. scene: a scene
-    file whose pourer is the tank ('': a box of ``width`` and ``depth``)."""
+    """A tank of liquid at rest.
 
-    width: float = 0.191
-    fill: float = 0.159
-    duration: float = 2.0
+    scene: a scene file whose pourer is the tank ('': a box of ``width`` and ``depth``).
+    """
+
+    width: float = setting(VesselSpec.inner_width, HYDROSTATIC, "Tank inner width (B).", "m", 0.0, 2.0, lo_open=True)
+    fill: float = setting(0.159, HYDROSTATIC, "Fill depth.", "m", 0.0, 2.0, lo_open=True)
+    duration: float = setting(2.0, HYDROSTATIC, "Simulated time before measuring.", "s", 0.0, 60.0, lo_open=True)
     scene: str = ""
 
     def __post_init__(self) -> None:
         self.validate_common()
-        check_positive("width", self.width, "m", 2.0)
-        check_positive("fill", self.fill, "m", 2.0)
-        check_positive("duration", self.duration, "s", 60.0)
+        check_settings(self)
 
     @property
     def resolved_spacing(self) -> float:

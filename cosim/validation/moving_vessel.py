@@ -22,37 +22,45 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cosim.checks import check_positive, check_range
 from cosim.pour_scene import load_scene
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
 from cosim.validation.scripted import FALL_HEIGHT, PoseScript, domain_around, run_scripted, shake_sideways, tilt_about_lip
 from cosim.validation.slosh import eq17_frequency
 from cosim.vessel import VesselSpec, seed_pouring_vessel
+from declared_settings.setting import check_settings, documented, setting
 
 HOLD_AFTER_TILT = 0.5  # s the tilted vessel is held before the run ends
 
 
+MOVING_VESSEL = "moving vessel"
+
+
+@documented
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
-    """fill: m. rate: deg/s (tilt). angle: deg (tilt). amplitude: m (shake). periods: shake periods.
-    particles_across: resolution across the vessel's inner width when ``spacing`` is not given. scene: a scene file
-    whose pourer is the vessel ('': the paper's vessel)."""
+    """A vessel tilted about its lip or shaken sideways.
 
-    fill: float = 0.159
-    rate: float = 60.0
-    angle: float = 90.0
-    amplitude: float = 0.01
-    periods: float = 4.0
-    particles_across: int = 24
+    scene: a scene file whose pourer is the vessel ('': the paper's vessel).
+    """
+
+    fill: float = setting(0.159, MOVING_VESSEL, "Liquid depth in the upright vessel.", "m", 0.0, "inner_height",
+                          lo_open=True)
+    rate: float = setting(60.0, MOVING_VESSEL, "Tilt rate.", "deg/s", 0.0, 600.0, lo_open=True)
+    angle: float = setting(90.0, MOVING_VESSEL, "Tilt.", "deg", 0.0, 180.0, lo_open=True)
+    amplitude: float = setting(0.01, MOVING_VESSEL, "Shake amplitude.", "m", 0.0, 0.1)
+    periods: float = setting(4.0, MOVING_VESSEL, "Shake periods.", "", 0.0, 50.0, lo_open=True)
+    particles_across: int = setting(24, MOVING_VESSEL, "Resolution across the vessel's inner width when spacing is not "
+                                    "given.", "", 8, 400)
     scene: str = ""
 
     def __post_init__(self) -> None:
         self.validate_common()
-        check_positive("fill", self.fill, "m", self.spec().inner_height)
-        check_positive("rate", self.rate, "deg/s", 600.0)
-        check_range("angle", self.angle, 0.0, 180.0, "deg", lo_open=True)
-        check_range("amplitude", self.amplitude, 0.0, 0.1, "m")
-        check_positive("periods", self.periods, "", 50.0)
+        check_settings(self)
+
+    @property
+    def inner_height(self) -> float:
+        """m, the vessel's inner height (the fill's limit)."""
+        return self.spec().inner_height
 
     def spec(self) -> VesselSpec:
         return load_scene(self.scene).vessels.pourer.spec("pourer", "vessels.pourer") if self.scene else seed_pouring_vessel()

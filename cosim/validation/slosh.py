@@ -17,7 +17,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cosim.checks import check_positive
 from cosim.fluid.config import GRAVITY
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
@@ -33,6 +32,7 @@ from cosim.validation.common import (
     zero_crossing_frequency,
 )
 from cosim.vessel import VesselSpec
+from declared_settings.setting import check_settings, documented, setting
 
 # Acceptance: first-mode frequency within 3 % of Eq. 17.
 FREQUENCY_TOLERANCE = 0.03
@@ -47,19 +47,21 @@ def eq17_frequency(width: float, fill: float, g: float = GRAVITY) -> float:
     return math.sqrt(g * math.pi / width * math.tanh(math.pi * fill / width)) / (2.0 * math.pi)
 
 
+SLOSH = "slosh"
+
+
+@documented
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
-    """width: m, tank inner width B. fill: m, fill depth A. periods: oscillation periods measured after the pulse."""
+    """A tank's first slosh mode, excited by a pulse."""
 
-    width: float = 0.191
-    fill: float = 0.108
-    periods: float = 5.0
+    width: float = setting(VesselSpec.inner_width, SLOSH, "Tank inner width B.", "m", 0.0, 2.0, lo_open=True)
+    fill: float = setting(0.108, SLOSH, "Fill depth A.", "m", 0.0, 2.0, lo_open=True)
+    periods: float = setting(5.0, SLOSH, "Oscillation periods measured after the pulse.", "", 0.0, 50.0, lo_open=True)
 
     def __post_init__(self) -> None:
         self.validate_common()
-        check_positive("width", self.width, "m", 2.0)
-        check_positive("fill", self.fill, "m", 2.0)
-        check_positive("periods", self.periods, "", 50.0)
+        check_settings(self)
 
     @property
     def resolved_spacing(self) -> float:

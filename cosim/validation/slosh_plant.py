@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from controllers.config import PourConfig
 from controllers.errors import ControllerInputError
 from controllers.slosh import SloshModel, VesselShape as SloshShape, potential_flow_model
-from cosim.checks import check_choice, check_int, check_positive
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.solver import FluidSolver
@@ -33,6 +33,7 @@ from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fl
 from cosim.validation.plant_fit import PlantFit, identify_plant
 from cosim.validation.scripted import run_scripted, tilt_about_axis_point
 from cosim.vessel import VesselShape, VesselSpec
+from declared_settings.setting import check_settings, documented, setting
 
 # Acceptance: the identified hinge within 5 mm and omega1 within 2 % of the potential-flow model.
 HINGE_TOLERANCE = 0.005  # m
@@ -40,7 +41,6 @@ OMEGA_TOLERANCE = 0.02
 TILT_ANGLE = 0.08  # rad: small, so the slosh stays linear (surface slope ~0.1)
 TILT_DURATION = 0.16  # s: about a third of the first period at the default fills, so the tilt excites the mode
 PIVOT_FRACTIONS = (0.0, 0.5, 1.0, 1.2)  # pivot heights as fractions of the potential-flow hinge H
-PARTICLES_ACROSS = 40
 MIN_PARTICLES_ACROSS = 8
 MIN_HOLD_PERIODS = 2.0  # the ring-down recorded after each tilt, in first-mode periods at least
 # s the seeded liquid relaxes upright, its velocity dropped after every sample, before each tilt
@@ -49,29 +49,31 @@ MIN_HOLD_PERIODS = 2.0  # the ring-down recorded after each tilt, in first-mode 
 SETTLE_TIME = 0.1
 
 
+SLOSH_PLANT = "slosh plant"
+
+
+@documented
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
-    """width: m, box inner width B or cylinder inner diameter. fill: m, fill depth A. shape: 'box' or 'cylinder'
-    (3-D only: in 2-D a cylinder's section is a box). hold: s recorded after each tilt. particles_across: the
-    resolution across ``width`` when ``spacing`` is not given."""
+    """A box or a cup tilted about pivots at several heights, its slosh identified as a pendulum."""
 
-    width: float = 0.191
-    fill: float = 0.1591
-    shape: VesselShape = VesselShape.BOX
-    hold: float = 1.5
-    particles_across: int = PARTICLES_ACROSS
+    width: float = setting(VesselSpec.inner_width, SLOSH_PLANT, "Box inner width B or cylinder inner diameter.", "m",
+                           0.0, 2.0, lo_open=True)
+    fill: float = setting(PourConfig.fill_depth, SLOSH_PLANT, "Fill depth A.", "m", 0.0, 2.0, lo_open=True)
+    shape: VesselShape = setting(VesselShape.BOX, SLOSH_PLANT, "'box' or 'cylinder' (3-D only: in 2-D a cylinder's "
+                                 "section is a box).")
+    hold: float = setting(1.5, SLOSH_PLANT, "Time recorded after each tilt, at least two first-mode periods.", "s",
+                          0.0, 60.0, lo_open=True)
+    particles_across: int = setting(40, SLOSH_PLANT, "The resolution across width when spacing is not "
+                                    "given.", "", MIN_PARTICLES_ACROSS, 200)
 
     def __post_init__(self) -> None:
         self.validate_common()
-        check_positive("width", self.width, "m", 2.0)
-        check_positive("fill", self.fill, "m", 2.0)
-        object.__setattr__(self, "shape", check_choice("shape", self.shape, VesselShape))
+        check_settings(self)
         if self.shape is VesselShape.CYLINDER and self.dim == 2:
             raise InputError("shape: a cylinder needs dim 3 (its 2-D section is a box); use shape box or dim 3")
-        check_int("particles_across", self.particles_across, MIN_PARTICLES_ACROSS, 200)
         require_particles_across("spacing", self.width, self.resolved_spacing, MIN_PARTICLES_ACROSS)
         period = self.model_at(self.fill).period
-        check_positive("hold", self.hold, "s", 60.0)
         if self.hold < MIN_HOLD_PERIODS * period:
             raise InputError(f"hold: {self.hold:g} s is under {MIN_HOLD_PERIODS:g} first-mode periods ({period:.3f} s each); "
                              f"needs >= {MIN_HOLD_PERIODS * period:.3f} s")

@@ -30,7 +30,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cosim.checks import check_positive, check_range
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY
 from cosim.fluid.seeding import ParticleSet, liquid_block
@@ -39,6 +38,7 @@ from cosim.fluid.wall_sampling import numerical_wall_thickness
 from cosim.frames import Pose
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
 from cosim.vessel import VesselSpec
+from declared_settings.setting import check_settings, documented, setting
 
 # Acceptance: the discharge coefficient within 5 % of Rehbock's at each head.
 COEFFICIENT_TOLERANCE = 0.05
@@ -57,24 +57,25 @@ def rehbock(head: float, crest_height: float) -> float:
     return 0.611 + 0.08 * head / crest_height
 
 
+WEIR = "weir"
+
+
+@documented
 @dataclass(frozen=True)
 class Params(FluidCaseParams):
-    """head: m, nominal head H0 over the crest (sets the piston's speed). crest_height: m, P. duration: s simulated.
-    window: s, the final stretch over which q and H are measured (the flow settles before it)."""
+    """A 2-D channel whose piston drives the liquid over the sharp-crested weir at its end."""
 
-    head: float = HEADS[0]
-    crest_height: float = 0.08
-    duration: float = 1.6
-    window: float = 0.8
+    head: float = setting(HEADS[0], WEIR, "Nominal head H0 over the crest (sets the piston's speed).", "m", 0.005, 0.2)
+    crest_height: float = setting(0.08, WEIR, "Crest height P.", "m", 0.02, 0.5)
+    duration: float = setting(1.6, WEIR, "Simulated time.", "s", 0.0, 10.0, lo_open=True)
+    window: float = setting(0.8, WEIR, "The final stretch over which q and H are measured (the flow settles before "
+                            "it).", "s", 0.05, "duration")
 
     def __post_init__(self) -> None:
         self.validate_common()
         if self.dim != 2:
             raise InputError("dim: the weir case runs in 2-D only (the pour plane); choose 2")
-        check_range("head", self.head, 0.005, 0.2, "m")
-        check_range("crest_height", self.crest_height, 0.02, 0.5, "m")
-        check_positive("duration", self.duration, "s", 10.0)
-        check_range("window", self.window, 0.05, self.duration, "s (at most the duration)")
+        check_settings(self)
         if self.head / self.resolved_spacing < 4.0 - 1e-9:
             raise InputError(f"spacing: {self.resolved_spacing:g} m gives {self.head / self.resolved_spacing:.1f} particles across "
                              f"the {self.head:g} m head; needs >= 4")
