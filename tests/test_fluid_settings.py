@@ -17,31 +17,10 @@ from cosim.pour_scene import FluidSettings
 from declared_settings.setting import declared, declared_fields
 from cosim.validation.common import FluidCaseParams
 from tests.support.cli_refusal import refusal
+from tests.support.setting_bounds import inside, outside
 
 FLUID = declared_fields(FluidConfig)
 BOUNDED = [(name, spec) for name, spec in FLUID if spec.bounds is not None and spec.kind in ("float", "int")]
-
-
-def outside(spec) -> list[float]:
-    """The values just outside each finite bound of ``spec`` (the bound itself where it is open)."""
-    b, step = spec.bounds, (lambda x, d: x + d) if spec.kind == "int" else (lambda x, d: math.nextafter(x, d * math.inf))
-    values = []
-    if b.lo is not None:
-        values.append(b.lo if b.lo_open else step(b.lo, -1))
-    if b.hi is not None:
-        values.append(b.hi if b.hi_open else step(b.hi, 1))
-    return values
-
-
-def inside(spec) -> list[float]:
-    """The values at (or, where open, just inside) each finite bound of ``spec``."""
-    b = spec.bounds
-    values = []
-    if b.lo is not None:
-        values.append(math.nextafter(b.lo, math.inf) if b.lo_open else b.lo)
-    if b.hi is not None:
-        values.append(math.nextafter(b.hi, -math.inf) if b.hi_open else b.hi)
-    return [int(v) for v in values] if spec.kind == "int" else values
 
 
 def test_every_setting_is_declared_in_a_known_group_with_a_meaning():

@@ -127,7 +127,7 @@ def case_fluid_config(
 
 
 def require_particles_across(name: str, width: float, spacing: float, minimum: int) -> None:
-    if width / spacing < minimum - 1e-9:
+    if width < (minimum - 1e-9) * spacing:  # a product: a spacing that underflowed to 0 is no division by zero
         raise InputError(f"{name}: spacing {spacing:g} m gives {width / spacing:.1f} particles across {width:g} m; needs >= {minimum}")
 
 

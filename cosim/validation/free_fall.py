@@ -45,7 +45,8 @@ FREE_FALL = "free fall"
 class Params(FluidCaseParams):
     """The stream from the paper's vessel tilted about its lip, followed particle by particle to where it lands."""
 
-    fill: float = setting(0.159, FREE_FALL, "Liquid depth in the upright vessel.", "m", 0.0, "inner_height", lo_open=True)
+    fill: float = setting(0.159, FREE_FALL, "Liquid depth in the upright vessel.", "m", 0.0,
+                          seed_pouring_vessel().inner_height, lo_open=True)
     rate: float = setting(57.3, FREE_FALL, "Tilt rate.", "deg/s", 0.0, 600.0, lo_open=True)
     angle: float = setting(75.0, FREE_FALL, "Tilt.", "deg", 0.0, 120.0, lo_open=True)
     hold: float = setting(1.0, FREE_FALL, "Time the tilted vessel is held while the liquid keeps pouring.", "s", 0.0, 60.0)
@@ -57,11 +58,6 @@ class Params(FluidCaseParams):
     def __post_init__(self) -> None:
         self.validate_common()
         check_settings(self)
-
-    @property
-    def inner_height(self) -> float:
-        """m, the vessel's inner height (the fill's limit)."""
-        return self.spec().inner_height
 
     def spec(self) -> VesselSpec:
         return seed_pouring_vessel()

@@ -1,0 +1,159 @@
+"""The controller's, the coupling's, the scene's and the validation cases' settings are declared once
+(declared_settings.setting): each range is enforced from that declaration, one step outside each bound is refused with
+one line naming the field and the range, the bound itself is accepted, each class's reference lists every setting,
+and ``cosim scene --dump`` shows each scene setting with the allowed values from the same declaration."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from controllers.config import ApproachConfig, CatcherConfig, CfsConfig, PourConfig, ReturnConfig, SimConfig
+from cosim.cli.main import main
+from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
+from cosim.errors import InputError
+from cosim.pour_scene import (
+    CatcherSettings, ControllerSettings, LiquidSettings, PlacementSettings, TrajectorySettings, VesselSettings,
+    VesselsSettings,
+)
+from cosim.validation import coupling_static, dam_break, free_fall, hydrostatic, moving_vessel, slosh, slosh_plant, weir
+from declared_settings.setting import REQUIRED, declared, declared_fields
+from tests.support.cli_refusal import refusal
+from tests.support.setting_bounds import inside, outside
+
+
+def _pour(**values) -> PourConfig:
+    return PourConfig(catcher=CatcherConfig(home_x=0.0), **values)
+
+
+def _pourer(**values) -> VesselsSettings:
+    return VesselsSettings(pourer=VesselSettings(**values))
+
+
+# class, how to build it with some of its settings given, the prefix its messages name the fields with
+CLASSES = [
+    (SimConfig, SimConfig, "sim."),
+    (ApproachConfig, ApproachConfig, "approach."),
+    (CfsConfig, CfsConfig, "cfs."),
+    (ReturnConfig, ReturnConfig, "returning."),
+    (CatcherConfig, lambda **v: CatcherConfig(**{"home_x": 0.0, **v}), "catcher."),
+    (PourConfig, _pour, "pour."),
+    (CouplingSettings, CouplingSettings, "coupling."),
+    (PoseFilterLimits, PoseFilterLimits, "pose_filter."),
+    (LiquidSettings, LiquidSettings, "liquid."),
+    (CatcherSettings, CatcherSettings, "controller.catcher."),
+    (ControllerSettings, ControllerSettings, "controller."),
+    (TrajectorySettings, TrajectorySettings, "trajectory."),
+    (PlacementSettings, PlacementSettings, "placement."),
+    (VesselSettings, _pourer, "vessels.pourer."),
+    # the validation cases name their parameters as their command-line options, with no prefix
+    (coupling_static.Params, coupling_static.Params, ""),
+    (dam_break.Params, dam_break.Params, ""),
+    (free_fall.Params, free_fall.Params, ""),
+    (hydrostatic.Params, hydrostatic.Params, ""),
+    (moving_vessel.Params, moving_vessel.Params, ""),
+    (slosh.Params, slosh.Params, ""),
+    (slosh_plant.Params, slosh_plant.Params, ""),
+    (weir.Params, lambda **v: weir.Params(**{"spacing": 0.001, **v}), ""),  # fine enough for the smallest head
+]
+
+
+def _owner(build, cls):
+    """The object whose attributes a named bound reads: the class as built with its defaults."""
+    built = build()
+    return built.pourer if cls is VesselSettings else built
+
+
+BOUNDED = [(cls, build, prefix, name, spec) for cls, build, prefix in CLASSES for name, spec in declared_fields(cls)
+           if spec.bounds is not None and spec.kind in ("float", "int")]
+IDS = [f"{prefix or cls.__module__.rsplit('.', 1)[-1] + '.'}{name}" for cls, _, prefix, name, _ in BOUNDED]
+
+
+@pytest.mark.parametrize("cls, build, prefix, name, spec", BOUNDED, ids=IDS)
+def test_each_bound_is_refused_one_step_outside_with_one_line_naming_the_field_and_the_range(cls, build, prefix, name, spec):
+    owner = _owner(build, cls)
+    unit = f" {spec.unit}" if spec.unit else ""
+    for value in outside(spec, owner):
+        with pytest.raises(InputError) as err:
+            build(**{name: value})
+        message = str(err.value)
+        assert message.startswith(f"{prefix}{name}: must be in {spec.bounds.of(owner).text()}{unit}, got "), message
+        assert "\n" not in message
+
+
+@pytest.mark.parametrize("cls, build, prefix, name, spec", BOUNDED, ids=IDS)
+def test_each_bound_itself_is_accepted(cls, build, prefix, name, spec):
+    owner = _owner(build, cls)
+    for value in inside(spec, owner):
+        try:
+            built = build(**{name: value})
+        except InputError as exc:  # a check across settings may refuse the combination, never this range
+            assert not str(exc).startswith(f"{prefix}{name}: must be in "), exc
+            continue
+        assert getattr(built.pourer if cls is VesselSettings else built, name) == value
+
+
+CHOICES = [(cls, build, prefix, name) for cls, build, prefix in CLASSES for name, spec in declared_fields(cls)
+           if spec.kind in ("choice", "bool")]
+
+
+@pytest.mark.parametrize("cls, build, prefix, name", CHOICES, ids=[f"{p}{n}" for _, _, p, n in CHOICES])
+def test_choices_and_switches_are_enforced_from_their_declarations(cls, build, prefix, name):
+    allowed = "one of " if declared(cls, name).kind == "choice" else "true or false"
+    with pytest.raises(InputError, match=f"^{prefix}{name}: must be {allowed}"):
+        build(**{name: "no-such-choice"})
+
+
+@pytest.mark.parametrize("cls", [c for c, _, _ in CLASSES], ids=[c.__module__ + "." + c.__name__ for c, _, _ in CLASSES])
+def test_each_class_documents_every_setting_from_its_declaration(cls):
+    for name, spec in declared_fields(cls):
+        assert spec.meaning.strip().endswith("."), name
+        assert f"{name}: {spec.meaning} Allowed: {spec.allowed()}." in cls.__doc__, name
+
+
+def test_a_setting_with_no_default_is_required():
+    assert dataclasses.fields(CatcherConfig)[0].default is REQUIRED
+    with pytest.raises(TypeError, match="home_x"):
+        CatcherConfig()
+
+
+def test_the_scene_takes_the_controllers_declarations_and_defaults():
+    for name in ("max_speed", "max_accel", "discharge_coefficient", "filter_time"):
+        assert declared(CatcherSettings, name) == declared(CatcherConfig, name), name
+        assert getattr(CatcherSettings(), name) == getattr(CatcherConfig(home_x=0.0), name), name
+    assert declared(ControllerSettings, "control_rate") == declared(PourConfig, "control_rate")
+    assert ControllerSettings().control_rate == _pour().control_rate
+    assert LiquidSettings().fill_depth == _pour().fill_depth == coupling_static.Params().fill
+
+
+# the scene's tables of declared settings, as a scene file names them
+SCENE_TABLES = [("liquid", LiquidSettings, "liquid."), ("controller", ControllerSettings, "controller."),
+                ("controller.sim", SimConfig, "sim."), ("controller.approach", ApproachConfig, "approach."),
+                ("controller.cfs", CfsConfig, "cfs."), ("controller.returning", ReturnConfig, "returning."),
+                ("controller.catcher", CatcherSettings, "controller.catcher."),
+                ("controller.pose_filter", PoseFilterLimits, "pose_filter."), ("coupling", CouplingSettings, "coupling."),
+                ("trajectory", TrajectorySettings, "trajectory."), ("placement", PlacementSettings, "placement."),
+                ("vessels.pourer", VesselSettings, "vessels.pourer.")]
+BAD_SCENE_VALUES = [(table, prefix, name, value) for table, cls, prefix in SCENE_TABLES
+                    for name, spec in declared_fields(cls) if spec.bounds is not None and spec.kind in ("float", "int")
+                    for value in outside(spec, cls() if cls is not VesselSettings else VesselSettings())]
+
+
+@pytest.mark.parametrize("table, prefix, name, value", BAD_SCENE_VALUES,
+                         ids=[f"{t}.{n}={v:g}" for t, _, n, v in BAD_SCENE_VALUES])
+def test_a_scene_value_outside_its_range_is_refused_with_one_line_and_exit_2(tmp_path, capsys, table, prefix, name, value):
+    path = tmp_path / "bad.toml"
+    path.write_text(f"[{table}]\n{name} = {value!r}\n")
+    message = refusal(capsys, ["scene", "--check", str(path)], "scene")
+    assert f"{prefix}{name}: must be in " in message, message
+
+
+def test_scene_dump_shows_each_scene_setting_with_its_allowed_values(capsys):
+    assert main(["scene", "--dump"]) == 0
+    text = capsys.readouterr().out
+    for table, cls, _ in SCENE_TABLES:
+        body = text.split(f"\n[{table}]\n", 1)[1].split("\n[", 1)[0]
+        for name, spec in declared_fields(cls):
+            lines = [line for line in body.splitlines() if line.startswith((f"{name} = ", f"# {name} = "))]
+            assert len(lines) == 1 and lines[0].endswith(f"# {spec.meaning} Allowed: {spec.allowed()}."), (table, name)
