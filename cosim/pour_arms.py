@@ -27,15 +27,11 @@ from cosim.robots.scene_config import (
     ArmModel, ArmPlacement, ArmRole, SceneConfig, check_per_joint, check_quat, ur10e_arm,
 )
 from cosim.robots.ur10e import UR10E_JOINTS, UR10E_PAYLOAD_KG
-from cosim.trajectory.limits import DEFAULT_ARM_MODEL, MAX_ACCELERATION_BOUND, MAX_JERK_BOUND, JointLimitOverride
+from cosim.trajectory.limits import DEFAULT_ARM_MODEL, JointLimitOverride, JointLimits
+from declared_settings.setting import declared
 
 # kg: the largest rated payload an arm section may give (a heavy industrial arm's).
 MAX_PAYLOAD_KG = 1000.0
-# (lower bound (open), upper bound, unit) of the trajectory limits an arm section gives per joint beyond its model's.
-_LIMIT_BOUNDS = {
-    "max_acceleration": (0.0, MAX_ACCELERATION_BOUND, "rad/s^2"),
-    "max_jerk": (0.0, MAX_JERK_BOUND, "rad/s^3"),
-}
 # Fields only a user's arm file takes (the bundled UR10e brings its own).
 _USER_ARM_ONLY = ("joints", "flange_site", "driver_joints", "servo_kp", "servo_kv")
 
@@ -134,9 +130,10 @@ class ArmSettings:
                                  f"another arm's file")
         ArmModel(**self._model_fields(ur10e_arm(), prefix))  # the joints, speeds, servos, ranges, torques, names
         n = self.joint_count
-        for name in ("max_acceleration", "max_jerk"):
+        for name in ("max_acceleration", "max_jerk"):  # the trajectory limits an arm section gives beyond its model's
             if getattr(self, name):
-                check_per_joint(f"{prefix}.{name}", getattr(self, name), n, *_LIMIT_BOUNDS[name])
+                spec = declared(JointLimits, name)
+                check_per_joint(f"{prefix}.{name}", getattr(self, name), n, spec.bounds.lo, spec.bounds.hi, spec.unit)
         if self.rated_payload is not None:
             check_range(f"{prefix}.rated_payload", self.rated_payload, 0.0, MAX_PAYLOAD_KG, "kg", lo_open=True)
         if self.base_pos:

@@ -13,10 +13,12 @@ from controllers.config import ApproachConfig, CatcherConfig, CfsConfig, PourCon
 from cosim.cli.main import main
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
+from cosim.io.recording_config import RecordingConfig
 from cosim.pour_scene import (
     CatcherSettings, ControllerSettings, LiquidSettings, PlacementSettings, TrajectorySettings, VesselSettings,
     VesselsSettings,
 )
+from cosim.trajectory.limits import JointLimits
 from cosim.validation import coupling_static, dam_break, free_fall, hydrostatic, moving_vessel, slosh, slosh_plant, weir
 from declared_settings.setting import REQUIRED, declared, declared_fields
 from tests.support.cli_refusal import refusal
@@ -29,6 +31,11 @@ def _pour(**values) -> PourConfig:
 
 def _pourer(**values) -> VesselsSettings:
     return VesselsSettings(pourer=VesselSettings(**values))
+
+
+def _joint(**values) -> JointLimits:
+    given = dict(max_velocity=1.0, max_acceleration=1.0, max_jerk=1.0, min_position=-1.0, max_position=1.0)
+    return JointLimits(name="arm/joint", **{**given, **values})
 
 
 # class, how to build it with some of its settings given, the prefix its messages name the fields with
@@ -47,6 +54,8 @@ CLASSES = [
     (TrajectorySettings, TrajectorySettings, "trajectory."),
     (PlacementSettings, PlacementSettings, "placement."),
     (VesselSettings, _pourer, "vessels.pourer."),
+    (RecordingConfig, RecordingConfig, "recording."),
+    (JointLimits, _joint, "limits.arm/joint."),
     # the validation cases name their parameters as their command-line options, with no prefix
     (coupling_static.Params, coupling_static.Params, ""),
     (dam_break.Params, dam_break.Params, ""),
@@ -134,7 +143,7 @@ SCENE_TABLES = [("liquid", LiquidSettings, "liquid."), ("controller", Controller
                 ("controller.catcher", CatcherSettings, "controller.catcher."),
                 ("controller.pose_filter", PoseFilterLimits, "pose_filter."), ("coupling", CouplingSettings, "coupling."),
                 ("trajectory", TrajectorySettings, "trajectory."), ("placement", PlacementSettings, "placement."),
-                ("vessels.pourer", VesselSettings, "vessels.pourer.")]
+                ("vessels.pourer", VesselSettings, "vessels.pourer."), ("logging.recording", RecordingConfig, "recording.")]
 BAD_SCENE_VALUES = [(table, prefix, name, value) for table, cls, prefix in SCENE_TABLES
                     for name, spec in declared_fields(cls) if spec.bounds is not None and spec.kind in ("float", "int")
                     for value in outside(spec, cls() if cls is not VesselSettings else VesselSettings())]

@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 from cosim.checks import check_positive, check_range
 from cosim.errors import InputError
 from cosim.robots.scene_config import ArmRole
+from declared_settings.setting import REQUIRED, check_settings, documented, setting
 
 if TYPE_CHECKING:
     import numpy as np
@@ -46,49 +47,34 @@ DEFAULT_MAX_ACCELERATION = 5.0  # rad/s^2, see the module docstring
 DEFAULT_MAX_JERK = 100.0  # rad/s^3, see the module docstring
 DEFAULT_ARM_MODEL = "UR10e"  # the arm of the project's scene (models/ur10e/ur10e.xml)
 
-# Accepted ranges of the limit values (units as above): generous bounds that still reject typos by orders of magnitude.
-MAX_VELOCITY_BOUND = 50.0
-MAX_ACCELERATION_BOUND = 1000.0
-MAX_JERK_BOUND = 1.0e6
-MAX_TORQUE_BOUND = 1.0e5
-POSITION_BOUND = 100.0  # |min_position|, |max_position|
-
 LIMIT_FIELDS = ("max_velocity", "max_acceleration", "max_jerk", "min_position", "max_position", "rated_torque")
 
+# The accepted ranges are generous bounds that still reject typos by orders of magnitude.
+LIMITS = "joint limits"
+MAX_TORQUE_BOUND = 1.0e5  # N m, a rated torque's largest (inf: a coordinate that is no motor's)
 
+
+@documented
 @dataclass(frozen=True)
 class JointLimits:
-    """Limits of one joint. name: full joint name ``<arm>/<joint>``.
-
-    max_velocity: rad/s, (0, 50]. max_acceleration: rad/s^2, (0, 1000]. max_jerk: rad/s^3, (0, 1e6].
-    min_position < max_position: rad, within [-100, 100]. rated_torque: N m, (0, 1e5], or inf for a coordinate that is
-    no motor's (a task-space filter's).
-    """
+    """Limits of one joint. name: full joint name ``<arm>/<joint>``. rated_torque: N m, the torque the joint's drive
+    may deliver, in (0, 1e5], or inf for a coordinate that is no motor's (a task-space filter's)."""
 
     name: str
-    max_velocity: float
-    max_acceleration: float
-    max_jerk: float
-    min_position: float
-    max_position: float
+    max_velocity: float = setting(REQUIRED, LIMITS, "Joint speed limit.", "rad/s", 0.0, 50.0, lo_open=True)
+    max_acceleration: float = setting(REQUIRED, LIMITS, "Joint acceleration limit.", "rad/s^2", 0.0, 1000.0, lo_open=True)
+    max_jerk: float = setting(REQUIRED, LIMITS, "Joint jerk limit.", "rad/s^3", 0.0, 1.0e6, lo_open=True)
+    min_position: float = setting(REQUIRED, LIMITS, "Lowest joint position.", "rad", -100.0, 100.0)
+    max_position: float = setting(REQUIRED, LIMITS, "Highest joint position.", "rad", "min_position", 100.0, lo_open=True)
     rated_torque: float = math.inf
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
             raise InputError(f"limits: joint name must be a non-empty string, got {self.name!r}")
         p = f"limits.{self.name}"
-        object.__setattr__(self, "max_velocity", check_positive(f"{p}.max_velocity", self.max_velocity, "rad/s", MAX_VELOCITY_BOUND))
-        object.__setattr__(
-            self, "max_acceleration",
-            check_positive(f"{p}.max_acceleration", self.max_acceleration, "rad/s^2", MAX_ACCELERATION_BOUND),
-        )
-        object.__setattr__(self, "max_jerk", check_positive(f"{p}.max_jerk", self.max_jerk, "rad/s^3", MAX_JERK_BOUND))
+        check_settings(self, p)
         if self.rated_torque != math.inf:
             object.__setattr__(self, "rated_torque", check_positive(f"{p}.rated_torque", self.rated_torque, "N m", MAX_TORQUE_BOUND))
-        lo = check_range(f"{p}.min_position", self.min_position, -POSITION_BOUND, POSITION_BOUND, "rad")
-        hi = check_range(f"{p}.max_position", self.max_position, lo, POSITION_BOUND, "rad", lo_open=True)
-        object.__setattr__(self, "min_position", lo)
-        object.__setattr__(self, "max_position", hi)
 
 
 @dataclass(frozen=True)
