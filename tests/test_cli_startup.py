@@ -92,7 +92,7 @@ def test_the_controllers_package_gives_each_public_name_from_its_module():
 IMPORT_ALL = """
 import importlib, importlib.util, json, os, pkgutil
 env = dict(os.environ)
-import cosim, controllers
+import cosim, controllers, declared_settings
 import warp as wp
 
 # warp's runtime object (None until wp.init), in warp._src.context in recent releases, warp.context before
@@ -102,7 +102,7 @@ def config():
     return {k: repr(v) for k, v in vars(wp.config).items() if not k.startswith("_")}
 
 cfg, names = config(), []
-for package in ("cosim", "controllers"):
+for package in ("cosim", "controllers", "declared_settings"):
     for info in pkgutil.walk_packages(importlib.import_module(package).__path__, package + "."):
         if info.name.rsplit(".", 1)[-1] != "__main__":  # ``python -m cosim`` runs the command
             importlib.import_module(info.name)

@@ -24,3 +24,4 @@ def test_wheel_ships_models_and_reference_data(tmp_path):
         assert f"cosim/models/{model.as_posix()}" in names
     assert "cosim/validation/data/martin_moyce_1952_surge_front.csv" in names
     assert "controllers/pour.py" in names
+    assert "declared_settings/setting.py" in names
