@@ -21,52 +21,32 @@ import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from cosim.checks import check_range, check_vector
 from cosim.errors import InputError
 from cosim.robots.scene_config import (
-    ArmModel, ArmPlacement, ArmRole, SceneConfig, check_per_joint, check_quat, ur10e_arm,
+    ArmModel, ArmPlacement, ArmRole, SceneConfig, check_quat, ur10e_arm,
 )
 from cosim.robots.ur10e import UR10E_JOINTS, UR10E_PAYLOAD_KG
-from cosim.trajectory.limits import DEFAULT_ARM_MODEL, JointLimitOverride, JointLimits
-from declared_settings.setting import declared
+from cosim.trajectory.limits import (
+    DEFAULT_ARM_MODEL, DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK, JointLimitOverride, JointLimits,
+)
+from declared_settings.setting import check_settings, documented, like, setting
 
-# kg: the largest rated payload an arm section may give (a heavy industrial arm's).
-MAX_PAYLOAD_KG = 1000.0
+ARM = "arm"
 # Fields only a user's arm file takes (the bundled UR10e brings its own).
 _USER_ARM_ONLY = ("joints", "flange_site", "driver_joints", "servo_kp", "servo_kv")
 
 
+@documented
 @dataclass(frozen=True)
 class ArmSettings:
-    """mjcf: the arm's MJCF file (a relative path is taken from the scene file's folder); '' is the bundled UR10e.
+    """The arm holding one vessel: the bundled UR10e or a user's MJCF, its limits, where it stands, how it grasps.
+
+    mjcf: the arm's MJCF file (a relative path is taken from the scene file's folder); '' is the bundled UR10e.
     joints: the arm's joint names in that file, base to flange (at least 6); [] for the UR10e.
     flange_site: a site on the arm's last link whose z axis points out of the tool flange; '' for the UR10e.
     driver_joints: the joints as the arm's ROS 2 driver names them, for trajectory.json and trajectory.mcap; []: the
       file's names (the UR10e: its driver's, 'shoulder_pan_joint' ...).
-    servo_kp: N m/rad per joint: where the file has no actuators, the scene drives each joint with a position servo
-      of this gain (and gravity compensation through the actuators); []: the file's own servos. (0, 1e7]
-    servo_kv: N m s/rad per joint, the servos' damping, with servo_kp. [0, 1e6]
-    max_velocity: rad/s per joint, the joint speed limit; required for a user's arm ([] for the UR10e: its data
-      sheet's). (0, 50]
-    max_acceleration: rad/s^2 per joint; []: 5 each (cosim.trajectory.limits). (0, 1000]
-    max_jerk: rad/s^3 per joint; []: 100 each. (0, 1e6]
-    min_position: rad per joint, the joints' lower limits, within the file's range; []: the file's. [-100, 100]
-    max_position: rad per joint, the upper limits, with min_position. [-100, 100]
-    rated_torque: N m per joint, the most each joint's drive delivers (the simulated drives are clamped to it and the
-      trajectories' inverse dynamics checked against it); []: the file's actuator force ranges. (0, 1e5]
-    rated_payload: kg, the arm's rated payload, against the vessel, its liquid and the mount; required for a user's
-      arm (not set for the UR10e: 12.5 kg). (0, 1000]
-    base_pos: m, the arm base's world position [x, y, z]; []: the project's cell (the UR10e's place by the table).
-    base_yaw: rad, the base's rotation about world z; not set: the cell's (pi for the pour arm, 0 for the catch
-      arm) unless base_quat is given. [-6.28319, 6.28319]
     base_quat: the base's orientation [w, x, y, z] instead of base_yaw (an arm on a wall or a ceiling); []: the yaw.
-    home_seed: rad per joint, the configuration the home posture is solved from (picks the inverse kinematics'
-      branch: elbow up or down); []: the UR10e's seed for the UR10e, zeros (the file's reference posture) for a
-      user's arm.
-    grasp_pos: m, where the vessel sits on the flange: its frame's origin (the centre of its inner floor) in the
-      flange site's frame [x, y, z]; []: the held wall's outer face (a mesh vessel's outermost point on that side: a
-      mug's handle) on the 10 mm mount plate, the flange at half the wall height (the pour arm holds the back wall,
-      the catch arm the front wall).
     grasp_quat: the vessel frame's orientation in the flange site's frame [w, x, y, z]; []: the flange's z axis
       into the held wall, the vessel's axis along the site's x.
     """
@@ -75,20 +55,37 @@ class ArmSettings:
     joints: tuple[str, ...] = ()
     flange_site: str = ""
     driver_joints: tuple[str, ...] = ()
-    servo_kp: tuple[float, ...] = ()
-    servo_kv: tuple[float, ...] = ()
-    max_velocity: tuple[float, ...] = ()
-    max_acceleration: tuple[float, ...] = ()
-    max_jerk: tuple[float, ...] = ()
-    min_position: tuple[float, ...] = ()
-    max_position: tuple[float, ...] = ()
-    rated_torque: tuple[float, ...] = ()
-    rated_payload: float | None = None
-    base_pos: tuple[float, ...] = ()
-    base_yaw: float | None = None
+    servo_kp: tuple[float, ...] = like(ArmModel, "servo_kp", (), "the file's own servos")
+    servo_kv: tuple[float, ...] = like(ArmModel, "servo_kv", (), "the file's own servos")
+    max_velocity: tuple[float, ...] = like(ArmModel, "max_velocity", (), "the UR10e's data sheet's (a user's arm must "
+                                           "give it)")
+    max_acceleration: tuple[float, ...] = like(JointLimits, "max_acceleration", (), f"{DEFAULT_MAX_ACCELERATION:g} "
+                                               "each (cosim.trajectory.limits)", kind="per_joint")
+    max_jerk: tuple[float, ...] = like(JointLimits, "max_jerk", (), f"{DEFAULT_MAX_JERK:g} each", kind="per_joint")
+    min_position: tuple[float, ...] = like(ArmModel, "min_position", (), "the file's range")
+    max_position: tuple[float, ...] = like(ArmModel, "max_position", (), "the file's range")
+    rated_torque: tuple[float, ...] = like(ArmModel, "rated_torque", (), "the file's actuator force ranges (the "
+                                           "simulated drives are clamped to it and the trajectories' inverse dynamics "
+                                           "checked against it)")
+    # at most a heavy industrial arm's payload
+    rated_payload: float | None = setting(None, ARM, "The arm's rated payload, against the vessel, its liquid and the "
+                                          "mount.", "kg", 0.0, 1000.0, lo_open=True,
+                                          none_means=f"the UR10e's {UR10E_PAYLOAD_KG:g} kg (a user's arm must give it)")
+    base_pos: tuple[float, ...] = setting((), ARM, "The arm base's world position [x, y, z].", "m", kind="vector",
+                                          none_means="the project's cell (the UR10e's place by the table)")
+    base_yaw: float | None = setting(None, ARM, "The base's rotation about world z.", "rad", -2.0 * math.pi,
+                                     2.0 * math.pi, none_means="the cell's (pi for the pour arm, 0 for the catch arm) "
+                                     "unless base_quat is given")
     base_quat: tuple[float, ...] = ()
-    home_seed: tuple[float, ...] = ()
-    grasp_pos: tuple[float, ...] = ()
+    home_seed: tuple[float, ...] = setting(
+        (), ARM, "The configuration the home posture is solved from (picks the inverse kinematics' branch: elbow up or "
+        "down).", "rad", -100.0, 100.0, kind="per_joint", none_means="the UR10e's seed for the UR10e, zeros (the "
+        "file's reference posture) for a user's arm")
+    grasp_pos: tuple[float, ...] = setting(
+        (), ARM, "Where the vessel sits on the flange: its frame's origin (the centre of its inner floor) in the flange "
+        "site's frame [x, y, z].", "m", kind="vector", none_means="the held wall's outer face (a mesh vessel's "
+        "outermost point on that side: a mug's handle) on the 10 mm mount plate, the flange at half the wall height "
+        "(the pour arm holds the back wall, the catch arm the front wall)")
     grasp_quat: tuple[float, ...] = ()
 
     @property
@@ -129,25 +126,11 @@ class ArmSettings:
                 raise InputError(f"{prefix}.{given[0]}: the bundled UR10e brings its own; set {prefix}.mjcf to use "
                                  f"another arm's file")
         ArmModel(**self._model_fields(ur10e_arm(), prefix))  # the joints, speeds, servos, ranges, torques, names
-        n = self.joint_count
-        for name in ("max_acceleration", "max_jerk"):  # the trajectory limits an arm section gives beyond its model's
-            if getattr(self, name):
-                spec = declared(JointLimits, name)
-                check_per_joint(f"{prefix}.{name}", getattr(self, name), n, spec.bounds.lo, spec.bounds.hi, spec.unit)
-        if self.rated_payload is not None:
-            check_range(f"{prefix}.rated_payload", self.rated_payload, 0.0, MAX_PAYLOAD_KG, "kg", lo_open=True)
-        if self.base_pos:
-            check_vector(f"{prefix}.base_pos", self.base_pos, 3)
-        if self.base_yaw is not None:
-            check_range(f"{prefix}.base_yaw", self.base_yaw, -2.0 * math.pi, 2.0 * math.pi, "rad")
-            if self.base_quat:
-                raise InputError(f"{prefix}.base_quat: give base_yaw or base_quat, not both")
+        check_settings(self, prefix)  # the same declarations, and the limits and placement the model does not hold
+        if self.base_yaw is not None and self.base_quat:
+            raise InputError(f"{prefix}.base_quat: give base_yaw or base_quat, not both")
         if self.base_quat:
             check_quat(f"{prefix}.base_quat", self.base_quat)
-        if self.home_seed:
-            check_per_joint(f"{prefix}.home_seed", self.home_seed, n, -100.0, 100.0, "rad")
-        if self.grasp_pos:
-            check_vector(f"{prefix}.grasp_pos", self.grasp_pos, 3)
         if self.grasp_quat:
             check_quat(f"{prefix}.grasp_quat", self.grasp_quat)
 

@@ -24,6 +24,7 @@ from declared_settings.errors import InputError
 
 SETTING = "setting"  # the metadata key of a field's Setting
 REQUIRED = dataclasses.MISSING  # the default of a setting that has none: every configuration must give it
+LISTS = ("vector", "per_joint")  # the kinds whose value is a list (an empty one: not set, where that is allowed)
 
 Bound = float | str | None  # a number, the name of another field (or property) of the same object, or unbounded
 
@@ -56,10 +57,12 @@ class Setting:
     group: the concern it belongs to (a reference lists fields group by group).
     meaning: what it is and why it matters (equations and references where physics), one or a few sentences.
     unit: SI unit, '' where dimensionless.
-    kind: 'float', 'int', 'bool', 'choice' (an :class:`enum.Enum`, ``choices``) or 'vector' (3 numbers).
-    bounds: a number's allowed interval; a vector's magnitude's.
+    kind: 'float', 'int', 'bool', 'choice' (an :class:`enum.Enum`, ``choices``), 'vector' (3 numbers) or
+      'per_joint' (a number per joint of the arm the setting belongs to: as many as its ``joint_count``).
+    bounds: a number's allowed interval; a vector's magnitude's; each of a per-joint setting's numbers'.
     choices: the Enum of a 'choice'.
-    optional: None is allowed too (``none_means`` says what it stands for).
+    optional: not setting it is allowed too (None; an empty list for a vector or a per-joint setting), ``none_means``
+      saying what that stands for.
     """
 
     group: str
@@ -80,16 +83,19 @@ class Setting:
             text = "one of " + ", ".join(repr(m.value) for m in self.choices)
         elif self.kind == "vector":
             text = f"3 numbers, magnitude in {self.bounds.text()}{unit}" if self.bounds else f"3 numbers ({self.unit})"
+        elif self.kind == "per_joint":
+            text = f"a number per joint, each in {(self.bounds or Bounds()).text()}{unit}"
         else:
             text = (self.bounds or Bounds()).text() + unit
-        return f"{text}; or not set: {self.none_means}" if self.optional else text
+        unset = "[]" if self.kind in LISTS else "not set"
+        return f"{text}; or {unset}: {self.none_means}" if self.optional else text
 
     def check(self, name: str, value: Any, owner: Any = None) -> Any:
         """``value`` checked (and coerced: an enum from its value, a vector to a tuple of floats); an
         :class:`InputError` line naming ``name`` and the allowed values where it is not allowed. ``owner``: the
         object the setting belongs to, whose attributes a named bound reads."""
-        if value is None and self.optional:
-            return None
+        if self.optional and (value is None or (self.kind in LISTS and _empty(value))):
+            return None if value is None else ()
         b = (self.bounds or Bounds()).of(owner)
         if self.kind == "bool":
             if not isinstance(value, bool):
@@ -102,6 +108,11 @@ class Setting:
             if self.bounds is not None:
                 check_range(f"{name} magnitude", math.hypot(*vector), b.lo, b.hi, self.unit, b.lo_open, b.hi_open)
             return vector
+        if self.kind == "per_joint":
+            vector = check_vector(name, value, owner.joint_count)
+            for i, v in enumerate(vector):
+                check_range(f"{name}[{i}]", v, b.lo, b.hi, self.unit, b.lo_open, b.hi_open)
+            return vector
         if self.kind == "int":
             check_int(name, value)
             check_range(name, value, b.lo, b.hi, self.unit, b.lo_open, b.hi_open)
@@ -109,19 +120,25 @@ class Setting:
         return check_range(name, value, b.lo, b.hi, self.unit, b.lo_open, b.hi_open)
 
 
+def _empty(value: Any) -> bool:
+    return not isinstance(value, (str, bytes)) and hasattr(value, "__len__") and len(value) == 0
+
+
 def setting(
     default: Any, group: str, meaning: str, unit: str = "", lo: Bound = None, hi: Bound = None,
     lo_open: bool = False, hi_open: bool = False, kind: str | None = None, none_means: str = "",
 ) -> Any:
     """A dataclass field with ``default`` declared as a :class:`Setting` (``kind`` from the default where not given:
-    a bool, an Enum member, a tuple (vector), an int or a float; a None default makes it optional, ``none_means``
-    saying what None stands for; :data:`REQUIRED`: no default, a float unless ``kind`` says otherwise). A bound
-    given as a name is that attribute of the object the setting belongs to (:meth:`Bounds.of`)."""
+    a bool, an Enum member, a tuple (vector), an int or a float; a None default, or an empty tuple for a list kind,
+    makes it optional, ``none_means`` saying what not setting it stands for; :data:`REQUIRED`: no default, a float
+    unless ``kind`` says otherwise). A bound given as a name is that attribute of the object the setting belongs to
+    (:meth:`Bounds.of`)."""
     if kind is None:
         kind = ("bool" if isinstance(default, bool) else "choice" if isinstance(default, Enum)
                 else "vector" if isinstance(default, tuple) else "int" if isinstance(default, int) else "float")
     bounds = None if lo is None and hi is None else Bounds(lo, hi, lo_open, hi_open)
-    spec = Setting(group, meaning, unit, kind, bounds, type(default) if kind == "choice" else None, default is None, none_means)
+    optional = default is None or (kind in LISTS and default == ())
+    spec = Setting(group, meaning, unit, kind, bounds, type(default) if kind == "choice" else None, optional, none_means)
     return dataclasses.field(default=default, metadata={SETTING: spec})
 
 
@@ -130,17 +147,23 @@ def declared(cls: type, name: str) -> Setting:
     return cls.__dataclass_fields__[name].metadata[SETTING]
 
 
-def like(cls: type, name: str, default: Any = dataclasses.MISSING, none_means: str = "") -> Any:
-    """A field declared as the same setting as ``cls``'s field ``name``, with its default; ``default=None``
-    makes it an optional override (None: ``none_means``, e.g. the fluid's own default). No other default: a
-    setting has one, and a caller that wants another value names it where it builds the configuration."""
+def like(cls: type, name: str, default: Any = dataclasses.MISSING, none_means: str = "", kind: str | None = None) -> Any:
+    """A field declared as the same setting as ``cls``'s field ``name``, with its default; ``default=None`` (an empty
+    tuple for a list kind) makes it an optional override (not set: ``none_means``, e.g. the fluid's own default).
+    No other default: a setting has one, and a caller that wants another value names it where it builds the
+    configuration. ``kind``: 'per_joint' declares a number per joint of a setting of one joint, 'float' one joint's
+    of a per-joint setting (the same unit, bounds and meaning)."""
     spec = declared(cls, name)
+    if kind is not None:
+        if {kind, spec.kind} != {"float", "per_joint"}:
+            raise ValueError(f"like({cls.__name__}, {name!r}): only a setting's one-joint and per-joint kinds convert")
+        spec = dataclasses.replace(spec, kind=kind)
     if default is dataclasses.MISSING:
         default = cls.__dataclass_fields__[name].default
-    elif default is None:
+    elif default is None or (spec.kind in LISTS and default == ()):
         spec = dataclasses.replace(spec, optional=True, none_means=none_means)
     else:
-        raise ValueError(f"like({cls.__name__}, {name!r}): only None may replace the declared default")
+        raise ValueError(f"like({cls.__name__}, {name!r}): only None (or an empty list) may replace the declared default")
     return dataclasses.field(default=default, metadata={SETTING: spec})
 
 
@@ -181,7 +204,7 @@ def default_text(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, tuple):
-        return "(" + ", ".join(f"{v:g}" for v in value) + ")"
+        return "(" + ", ".join(f"{v:g}" for v in value) + ")" if value else "[]"
     return "not set" if value is None else f"{value:g}" if isinstance(value, float) else str(value)
 
 

@@ -14,6 +14,8 @@ from cosim.cli.main import main
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
 from cosim.io.recording_config import RecordingConfig
+from cosim.pour_arms import ArmSettings, ArmsSettings
+from cosim.robots.scene_config import ArmModel
 from cosim.pour_scene import (
     CatcherSettings, ControllerSettings, LiquidSettings, PlacementSettings, TrajectorySettings, VesselSettings,
     VesselsSettings,
@@ -31,6 +33,20 @@ def _pour(**values) -> PourConfig:
 
 def _pourer(**values) -> VesselsSettings:
     return VesselsSettings(pourer=VesselSettings(**values))
+
+
+JOINTS = tuple(f"joint_{i}" for i in range(1, 7))
+# a user's arm as a scene file gives it: what it must give, with arbitrary values in range (its file is not read)
+USER_ARM = dict(mjcf="arm.xml", joints=JOINTS, flange_site="flange", max_velocity=(1.0,) * 6, rated_payload=10.0)
+
+
+def _arm_model(**values) -> ArmModel:
+    given = {k: v for k, v in USER_ARM.items() if k != "rated_payload"}
+    return ArmModel(**{**given, **values}, label="arms.pour")
+
+
+def _arm_settings(**values) -> ArmsSettings:
+    return ArmsSettings(pour=ArmSettings(**{**USER_ARM, **values}))
 
 
 def _joint(**values) -> JointLimits:
@@ -56,6 +72,8 @@ CLASSES = [
     (VesselSettings, _pourer, "vessels.pourer."),
     (RecordingConfig, RecordingConfig, "recording."),
     (JointLimits, _joint, "limits.arm/joint."),
+    (ArmModel, _arm_model, "arms.pour."),
+    (ArmSettings, _arm_settings, "arms.pour."),
     # the validation cases name their parameters as their command-line options, with no prefix
     (coupling_static.Params, coupling_static.Params, ""),
     (dam_break.Params, dam_break.Params, ""),
@@ -68,14 +86,30 @@ CLASSES = [
 ]
 
 
+def _part(built, cls):
+    """The instance of ``cls`` in what a build returned (a scene section holds the vessel or the arm)."""
+    return built.pourer if cls is VesselSettings else built.pour if cls is ArmSettings else built
+
+
 def _owner(build, cls):
-    """The object whose attributes a named bound reads: the class as built with its defaults."""
-    built = build()
-    return built.pourer if cls is VesselSettings else built
+    """The object whose attributes a named bound reads (and whose joints a per-joint setting counts): the class as
+    built with its defaults."""
+    return _part(build(), cls)
+
+
+def _given(spec, value, owner):
+    """``value`` as the setting is given: itself, or for a per-joint setting at the first joint, the others inside."""
+    if spec.kind != "per_joint":
+        return value
+    return (value,) + (inside(spec, owner)[0],) * (owner.joint_count - 1)
+
+
+def _field(spec, name: str) -> str:
+    return f"{name}[0]" if spec.kind == "per_joint" else name
 
 
 BOUNDED = [(cls, build, prefix, name, spec) for cls, build, prefix in CLASSES for name, spec in declared_fields(cls)
-           if spec.bounds is not None and spec.kind in ("float", "int")]
+           if spec.bounds is not None and spec.kind in ("float", "int", "per_joint")]
 IDS = [f"{prefix or cls.__module__.rsplit('.', 1)[-1] + '.'}{name}" for cls, _, prefix, name, _ in BOUNDED]
 
 
@@ -85,9 +119,9 @@ def test_each_bound_is_refused_one_step_outside_with_one_line_naming_the_field_a
     unit = f" {spec.unit}" if spec.unit else ""
     for value in outside(spec, owner):
         with pytest.raises(InputError) as err:
-            build(**{name: value})
+            build(**{name: _given(spec, value, owner)})
         message = str(err.value)
-        assert message.startswith(f"{prefix}{name}: must be in {spec.bounds.of(owner).text()}{unit}, got "), message
+        assert message.startswith(f"{prefix}{_field(spec, name)}: must be in {spec.bounds.of(owner).text()}{unit}, got "), message
         assert "\n" not in message
 
 
@@ -96,11 +130,11 @@ def test_each_bound_itself_is_accepted(cls, build, prefix, name, spec):
     owner = _owner(build, cls)
     for value in inside(spec, owner):
         try:
-            built = build(**{name: value})
+            built = build(**{name: _given(spec, value, owner)})
         except InputError as exc:  # a check across settings may refuse the combination, never this range
-            assert not str(exc).startswith(f"{prefix}{name}: must be in "), exc
+            assert not str(exc).startswith(f"{prefix}{_field(spec, name)}: must be in "), exc
             continue
-        assert getattr(built.pourer if cls is VesselSettings else built, name) == value
+        assert getattr(_part(built, cls), name) == _given(spec, value, owner)
 
 
 CHOICES = [(cls, build, prefix, name) for cls, build, prefix in CLASSES for name, spec in declared_fields(cls)
@@ -161,7 +195,7 @@ def test_a_scene_value_outside_its_range_is_refused_with_one_line_and_exit_2(tmp
 def test_scene_dump_shows_each_scene_setting_with_its_allowed_values(capsys):
     assert main(["scene", "--dump"]) == 0
     text = capsys.readouterr().out
-    for table, cls, _ in SCENE_TABLES:
+    for table, cls, _ in SCENE_TABLES + [("arms.pour", ArmSettings, ""), ("arms.catch", ArmSettings, "")]:
         body = text.split(f"\n[{table}]\n", 1)[1].split("\n[", 1)[0]
         for name, spec in declared_fields(cls):
             lines = [line for line in body.splitlines() if line.startswith((f"{name} = ", f"# {name} = "))]

@@ -17,10 +17,11 @@ import math
 from dataclasses import dataclass, field
 from enum import Enum
 
-from cosim.checks import check_choice, check_number, check_positive, check_range, check_vector
+from cosim.checks import check_choice, check_number, check_positive, check_vector
 from cosim.errors import InputError
 from cosim.robots.ur10e import UR10E_DRIVER_JOINTS, UR10E_JOINTS, UR10E_MAX_JOINT_SPEED
 from cosim.vessel import VesselSpec, default_catching_vessel, seed_pouring_vessel
+from declared_settings.setting import REQUIRED, check_settings, documented, setting
 
 
 class ArmRole(Enum):
@@ -37,38 +38,45 @@ class MountSide(Enum):
     FRONT = "front"  # the +x wall: the arm reaches from +x
 
 
+ARM = "arm"
+
+
+@documented
 @dataclass(frozen=True)
 class ArmModel:
-    """An arm MJCF and how it maps onto the project's conventions.
+    """An arm MJCF and how it maps onto the project's conventions. The per-joint settings' accepted ranges are
+    generous bounds that still reject typos by orders of magnitude.
 
     mjcf: path of the arm's MJCF; a relative path is resolved against the project's models directory.
     joints: the arm's joint names in that file, base to tip (n >= 6); each driven by a position servo: the file's own
         (an actuator with ``biastype="affine"`` and bias -kp on the joint) or the one :attr:`servo_kp` asks for.
     flange_site: a site on the last link whose z axis points out of the tool flange; the vessel mount is built on it.
-    max_velocity: rad/s per joint (n,), the joint speed limit, for trajectory generation (MuJoCo models have no speed
-        limits). (0, 50]
     driver_joints: the same joints as the arm's ROS 2 driver names them (n, without its tf prefix), for the exported
         trajectories; empty: the MJCF's names.
-    servo_kp, servo_kv: N m/rad and N m s/rad per joint (n,), for a file without actuators on its joints: the scene
-        adds a position servo ``tau = kp (u - q) - kv qdot`` on each, with gravity compensation through the actuators
-        (body ``gravcomp``, joint ``actuatorgravcomp``), as an arm's controller compensates gravity from its dynamic
-        model; empty: the file's own servos.
-    min_position, max_position: rad per joint (n,), the joints' range, within the file's; empty: the file's range.
-    rated_torque: N m per joint (n,), the most each joint's drive delivers (the joint's actuator force range);
-        empty: the file's.
     label: how messages name this arm's settings (a scene file's ``arms.pour``); empty: ``arm``.
     """
 
     mjcf: str
     joints: tuple[str, ...]
     flange_site: str
-    max_velocity: tuple[float, ...]
+    max_velocity: tuple[float, ...] = setting(
+        REQUIRED, ARM, "The joint speed limit, for trajectory generation (MuJoCo models have no speed limits).", "rad/s",
+        0.0, 50.0, lo_open=True, kind="per_joint")
     driver_joints: tuple[str, ...] = ()
-    servo_kp: tuple[float, ...] = ()
-    servo_kv: tuple[float, ...] = ()
-    min_position: tuple[float, ...] = ()
-    max_position: tuple[float, ...] = ()
-    rated_torque: tuple[float, ...] = ()
+    servo_kp: tuple[float, ...] = setting(
+        (), ARM, "For a file without actuators on its joints, the scene adds a position servo tau = kp (u - q) - kv "
+        "qdot on each, with gravity compensation through the actuators (body gravcomp, joint actuatorgravcomp), as an "
+        "arm's controller compensates gravity from its dynamic model; given with servo_kv.", "N m/rad", 0.0, 1.0e7,
+        lo_open=True, kind="per_joint", none_means="the file's own servos")
+    servo_kv: tuple[float, ...] = setting((), ARM, "The added servos' damping, with servo_kp.", "N m s/rad", 0.0, 1.0e6,
+                                          kind="per_joint", none_means="the file's own servos")
+    min_position: tuple[float, ...] = setting((), ARM, "The joints' lower limits, within the file's range.", "rad",
+                                              -100.0, 100.0, kind="per_joint", none_means="the file's range")
+    max_position: tuple[float, ...] = setting((), ARM, "The joints' upper limits, with min_position.", "rad",
+                                              -100.0, 100.0, kind="per_joint", none_means="the file's range")
+    rated_torque: tuple[float, ...] = setting((), ARM, "The most each joint's drive delivers (the joint's actuator "
+                                              "force range).", "N m", 0.0, 1.0e5, lo_open=True, kind="per_joint",
+                                              none_means="the file's actuator force ranges")
     label: str = ""
 
     def __post_init__(self) -> None:
@@ -83,7 +91,7 @@ class ArmModel:
             raise InputError(f"{p}.flange_site: must be a site name, got {self.flange_site!r}")
         n = len(self.joints)
         object.__setattr__(self, "joints", tuple(self.joints))
-        object.__setattr__(self, "max_velocity", check_per_joint(f"{p}.max_velocity", self.max_velocity, n, 0.0, 50.0, "rad/s"))
+        check_settings(self, p)
         driver = tuple(self.driver_joints)
         named = all(isinstance(j, str) and j and not any(c.isspace() for c in j) for j in driver)
         if driver and (not named or len(driver) != n or len(set(driver)) != len(driver)):
@@ -91,15 +99,16 @@ class ArmModel:
         object.__setattr__(self, "driver_joints", driver)
         if len(self.servo_kp) != len(self.servo_kv):
             raise InputError(f"{p}.servo_kv: give servo_kp and servo_kv together, one of each per joint ({n})")
-        for name, lo, hi, unit in SERVO_AND_RANGE_BOUNDS:
-            value = getattr(self, name)
-            if value:
-                object.__setattr__(self, name, check_per_joint(f"{p}.{name}", value, n, lo, hi, unit))
         if bool(self.min_position) != bool(self.max_position):
             raise InputError(f"{p}.max_position: give min_position and max_position together, one of each per joint ({n})")
         for i, (lo, hi) in enumerate(zip(self.min_position, self.max_position)):
             if not lo < hi:
                 raise InputError(f"{p}.max_position[{i}]: must be above min_position[{i}] = {lo:g} rad, got {hi:g}")
+
+    @property
+    def joint_count(self) -> int:
+        """The arm's number of joints (each per-joint setting gives one number per joint)."""
+        return len(self.joints)
 
     @property
     def field_prefix(self) -> str:
@@ -110,25 +119,6 @@ class ArmModel:
     def exported_joints(self) -> tuple[str, ...]:
         """The joint names the exported trajectories use (before the prefix): :attr:`driver_joints`, else the MJCF's."""
         return self.driver_joints or self.joints
-
-
-# (field, lower bound, upper bound, unit) of ArmModel's optional per-joint values, as check_per_joint takes them.
-SERVO_AND_RANGE_BOUNDS = (
-    ("servo_kp", 0.0, 1.0e7, "N m/rad"),
-    ("servo_kv", None, 1.0e6, "N m s/rad"),
-    ("min_position", -100.0, 100.0, "rad"),
-    ("max_position", -100.0, 100.0, "rad"),
-    ("rated_torque", 0.0, 1.0e5, "N m"),
-)
-
-
-def check_per_joint(field: str, values: object, n: int, lo: float | None, hi: float, unit: str) -> tuple[float, ...]:
-    """``n`` numbers, each at most ``hi`` and above ``lo`` (a positive quantity: ``lo`` = 0, open), or at least ``lo``
-    where it is negative (a position), or at least 0 where ``lo`` is None (a damping)."""
-    vector = check_vector(field, values, n)
-    for i, v in enumerate(vector):
-        check_range(f"{field}[{i}]", v, 0.0 if lo is None else lo, hi, unit, lo_open=lo is not None and lo >= 0.0)
-    return vector
 
 
 def check_quat(field: str, values: object) -> tuple[float, ...]:

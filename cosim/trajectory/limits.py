@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 
 from cosim.checks import check_positive, check_range
 from cosim.errors import InputError
-from cosim.robots.scene_config import ArmRole
+from cosim.robots.scene_config import ARM, ArmRole
 from declared_settings.setting import REQUIRED, check_settings, documented, setting
 
 if TYPE_CHECKING:
@@ -50,7 +50,6 @@ DEFAULT_ARM_MODEL = "UR10e"  # the arm of the project's scene (models/ur10e/ur10
 LIMIT_FIELDS = ("max_velocity", "max_acceleration", "max_jerk", "min_position", "max_position", "rated_torque")
 
 # The accepted ranges are generous bounds that still reject typos by orders of magnitude.
-LIMITS = "joint limits"
 MAX_TORQUE_BOUND = 1.0e5  # N m, a rated torque's largest (inf: a coordinate that is no motor's)
 
 
@@ -61,11 +60,11 @@ class JointLimits:
     may deliver, in (0, 1e5], or inf for a coordinate that is no motor's (a task-space filter's)."""
 
     name: str
-    max_velocity: float = setting(REQUIRED, LIMITS, "Joint speed limit.", "rad/s", 0.0, 50.0, lo_open=True)
-    max_acceleration: float = setting(REQUIRED, LIMITS, "Joint acceleration limit.", "rad/s^2", 0.0, 1000.0, lo_open=True)
-    max_jerk: float = setting(REQUIRED, LIMITS, "Joint jerk limit.", "rad/s^3", 0.0, 1.0e6, lo_open=True)
-    min_position: float = setting(REQUIRED, LIMITS, "Lowest joint position.", "rad", -100.0, 100.0)
-    max_position: float = setting(REQUIRED, LIMITS, "Highest joint position.", "rad", "min_position", 100.0, lo_open=True)
+    max_velocity: float = setting(REQUIRED, ARM, "Joint speed limit.", "rad/s", 0.0, 50.0, lo_open=True)
+    max_acceleration: float = setting(REQUIRED, ARM, "Joint acceleration limit.", "rad/s^2", 0.0, 1000.0, lo_open=True)
+    max_jerk: float = setting(REQUIRED, ARM, "Joint jerk limit.", "rad/s^3", 0.0, 1.0e6, lo_open=True)
+    min_position: float = setting(REQUIRED, ARM, "Lowest joint position.", "rad", -100.0, 100.0)
+    max_position: float = setting(REQUIRED, ARM, "Highest joint position.", "rad", "min_position", 100.0, lo_open=True)
     rated_torque: float = math.inf
 
     def __post_init__(self) -> None:
