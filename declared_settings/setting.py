@@ -152,14 +152,16 @@ def like(cls: type, name: str, default: Any = dataclasses.MISSING, none_means: s
     tuple for a list kind) makes it an optional override (not set: ``none_means``, e.g. the fluid's own default).
     No other default: a setting has one, and a caller that wants another value names it where it builds the
     configuration. ``kind``: 'per_joint' declares a number per joint of a setting of one joint, 'float' one joint's
-    of a per-joint setting (the same unit, bounds and meaning)."""
+    of a per-joint setting (the same unit, bounds and meaning; required unless the default says otherwise)."""
     spec = declared(cls, name)
+    declared_default = cls.__dataclass_fields__[name].default
     if kind is not None:
         if {kind, spec.kind} != {"float", "per_joint"}:
             raise ValueError(f"like({cls.__name__}, {name!r}): only a setting's one-joint and per-joint kinds convert")
-        spec = dataclasses.replace(spec, kind=kind)
+        spec = dataclasses.replace(spec, kind=kind, optional=False, none_means="")
+        declared_default = REQUIRED  # one joint's value is no list's default, nor the other way round
     if default is dataclasses.MISSING:
-        default = cls.__dataclass_fields__[name].default
+        default = declared_default
     elif default is None or (spec.kind in LISTS and default == ()):
         spec = dataclasses.replace(spec, optional=True, none_means=none_means)
     else:

@@ -30,13 +30,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING
 
-from cosim.checks import check_positive, check_range
+from cosim.checks import check_range
 from cosim.errors import InputError
-from cosim.robots.scene_config import ARM, ArmRole
-from declared_settings.setting import REQUIRED, check_settings, documented, setting
+from cosim.robots.scene_config import ARM, ArmModel, ArmRole
+from declared_settings.setting import REQUIRED, check_settings, declared, documented, like, setting
 
 if TYPE_CHECKING:
     import numpy as np
@@ -49,22 +49,24 @@ DEFAULT_ARM_MODEL = "UR10e"  # the arm of the project's scene (models/ur10e/ur10
 
 LIMIT_FIELDS = ("max_velocity", "max_acceleration", "max_jerk", "min_position", "max_position", "rated_torque")
 
-# The accepted ranges are generous bounds that still reject typos by orders of magnitude.
-MAX_TORQUE_BOUND = 1.0e5  # N m, a rated torque's largest (inf: a coordinate that is no motor's)
+RATED_TORQUE = replace(declared(ArmModel, "rated_torque"), kind="float")  # one joint's, as the arm model declares it
 
 
 @documented
 @dataclass(frozen=True)
 class JointLimits:
-    """Limits of one joint. name: full joint name ``<arm>/<joint>``. rated_torque: N m, the torque the joint's drive
-    may deliver, in (0, 1e5], or inf for a coordinate that is no motor's (a task-space filter's)."""
+    """Limits of one joint (the arm model's per-joint settings, one joint's). name: full joint name
+    ``<arm>/<joint>``. rated_torque: N m, the torque the joint's drive may deliver, within the arm model's range, or
+    inf for a coordinate that is no motor's (a task-space filter's)."""
 
     name: str
-    max_velocity: float = setting(REQUIRED, ARM, "Joint speed limit.", "rad/s", 0.0, 50.0, lo_open=True)
+    max_velocity: float = like(ArmModel, "max_velocity", kind="float")
+    # generous bounds that still reject typos by orders of magnitude
     max_acceleration: float = setting(REQUIRED, ARM, "Joint acceleration limit.", "rad/s^2", 0.0, 1000.0, lo_open=True)
     max_jerk: float = setting(REQUIRED, ARM, "Joint jerk limit.", "rad/s^3", 0.0, 1.0e6, lo_open=True)
-    min_position: float = setting(REQUIRED, ARM, "Lowest joint position.", "rad", -100.0, 100.0)
-    max_position: float = setting(REQUIRED, ARM, "Highest joint position.", "rad", "min_position", 100.0, lo_open=True)
+    min_position: float = like(ArmModel, "min_position", kind="float")
+    max_position: float = setting(REQUIRED, ARM, "The joint's upper limit.", "rad", "min_position",
+                                  declared(ArmModel, "max_position").bounds.hi, lo_open=True)
     rated_torque: float = math.inf
 
     def __post_init__(self) -> None:
@@ -73,7 +75,7 @@ class JointLimits:
         p = f"limits.{self.name}"
         check_settings(self, p)
         if self.rated_torque != math.inf:
-            object.__setattr__(self, "rated_torque", check_positive(f"{p}.rated_torque", self.rated_torque, "N m", MAX_TORQUE_BOUND))
+            object.__setattr__(self, "rated_torque", RATED_TORQUE.check(f"{p}.rated_torque", self.rated_torque))
 
 
 @dataclass(frozen=True)
