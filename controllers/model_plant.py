@@ -21,45 +21,41 @@ import control as ct
 import numpy as np
 
 from controllers.catcher import weir_velocity
-from controllers.checks import check_range
-from controllers.errors import ControllerInputError
+from controllers.config import CatcherConfig, PourConfig
 from controllers.geometry import PlanarPose, VesselGeometry, height_above, surface_offset
 from controllers.measurement import LiquidMeasurement, PourCommand
 from controllers.pour import PourController
-from controllers.slosh import GRAVITY, SloshModel, potential_flow_model
+from controllers.slosh import SloshModel, potential_flow_model
+from declared_settings.setting import check_settings, documented, like, setting
 
 
+PLANT = "model plant"
+
+
+@documented
 @dataclass(frozen=True)
 class ModelPlantConfig:
-    """The stand-in's scene. Lengths in m (world x-z for positions).
+    """The stand-in's scene, the pour's settings (:class:`controllers.config.PourConfig`) where it shares them.
 
-    home_x, home_z: world position of the pourer's vessel-frame origin at home.
-    catcher_rim_z: world z of vessel B's rim.
-    discharge_coefficient: C_d of the weir outflow. (0, 1]
-    substeps: integration steps per control period (the input is interpolated linearly). [1, 100]
-    arm_delay_steps: control periods by which the arm carries out each command late. [0, 100]
+    vessel: the pourer's :class:`controllers.geometry.VesselGeometry`.
     slosh: the liquid's first-mode pendulum; None: potential flow for the box and fill.
     """
 
     vessel: VesselGeometry = field(default_factory=VesselGeometry)
-    fill_depth: float = 0.1591
-    home_x: float = 0.0
-    home_z: float = 0.30
-    catcher_rim_z: float = 0.20
-    discharge_coefficient: float = 0.6
-    substeps: int = 10
-    gravity: float = GRAVITY
-    arm_delay_steps: int = 0
+    fill_depth: float = like(PourConfig, "fill_depth")
+    home_x: float = setting(0.0, PLANT, "World x of the pourer's vessel-frame origin at home.", "m")
+    home_z: float = setting(0.30, PLANT, "World z of the pourer's vessel-frame origin at home.", "m")
+    catcher_rim_z: float = setting(0.20, PLANT, "World z of vessel B's rim.", "m")
+    discharge_coefficient: float = like(CatcherConfig, "discharge_coefficient")
+    substeps: int = setting(10, PLANT, "Integration steps per control period (the input is interpolated linearly).", "",
+                            1, 100)
+    gravity: float = like(PourConfig, "gravity")
+    arm_delay_steps: int = setting(0, PLANT, "Control periods by which the arm carries out each command late.", "",
+                                   0, 100)
     slosh: SloshModel | None = None
 
     def __post_init__(self) -> None:
-        check_range("plant.fill_depth", self.fill_depth, 0.0, self.vessel.inner_height, "m", lo_open=True)
-        check_range("plant.discharge_coefficient", self.discharge_coefficient, 0.0, 1.0, lo_open=True)
-        if isinstance(self.substeps, bool) or not isinstance(self.substeps, int) or not 1 <= self.substeps <= 100:
-            raise ControllerInputError(f"plant.substeps: must be an integer in [1, 100], got {self.substeps!r}")
-        steps = self.arm_delay_steps
-        if isinstance(steps, bool) or not isinstance(steps, int) or not 0 <= steps <= 100:
-            raise ControllerInputError(f"plant.arm_delay_steps: must be an integer in [0, 100], got {steps!r}")
+        check_settings(self, "plant")
 
 
 class ModelPlant:

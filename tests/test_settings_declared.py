@@ -10,6 +10,7 @@ import dataclasses
 import pytest
 
 from controllers.config import ApproachConfig, CatcherConfig, CfsConfig, PourConfig, ReturnConfig, SimConfig
+from controllers.model_plant import ModelPlantConfig
 from cosim.cli.main import main
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
@@ -62,6 +63,7 @@ CLASSES = [
     (ReturnConfig, ReturnConfig, "returning."),
     (CatcherConfig, lambda **v: CatcherConfig(**{"home_x": 0.0, **v}), "catcher."),
     (PourConfig, _pour, "pour."),
+    (ModelPlantConfig, ModelPlantConfig, "plant."),
     (CouplingSettings, CouplingSettings, "coupling."),
     (PoseFilterLimits, PoseFilterLimits, "pose_filter."),
     (LiquidSettings, LiquidSettings, "liquid."),
