@@ -29,7 +29,7 @@ from cosim.robots.scene_config import (
     CATCHER_HOME_X, POUR_HEIGHT, POURER_FLOOR_ABOVE_TABLE, TABLE_TOP, SceneConfig, pour_cell_config,
 )
 from cosim.trajectory.limits import JointLimitOverride
-from cosim.trajectory.recorder import DEFAULT_SAMPLE_RATE_HZ, MAX_SAMPLE_RATE_HZ
+from cosim.trajectory.sampling import DEFAULT_SAMPLE_RATE_HZ, MAX_SAMPLE_RATE_HZ
 from cosim.vessel import VesselShape, VesselSpec, default_catching_vessel, mesh_vessel_spec, seed_pouring_vessel
 from declared_settings.setting import (
     Derived, check_settings, declared, declared_fields, derived, documented, like, setting,

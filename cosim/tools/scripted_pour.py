@@ -25,7 +25,7 @@ from cosim.trajectory.deviation import path_deviation
 from cosim.trajectory.driver_names import JointPrefix, driver_joint_names
 from cosim.trajectory.export import write_trajectory_files
 from cosim.trajectory.pour_motion import Pivot, PourMotionSpec
-from cosim.trajectory.recorder import DEFAULT_SAMPLE_RATE_HZ
+from cosim.trajectory.sampling import DEFAULT_SAMPLE_RATE_HZ
 from cosim.trajectory.scripted import generate_scripted, pour_path, pour_poses
 
 

@@ -16,9 +16,8 @@ from cosim.checks import check_positive
 from cosim.trajectory.generator import TIME_EPSILON, TrajectoryGenerator
 from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits
+from cosim.trajectory.sampling import DEFAULT_SAMPLE_RATE_HZ, MAX_SAMPLE_RATE_HZ
 
-DEFAULT_SAMPLE_RATE_HZ = 500.0
-MAX_SAMPLE_RATE_HZ = 10_000.0
 
 
 class TrajectoryRecorder:

@@ -31,7 +31,8 @@ from cosim.trajectory.generator import STREAM_DELAY_PERIODS, GeneratorSettings, 
 from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits, scene_limits
 from cosim.trajectory.pour_motion import PourMotionSpec, task_poses
-from cosim.trajectory.recorder import DEFAULT_SAMPLE_RATE_HZ, TrajectoryRecorder
+from cosim.trajectory.recorder import TrajectoryRecorder
+from cosim.trajectory.sampling import DEFAULT_SAMPLE_RATE_HZ
 
 # IK tolerances (m, rad) of the scripted targets. With the scene's default vessel-target tolerance (1e-5) the joint
 # targets carry up to 2e-5 rad of solver noise, which differencing at 100 Hz turns into 0.2 rad/s^2 of acceleration
