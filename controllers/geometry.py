@@ -20,8 +20,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from controllers.checks import check_choice, check_range
 from controllers.slosh import VesselShape
+from declared_settings.setting import check_settings, documented, setting
 
 MAX_STATIC_TILT = 0.5 * math.pi - 1e-6  # rad; the static liquid formulas need a tilt below 90 deg
 BISECTION_STEPS = 60  # halvings of [0, 90 deg): 1.4e-18 rad resolution, far below float64 on the angle
@@ -56,31 +56,27 @@ class PlanarPose:
         return PlanarPose(wx - rx, wz - rz, theta)
 
 
+VESSEL = "vessel"
+
+
+@documented
 @dataclass(frozen=True)
 class VesselGeometry:
-    """The pouring vessel, an open box (vessel 1 of Camporredondo et al. 2019). Lengths in m.
+    """The pouring vessel, an open box (vessel 1 of Camporredondo et al. 2019)."""
 
-    inner_width: B, along the pour direction (vessel x). (0, 2]
-    inner_height: L, floor to rim (vessel z). (0, 2]
-    wall_thickness: t. [0, 0.2]
-    inner_depth: perpendicular to the pour plane (vessel y); volume = area in the pour plane * inner_depth. (0, 2]
-    shape: the liquid's horizontal section, which sets its slosh mode (:func:`controllers.slosh.potential_flow_model`):
-      'box', or 'cylinder' of inner diameter inner_width (a 3-D liquid in a cup; the static liquid is then that of
-      the box of equal floor area, inner_depth = pi inner_width / 4, the same volume at every fill).
-    """
-
-    inner_width: float = 0.191
-    inner_height: float = 0.191
-    wall_thickness: float = 0.005
-    inner_depth: float = 0.100
-    shape: VesselShape = VesselShape.BOX
+    inner_width: float = setting(0.191, VESSEL, "B, along the pour direction (vessel x).", "m", 0.0, 2.0, lo_open=True)
+    inner_height: float = setting(0.191, VESSEL, "L, floor to rim (vessel z).", "m", 0.0, 2.0, lo_open=True)
+    wall_thickness: float = setting(0.005, VESSEL, "t, the walls' thickness.", "m", 0.0, 0.2)
+    inner_depth: float = setting(0.100, VESSEL, "Perpendicular to the pour plane (vessel y); volume = area in the pour "
+                                 "plane * inner_depth.", "m", 0.0, 2.0, lo_open=True)
+    shape: VesselShape = setting(
+        VesselShape.BOX, VESSEL, "The liquid's horizontal section, which sets its slosh mode "
+        "(controllers.slosh.potential_flow_model): 'box', or 'cylinder' of inner diameter inner_width (a 3-D liquid in "
+        "a cup; the static liquid is then that of the box of equal floor area, inner_depth = pi inner_width / 4, the "
+        "same volume at every fill).")
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "shape", check_choice("vessel.shape", self.shape, VesselShape))
-        check_range("vessel.inner_width", self.inner_width, 0.0, 2.0, "m", lo_open=True)
-        check_range("vessel.inner_height", self.inner_height, 0.0, 2.0, "m", lo_open=True)
-        check_range("vessel.wall_thickness", self.wall_thickness, 0.0, 0.2, "m")
-        check_range("vessel.inner_depth", self.inner_depth, 0.0, 2.0, "m", lo_open=True)
+        check_settings(self, "vessel")
 
     @property
     def lip(self) -> tuple[float, float]:

@@ -18,7 +18,8 @@ from dataclasses import dataclass, field
 from enum import Enum
 from typing import TYPE_CHECKING
 
-from cosim.checks import check_choice, check_positive, check_range
+from cosim.checks import check_range
+from declared_settings.setting import check_settings, documented, setting
 
 if TYPE_CHECKING:  # NumPy is imported by the methods that use it: a scene's settings are checked without it
     import numpy as np
@@ -54,40 +55,38 @@ class WallBox:
     half_size: tuple[float, float, float]
 
 
+VESSEL = "vessel"
+
+
+@documented
 @dataclass(frozen=True)
 class VesselSpec:
-    """An open vessel: inner dimensions, wall thickness and wall material.
+    """An open vessel: inner dimensions, wall thickness and wall material (SI units); by default the paper's pouring
+    vessel (Camporredondo et al. 2019).
 
-    Fields (SI units):
-      name: identifier used for MuJoCo bodies, log entities and summaries.
-      shape: :class:`VesselShape` (box or cylinder).
-      inner_width: m, inner size along the pour direction (local x); a cylinder's inner diameter. (0, 2]
-      inner_depth: m, inner size perpendicular to the pour plane (local y); ignored for a cylinder. (0, 2]
-      inner_height: m, inner floor to rim (local z); the paper's L. (0, 2]
-      wall_thickness: m, thickness of floor and walls. (0, 0.05]
-      wall_density: kg/m^3, wall material density (sets the empty vessel's mass). (0, 25000]
-      mesh: the walls of a 'mesh' vessel (:class:`cosim.mesh_vessel.VesselMesh`, vessel frame); its box
-        equivalent (:func:`mesh_vessel_spec`) gives the sizes above. None for a box or cylinder.
+    name: identifier used for MuJoCo bodies, log entities and summaries.
+    mesh: the walls of a 'mesh' vessel (:class:`cosim.mesh_vessel.VesselMesh`, vessel frame); its box equivalent
+      (:func:`mesh_vessel_spec`) gives the sizes. None for a box or cylinder.
     """
 
     name: str = "pourer"
-    shape: VesselShape = VesselShape.BOX
-    inner_width: float = 0.191
-    inner_depth: float = 0.100
-    inner_height: float = 0.191
-    wall_thickness: float = 0.005
-    wall_density: float = ACRYLIC_DENSITY
+    shape: VesselShape = setting(VesselShape.BOX, VESSEL, "The vessel's shape: a box, a cylinder or a mesh's walls.")
+    inner_width: float = setting(0.191, VESSEL, "Inner size along the pour direction (local x); a cylinder's inner "
+                                 "diameter.", "m", 0.0, 2.0, lo_open=True)
+    inner_depth: float = setting(0.100, VESSEL, "Inner size perpendicular to the pour plane (local y); ignored for a "
+                                 "cylinder.", "m", 0.0, 2.0, lo_open=True)
+    inner_height: float = setting(0.191, VESSEL, "Inner floor to rim (local z); the paper's L.", "m", 0.0, 2.0,
+                                  lo_open=True)
+    wall_thickness: float = setting(0.005, VESSEL, "Thickness of floor and walls.", "m", 0.0, 0.05, lo_open=True)
+    wall_density: float = setting(ACRYLIC_DENSITY, VESSEL, "Wall material density (sets the empty vessel's mass).",
+                                  "kg/m^3", 0.0, 25000.0, lo_open=True)
     mesh: VesselMesh | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         p = f"vessel[{self.name}]"
-        object.__setattr__(self, "shape", check_choice(f"{p}.shape", self.shape, VesselShape))
+        check_settings(self, p)
         if (self.shape is VesselShape.MESH) != (self.mesh is not None):
             raise ValueError(f"{p}: a mesh vessel needs its mesh, and only a mesh vessel has one")
-        for field_name in ("inner_width", "inner_depth", "inner_height"):
-            object.__setattr__(self, field_name, check_positive(f"{p}.{field_name}", getattr(self, field_name), "m", 2.0))
-        object.__setattr__(self, "wall_thickness", check_positive(f"{p}.wall_thickness", self.wall_thickness, "m", 0.05))
-        object.__setattr__(self, "wall_density", check_positive(f"{p}.wall_density", self.wall_density, "kg/m^3", 25000.0))
 
     # ---- derived geometry -------------------------------------------------------------------------------------
     @property

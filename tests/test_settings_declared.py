@@ -6,10 +6,12 @@ and ``cosim scene --dump`` shows each scene setting with the allowed values from
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import pytest
 
 from controllers.config import ApproachConfig, CatcherConfig, CfsConfig, PourConfig, ReturnConfig, SimConfig
+from controllers.geometry import VesselGeometry
 from controllers.model_plant import ModelPlantConfig
 from cosim.cli.main import main
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
@@ -22,6 +24,7 @@ from cosim.pour_scene import (
     VesselsSettings,
 )
 from cosim.trajectory.limits import JointLimits
+from cosim.vessel import VesselSpec
 from cosim.validation import coupling_static, dam_break, free_fall, hydrostatic, moving_vessel, slosh, slosh_plant, weir
 from declared_settings.setting import REQUIRED, declared, declared_fields
 from tests.support.cli_refusal import refusal
@@ -64,6 +67,8 @@ CLASSES = [
     (CatcherConfig, lambda **v: CatcherConfig(**{"home_x": 0.0, **v}), "catcher."),
     (PourConfig, _pour, "pour."),
     (ModelPlantConfig, ModelPlantConfig, "plant."),
+    (VesselGeometry, VesselGeometry, "vessel."),
+    (VesselSpec, VesselSpec, "vessel[pourer]."),
     (CouplingSettings, CouplingSettings, "coupling."),
     (PoseFilterLimits, PoseFilterLimits, "pose_filter."),
     (LiquidSettings, LiquidSettings, "liquid."),
@@ -146,7 +151,7 @@ CHOICES = [(cls, build, prefix, name) for cls, build, prefix in CLASSES for name
 @pytest.mark.parametrize("cls, build, prefix, name", CHOICES, ids=[f"{p}{n}" for _, _, p, n in CHOICES])
 def test_choices_and_switches_are_enforced_from_their_declarations(cls, build, prefix, name):
     allowed = "one of " if declared(cls, name).kind == "choice" else "true or false"
-    with pytest.raises(InputError, match=f"^{prefix}{name}: must be {allowed}"):
+    with pytest.raises(InputError, match=f"^{re.escape(prefix + name)}: must be {allowed}"):
         build(**{name: "no-such-choice"})
 
 
