@@ -11,7 +11,7 @@ import numpy as np
 from cosim.checks import check_device
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
-from declared_settings.setting import declared
+from declared_settings.setting import check_settings, declared
 
 # FluidConfig fields a case's numerics may override (the rest is the case's geometry, physics and solver).
 NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "density_iteration", "density_tolerance")
@@ -74,7 +74,8 @@ class FluidCaseParams:
     solver: PressureSolver = FluidConfig.pressure_solver
     numerics: tuple[tuple[str, Any], ...] = ()
 
-    def validate_common(self) -> None:
+    def __post_init__(self) -> None:
+        """The shared parameters checked, then a case's own declared ones (:func:`check_settings`)."""
         if self.spacing is not None:
             declared(FluidConfig, "spacing").check("spacing", self.spacing)
         declared(FluidConfig, "dim").check("dim", self.dim)
@@ -85,6 +86,7 @@ class FluidCaseParams:
             if name not in NUMERICS_FIELDS:
                 raise InputError(f"numerics: {name!r} cannot be overridden; choose from {', '.join(NUMERICS_FIELDS)}")
         FluidConfig(**dict(self.numerics))  # the values' own range checks, before anything runs
+        check_settings(self)
 
     def tank_depth(self, spacing: float) -> float:
         """m, the tank depth the case builds: in 3-D ``depth`` in whole spacings (:func:`whole_spacings`); in 2-D

@@ -28,7 +28,7 @@ from cosim.robots.scene import RobotScene
 from cosim.robots.scene_builder import build_scene_spec
 from cosim.robots.scene_config import ArmRole
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, new_figure
-from declared_settings.setting import check_settings, documented, setting
+from declared_settings.setting import documented, setting
 
 # Acceptance: the reaction equals the liquid's weight within 1 %; the joint torques match the rigid-payload model
 # within 2 %.
@@ -49,11 +49,6 @@ class Params(FluidCaseParams):
     fill: float = setting(PourConfig.fill_depth, COUPLING_STATIC, "Liquid depth in the pourer.", "m", 0.0, 2.0,
                           lo_open=True)
     duration: float = setting(0.5, COUPLING_STATIC, "Time held.", "s", 0.0, 30.0, lo_open=True)
-
-    def __post_init__(self) -> None:
-        self.validate_common()
-        check_settings(self)
-
 
 def _hold(scene: RobotScene, steps: int, window: int, step_fn) -> np.ndarray:
     """Run ``steps`` MuJoCo steps holding home; return the pour arm's mean qfrc_actuator over the last ``window``."""

@@ -33,7 +33,7 @@ from cosim.fluid.wall_sampling import numerical_wall_thickness
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
 from cosim.validation.dam_gate import MAX_GATE_SPEED, lauber_hager_speed, lifted_gate
 from cosim.vessel import VesselSpec
-from declared_settings.setting import check_settings, documented, setting
+from declared_settings.setting import documented, setting
 
 # Acceptance: surge front within 10 % of Martin & Moyce at every point with T <= 3.
 FRONT_TOLERANCE = 0.10
@@ -92,11 +92,6 @@ class Params(FluidCaseParams):
     gate_speed: float | None = setting(None, DAM_BREAK, "The column is released by a gate lifted at this speed "
                                        "(cosim.validation.dam_gate).", "m/s", 0.0, MAX_GATE_SPEED, lo_open=True,
                                        none_means="released instantaneously")
-
-    def __post_init__(self) -> None:
-        self.validate_common()
-        check_settings(self)
-
     @property
     def resolved_spacing(self) -> float:
         return self.spacing if self.spacing is not None else self.width / PARTICLES_ACROSS

@@ -29,7 +29,7 @@ from cosim.pour_scene import FluidSettings
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
 from cosim.validation.scripted import FALL_HEIGHT, domain_around, run_scripted, tilt_about_lip
 from cosim.vessel import VesselSpec, seed_pouring_vessel
-from declared_settings.setting import check_settings, documented, like, setting
+from declared_settings.setting import documented, like, setting
 
 # Acceptance: the median landing error of the followed particles within 10 mm, the landing accuracy asked
 # of the pour (there measured against the controller's prediction, which adds the measurement of the jet).
@@ -54,11 +54,6 @@ class Params(FluidCaseParams):
     launch_spacings: float = setting(1.0, FREE_FALL, "How far beyond the lip (in particle spacings) the launch state "
                                      "is taken.", "", 0.0, 10.0)
     particles_across: int = like(FluidSettings, "particles_across")
-
-    def __post_init__(self) -> None:
-        self.validate_common()
-        check_settings(self)
-
     def spec(self) -> VesselSpec:
         return seed_pouring_vessel()
 

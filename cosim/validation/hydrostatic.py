@@ -26,7 +26,7 @@ from cosim.frames import Pose
 from cosim.pour_scene import load_scene
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure, require_particles_across, whole_spacings
 from cosim.vessel import VesselSpec
-from declared_settings.setting import check_settings, documented, setting
+from declared_settings.setting import documented, setting
 
 # Acceptance: pressure within 2 % of rho0 g (H - z) away from walls and surface, density error <= 1 % (the weakly
 # compressible bound (v_max / c0)^2 with c0 >= 10 v_max: Monaghan 1994, "Simulating free surface flows with SPH"),
@@ -54,11 +54,6 @@ class Params(FluidCaseParams):
     fill: float = setting(0.159, HYDROSTATIC, "Fill depth.", "m", 0.0, 2.0, lo_open=True)
     duration: float = setting(2.0, HYDROSTATIC, "Simulated time before measuring.", "s", 0.0, 60.0, lo_open=True)
     scene: str = ""
-
-    def __post_init__(self) -> None:
-        self.validate_common()
-        check_settings(self)
-
     @property
     def resolved_spacing(self) -> float:
         return self.spacing if self.spacing is not None else self.tank_width / MIN_PARTICLES_ACROSS

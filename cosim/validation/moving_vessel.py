@@ -27,7 +27,7 @@ from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fl
 from cosim.validation.scripted import FALL_HEIGHT, PoseScript, domain_around, run_scripted, shake_sideways, tilt_about_lip
 from cosim.validation.slosh import eq17_frequency
 from cosim.vessel import VesselSpec, seed_pouring_vessel
-from declared_settings.setting import check_settings, documented, setting
+from declared_settings.setting import documented, setting
 
 HOLD_AFTER_TILT = 0.5  # s the tilted vessel is held before the run ends
 
@@ -52,11 +52,6 @@ class Params(FluidCaseParams):
     particles_across: int = setting(24, MOVING_VESSEL, "Resolution across the vessel's inner width when spacing is not "
                                     "given.", "", 8, 400)
     scene: str = ""
-
-    def __post_init__(self) -> None:
-        self.validate_common()
-        check_settings(self)
-
     @property
     def inner_height(self) -> float:
         """m, the vessel's inner height (the fill's limit)."""

@@ -32,7 +32,7 @@ from cosim.validation.common import (
     zero_crossing_frequency,
 )
 from cosim.vessel import VesselSpec
-from declared_settings.setting import check_settings, documented, setting
+from declared_settings.setting import documented, setting
 
 # Acceptance: first-mode frequency within 3 % of Eq. 17.
 FREQUENCY_TOLERANCE = 0.03
@@ -58,11 +58,6 @@ class Params(FluidCaseParams):
     width: float = setting(VesselSpec.inner_width, SLOSH, "Tank inner width B.", "m", 0.0, 2.0, lo_open=True)
     fill: float = setting(0.108, SLOSH, "Fill depth A.", "m", 0.0, 2.0, lo_open=True)
     periods: float = setting(5.0, SLOSH, "Oscillation periods measured after the pulse.", "", 0.0, 50.0, lo_open=True)
-
-    def __post_init__(self) -> None:
-        self.validate_common()
-        check_settings(self)
-
     @property
     def resolved_spacing(self) -> float:
         return self.spacing if self.spacing is not None else self.width / MIN_PARTICLES_ACROSS

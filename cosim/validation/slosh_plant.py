@@ -33,7 +33,7 @@ from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fl
 from cosim.validation.plant_fit import PlantFit, identify_plant
 from cosim.validation.scripted import run_scripted, tilt_about_axis_point
 from cosim.vessel import VesselShape, VesselSpec
-from declared_settings.setting import check_settings, documented, setting
+from declared_settings.setting import documented, setting
 
 # Acceptance: the identified hinge within 5 mm and omega1 within 2 % of the potential-flow model.
 HINGE_TOLERANCE = 0.005  # m
@@ -68,8 +68,7 @@ class Params(FluidCaseParams):
                                     "given.", "", MIN_PARTICLES_ACROSS, 200)
 
     def __post_init__(self) -> None:
-        self.validate_common()
-        check_settings(self)
+        super().__post_init__()
         if self.shape is VesselShape.CYLINDER and self.dim == 2:
             raise InputError("shape: a cylinder needs dim 3 (its 2-D section is a box); use shape box or dim 3")
         require_particles_across("spacing", self.width, self.resolved_spacing, MIN_PARTICLES_ACROSS)

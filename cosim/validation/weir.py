@@ -38,7 +38,7 @@ from cosim.fluid.wall_sampling import numerical_wall_thickness
 from cosim.frames import Pose
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
 from cosim.vessel import VesselSpec
-from declared_settings.setting import check_settings, documented, setting
+from declared_settings.setting import documented, setting
 
 # Acceptance: the discharge coefficient within 5 % of Rehbock's at each head.
 COEFFICIENT_TOLERANCE = 0.05
@@ -72,10 +72,9 @@ class Params(FluidCaseParams):
                             "it).", "s", 0.05, "duration")
 
     def __post_init__(self) -> None:
-        self.validate_common()
+        super().__post_init__()
         if self.dim != 2:
             raise InputError("dim: the weir case runs in 2-D only (the pour plane); choose 2")
-        check_settings(self)
         if self.head / self.resolved_spacing < 4.0 - 1e-9:
             raise InputError(f"spacing: {self.resolved_spacing:g} m gives {self.head / self.resolved_spacing:.1f} particles across "
                              f"the {self.head:g} m head; needs >= 4")
