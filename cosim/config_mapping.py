@@ -131,7 +131,7 @@ def from_mapping(cls: type, table: dict[str, Any], path: str, default: Any = Non
         raise
     except TypeError as exc:  # a required field is missing
         raise InputError(f"{path}: {exc}") from None
-    except ValueError as exc:  # a check that raises a plain ValueError (e.g. a vessel without its mesh)
+    except ValueError as exc:  # a check that raises a plain ValueError
         raise InputError(f"{path}: {exc}" if not str(exc).startswith(path.split(".")[-1]) else str(exc)) from None
 
 
