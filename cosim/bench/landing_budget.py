@@ -47,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from cosim.coupling.landing import BAND_SPACINGS, MIN_FALL_SPEED_FRACTION, landing_pairs, paired_prediction
+from cosim.coupling.outflow import RATE_WINDOW
 from cosim.io.pour_series import read_series_csv, write_series_csv
 
 PARTICLES_FILE = "particles.npz"
@@ -55,6 +56,7 @@ LANDING_FILE = "landing.json"
 # The probe's launch window (:class:`controllers.measurement.LiquidMeasurement`, v_q), in particle spacings past the
 # lip along world x and below the lip along world z; its top is one spacing over the lip plus the head.
 WINDOW_NEAR, WINDOW_FAR, WINDOW_BELOW, WINDOW_ABOVE = 1.0, 4.0, 6.0, 1.0
+BRINK_DEPTH_RATIO = 0.715  # brink depth / critical depth of a free overfall (Rouse 1936)
 
 
 def record(scene, out: Path) -> dict:
@@ -184,7 +186,59 @@ def decompose(run: Path) -> dict:
             "spread": x_b - x_l, "timing": x_l - xp, "particles": len(band),
             "catcher_offset": measured - (sp.home_x + float(s["smoothed_catcher_dx"][k])),
         })
-    return {"samples": len(steps), "decomposed": len(rows), "skipped": skipped, "rows": rows}
+    return {"samples": len(steps), "decomposed": len(rows), "skipped": skipped, "rows": rows,
+            "references": reference_predictions(sp, steps, predicted)}
+
+
+def all_crossings(sp: StreamParticles) -> tuple[np.ndarray, np.ndarray]:
+    """Time (s) and world x (m) of every particle's first downward crossing of the rim plane faster than the band's
+    minimum speed, in time order (interpolated linearly between control steps)."""
+    rim = sp.series["catcher_rim_z"][:, None]
+    z = sp.state[..., 1] - rim
+    speed = MIN_FALL_SPEED_FRACTION * np.sqrt(2.0 * sp.gravity * np.maximum(sp.series["lip_z"] - sp.series["catcher_rim_z"], 0.0))
+    down = (z[:-1] >= 0.0) & (z[1:] < 0.0) & (sp.state[1:, :, 3] < -speed[1:, None])
+    times, xs = [], []
+    for i in np.flatnonzero(down.any(axis=0)):
+        j = int(np.flatnonzero(down[:, i])[0])
+        f = z[j, i] / (z[j, i] - z[j + 1, i])
+        times.append(sp.t[j] + f * (sp.t[j + 1] - sp.t[j]))
+        xs.append((1.0 - f) * sp.state[j, i, 0] + f * sp.state[j + 1, i, 0])
+    order = np.argsort(times)
+    return np.asarray(times)[order], np.asarray(xs)[order]
+
+
+def reference_predictions(sp: StreamParticles, steps: np.ndarray, predicted: np.ndarray) -> dict:
+    """Median |error| (mm) over the measured samples of two predictions that are not the controller's:
+
+    ``stream_centre``: the mean crossing x of all other particles that cross the rim plane within RATE_WINDOW / 2 of
+    the sample (what a prediction that knew the stream's centre exactly would score: the floor a single-particle
+    sample leaves to any prediction of the stream); ``crest_head``: the landing of a jet launched horizontally at the
+    lip with the brink velocity of critical flow over the crest, v_b = sqrt(g y_c) / 0.715, y_c = 2 h_q / 3
+    (critical depth over a broad crest; brink depth 0.715 y_c, Rouse 1936), falling freely, at the launch time the
+    metric pairs (what the head over the crest alone predicts). Also the stream's launch point, the window's mean
+    position past the lip (median over the flowing steps, mm)."""
+    s = sp.series
+    measured = s["landing_measured_x"][steps]
+    times, xs = all_crossings(sp)
+    centre = []
+    for k in steps:
+        near = (np.abs(times - sp.t[k]) <= 0.5 * RATE_WINDOW) & (np.abs(times - sp.t[k]) > 0.5 * (sp.t[1] - sp.t[0]))
+        centre.append(xs[near].mean() if near.any() else math.nan)
+    head = np.maximum(s["h_q"], 0.0)
+    v_brink = np.sqrt(sp.gravity * 2.0 * head / 3.0) / BRINK_DEPTH_RATIO
+    drop = np.maximum(s["lip_z"] - s["catcher_rim_z"], 0.0)
+    fall = np.sqrt(2.0 * drop / sp.gravity)
+    launch = sp.t[steps] - np.interp(sp.t[steps], sp.t + fall, fall)
+    crest_head = np.interp(launch, sp.t, s["lip_x"] + v_brink * fall)
+    flowing = np.isfinite(s["landing_fall_time"]) & np.isin(s["phase"], ("cfs", "cfs_final"))
+    return {
+        "stream_centre_median_abs_mm": 1e3 * float(np.nanmedian(np.abs(measured - np.asarray(centre)))),
+        "crest_head_median_abs_mm": 1e3 * float(np.median(np.abs(measured - crest_head))),
+        "crest_head_mean_mm": 1e3 * float(np.mean(measured - crest_head)),
+        "controller_median_abs_mm": 1e3 * float(np.median(np.abs(measured - predicted))),
+        "launch_point_past_lip_mm": [1e3 * float(np.median(s[c][flowing])) for c in ("jet_dx", "jet_dz")],
+        "crossings": len(times),
+    }
 
 
 def budget(decomposition: dict) -> dict:
@@ -200,6 +254,7 @@ def budget(decomposition: dict) -> dict:
                      "median_abs_mm": 1e3 * float(np.median(np.abs(v)))}
         if term in TERMS:
             out[term]["without_mm"] = 1e3 * float(np.median(np.abs(error - v)))
+    out["references"] = decomposition["references"]
     return out
 
 
