@@ -46,9 +46,13 @@ from pathlib import Path
 
 import numpy as np
 
+from cosim.checks import check_positive
 from cosim.coupling.landing import BAND_SPACINGS, MIN_FALL_SPEED_FRACTION, landing_pairs, paired_prediction
 from cosim.coupling.outflow import RATE_WINDOW
+from cosim.errors import InputError
+from cosim.fluid.config import FluidConfig
 from cosim.io.pour_series import read_series_csv, write_series_csv
+from cosim.setting import declared
 
 PARTICLES_FILE = "particles.npz"
 SERIES_FILE = "series.csv"
@@ -258,28 +262,71 @@ def budget(decomposition: dict) -> dict:
     return out
 
 
+def check_run(run: Path) -> None:
+    """A folder ``record`` wrote: its series.csv and particles.npz are there (InputError naming RUN otherwise)."""
+    missing = [name for name in (SERIES_FILE, PARTICLES_FILE) if not (run / name).is_file()]
+    if missing:
+        raise InputError(f"RUN: {run} has no {' or '.join(missing)} (a folder written by "
+                         f"'python -m cosim.bench.landing_budget record ... --out RUN')")
+
+
+def report(b: dict) -> str:
+    """The budget as text: the error, each term's share, the catcher and the reference predictions (mm)."""
+    r = b["references"]
+    lines = [f"{b['decomposed']} of {b['samples']} samples, median {b['median_abs_error_mm']:.2f} mm, mean "
+             f"{b['mean_error_mm']:+.2f} mm; particles in the band per sample: median {b['particles_in_band_median']:.0f}",
+             f"{'term':<8} {'median |term|':>14} {'mean':>8} {'median |error| without it':>27}"]
+    for term in TERMS:
+        t = b[term]
+        lines.append(f"{term:<8} {t['median_abs_mm']:>14.2f} {t['mean_mm']:>+8.2f} {t['without_mm']:>27.2f}")
+    c = b["catcher_offset"]
+    lines += [f"catcher's centre to the measured landing: median {c['median_mm']:+.2f} mm, median |offset| {c['median_abs_mm']:.2f} mm",
+              f"stream's centre known exactly: {r['stream_centre_median_abs_mm']:.2f} mm; launched from the crest and head: "
+              f"{r['crest_head_median_abs_mm']:.2f} mm (mean {r['crest_head_mean_mm']:+.2f} mm); launch point "
+              f"{r['launch_point_past_lip_mm'][0]:.1f} mm past the lip, {r['launch_point_past_lip_mm'][1]:+.1f} mm above it"]
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if argv[:1] == ["record"]:
-        p = argparse.ArgumentParser(prog="python -m cosim.bench.landing_budget record", description=__doc__,
+    try:
+        if argv[:1] == ["record"]:
+            return _record_command(argv[1:])
+        p = argparse.ArgumentParser(prog="python -m cosim.bench.landing_budget", description=__doc__,
                                     formatter_class=argparse.RawDescriptionHelpFormatter)
-        p.add_argument("scene", nargs="?", type=Path, help="scene TOML file (default: the embedded default scene)")
-        p.add_argument("--out", type=Path, required=True, help="folder for series.csv, landing.json, particles.npz")
-        p.add_argument("--threads", type=int, help="CPU threads of the liquid solver")
-        p.add_argument("--duration", type=float, help="longest simulated time, s")
-        args = p.parse_args(argv[1:])
-        from cosim.cli.pour import scene_from_args
+        p.add_argument("run", type=Path, help="a folder written by 'record'")
+        p.add_argument("--json", action="store_true", help="print the budget as JSON")
+        args = p.parse_args(argv)
+        check_run(args.run)
+        b = budget(decompose(args.run))
+    except InputError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    print(json.dumps(b, indent=2) if args.json else report(b))
+    return 0
 
-        args.device, args.dim, args.no_log = None, None, True
-        accuracy = record(scene_from_args(args), args.out)
-        print(json.dumps(accuracy))
-        return 0
-    p = argparse.ArgumentParser(prog="python -m cosim.bench.landing_budget", description=__doc__,
+
+def _record_command(argv: list[str]) -> int:
+    p = argparse.ArgumentParser(prog="python -m cosim.bench.landing_budget record", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("run", type=Path, help="a folder written by 'record'")
-    p.add_argument("--json", action="store_true", help="print the budget as JSON")
+    p.add_argument("scene", nargs="?", type=Path, help="scene TOML file (default: the embedded default scene)")
+    p.add_argument("--out", type=Path, required=True, help="new folder for series.csv, landing.json, particles.npz")
+    p.add_argument("--threads", type=int, help="CPU threads of the liquid solver (overrides fluid.cpu_threads)")
+    p.add_argument("--duration", type=float, help="longest simulated time, s (overrides coupling.max_duration)")
     args = p.parse_args(argv)
-    print(json.dumps(budget(decompose(args.run)), indent=2))
+    threads = declared(FluidConfig, "cpu_threads").check("--threads", args.threads) if args.threads is not None else None
+    duration = check_positive("--duration", args.duration, "s", 600.0) if args.duration is not None else None
+    if args.out.exists() and (not args.out.is_dir() or any(args.out.iterdir())):
+        raise InputError(f"--out: {args.out} already exists and is not an empty folder")
+    from cosim.pour_scene import PourScene, load_scene
+
+    scene = load_scene(args.scene).named_after(args.scene) if args.scene is not None else PourScene()
+    if threads is not None:
+        scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=threads))
+    if duration is not None:
+        scene = replace(scene, coupling=replace(scene.coupling, max_duration=duration))
+    scene = replace(scene, logging=replace(scene.logging, enabled=False))
+    print(json.dumps(record(scene, args.out)))
     return 0
 
 
