@@ -14,25 +14,23 @@ within BAND_SPACINGS of the rim's height, :mod:`cosim.coupling.landing`) with th
 with (made at the launch time t_l, t_l + t_fall(t_l) = t) and splits the error e = x_measured(t) - x_predicted(t_l)
 into terms that add up to it exactly:
 
-* ``flight``: each particle in the band where it actually crosses, less where a free ballistic flight from its own
-  launch state would have put it (gravity only, Camporredondo et al. 2019, Eqs. 6-7). Launch state: the particle's
-  position and velocity at the last control step it spent in the probe's launch window (one to four spacings past
-  the lip, :class:`controllers.measurement.LiquidMeasurement`); what pressure, viscosity and neighbours do to it
-  in the fall lands here.
-* ``band``: the measured median against the crossing points of the same particles (the band is two spacings
-  thick: a particle in it is not yet, or no longer, at the rim's height).
-* ``spread``: the particles' own ballistic landings against the ballistic landing of the window's mean launch
-  state at their launch times: how far apart the particles of one stream land (the stream resolved by a few
-  particles, each with its own launch position and velocity).
-* ``timing``: that mean-state landing at the particles' own launch times against the prediction at the launch time
-  the metric assumes (the mean state's fall time): the pairing of a measurement with a prediction.
-* ``state``: the remainder, the prediction at t_l against the ballistic landing of the window's mean state at the
-  particles' launch times that the ``timing`` term used; zero when the launch times agree, and the part of the
-  controller's own estimate (its launch point and velocity, as measured) otherwise.
+* ``band``: the measured median against the median of where the same particles actually cross the rim plane
+  (the band is two spacings thick: a particle in it is not yet, or no longer, at the rim's height).
+* ``flight``: those crossings against where a free ballistic flight from each particle's own launch state would
+  have put it (gravity only, Camporredondo et al. 2019, Eqs. 6-7; medians over the band's particles). Launch state:
+  the particle's position and velocity at the last control step it spent in the probe's launch window (one to
+  four spacings past the lip, :class:`controllers.measurement.LiquidMeasurement`); what pressure, viscosity and
+  neighbours do to it in the fall lands here.
+* ``spread``: the particles' own ballistic landings against the controller's predictions at their launch steps
+  (the ballistic landing of the window's mean launch state): how far one particle lands from the mean of the
+  stream it left with.
+* ``timing``: those predictions against the one the metric pairs the sample with (at the launch time t_l from the
+  mean state's fall time): the pairing of a measurement with a prediction.
 
-Reported per term: its median, mean and the median |error| left when the term is removed (the error it costs). The
-catcher's lag, the distance from vessel B's centre to the measured landing, is reported beside them; it is not a
-part of the prediction's error (the metric compares two landing points, not the catcher's position).
+Reported per term: its median, mean and the median |error| left when the term is removed (the error it costs).
+Beside them: the catcher's offset, the measured landing less vessel B's smoothed centre (not a part of the
+prediction's error: the metric compares two landing points), and two predictions that are not the controller's
+(:func:`reference_predictions`).
 """
 
 from __future__ import annotations
