@@ -58,6 +58,20 @@ def test_prediction_is_paired_with_the_arrival_of_its_liquid() -> None:
     assert landing_accuracy(t, predicted, np.full_like(t, np.nan), measured, in_cfs) == {"samples": 0}
 
 
+def test_scatter_about_the_stream_centre_is_split_from_the_centre_error() -> None:
+    t = np.arange(0.0, 6.0, 0.01)
+    fall = np.full_like(t, 0.2)
+    in_cfs = np.ones_like(t, bool)
+    predicted = np.full_like(t, 0.20)
+    # the stream's centre lands 1 mm beyond the prediction; single particles scatter +-6 mm about it, alternately
+    scatter = np.where(np.arange(len(t)) % 2 == 0, 0.006, -0.006)
+    measured = 0.201 + scatter
+    acc = landing_accuracy(t, predicted, fall, measured, in_cfs)
+    assert acc["median_abs_error"] == pytest.approx(0.006, abs=1.1e-3)  # 5 or 7 mm per sample
+    assert acc["centre_median_abs_error"] == pytest.approx(0.001, abs=2e-4)  # the window's mean: the centre's 1 mm
+    assert acc["scatter_median_abs"] == pytest.approx(0.006, abs=2e-4)
+
+
 def test_series_csv_round_trip(tmp_path) -> None:
     rows = {c: [0.1, 0.2] for c in COLUMNS}
     rows["phase"] = ["cfs", "return"]
