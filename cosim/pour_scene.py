@@ -201,7 +201,7 @@ class LoggingSettings:
     """
 
     enabled: bool = True
-    recording: RecordingConfig = field(default_factory=lambda: RecordingConfig(particle_rate_hz=30.0))
+    recording: RecordingConfig = field(default_factory=RecordingConfig)
 
 
 @documented
@@ -332,7 +332,7 @@ class PourScene:
     liquid: LiquidSettings = field(default_factory=LiquidSettings)
     fluid: FluidSettings = field(default_factory=FluidSettings)
     controller: ControllerSettings = field(default_factory=ControllerSettings)
-    coupling: CouplingSettings = field(default_factory=lambda: CouplingSettings(max_duration=60.0))
+    coupling: CouplingSettings = field(default_factory=CouplingSettings)
     trajectory: TrajectorySettings = field(default_factory=TrajectorySettings)
     logging: LoggingSettings = field(default_factory=LoggingSettings)
     vessels: VesselsSettings = field(default_factory=VesselsSettings)
