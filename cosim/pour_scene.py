@@ -210,7 +210,8 @@ class VesselSettings:
     """An open vessel standing on its floor: a box, a cylinder or the walls of a mesh file.
 
     mesh: a 'mesh' vessel's file: OBJ or STL, one watertight solid of the walls, in metres, its opening up (+z);
-      relative to the scene file. Its bounding box within [0.005, 2] m.
+      relative to the scene file. Its size is a vessel's an arm pours from, in metres: a file outside the allowed
+      sizes (one in millimetres, say) is refused with a message naming them.
     """
 
     shape: VesselShape = setting(VesselSpec.shape, VESSEL, "'box' or 'cylinder', an open vessel standing on its floor; "
