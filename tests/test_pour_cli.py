@@ -245,8 +245,8 @@ def test_scene_check_refuses_a_numerical_setting_out_of_range(tmp_path, capsys):
 
 @pytest.mark.parametrize("toml", ["[coupling]\nstart_delay = 0.3\n", "[logging.recording]\nparticle_stride = 2\n"])
 def test_a_section_changes_only_its_own_keys_of_the_scene_default(tmp_path, toml):
-    # the scene's defaults for a section (coupling.max_duration 60 s, recording.particle_rate_hz 30 Hz) differ from
-    # the section classes' own defaults; a file that sets one key of the section must keep the scene's others
+    # a file that sets one key of a section keeps the scene's defaults for its others (coupling.max_duration 60 s,
+    # recording.particle_rate_hz 30 Hz: the section classes' own, declared once)
     path = tmp_path / "scene.toml"
     path.write_text(toml)
     scene, default = load_scene(path), PourScene()
