@@ -150,6 +150,15 @@ def setting(
     return dataclasses.field(default=default, metadata={SETTING: spec})
 
 
+def argument(group: str, meaning: str, unit: str = "", lo: Bound = None, hi: Bound = None, lo_open: bool = False,
+             hi_open: bool = False, kind: str = "float") -> Setting:
+    """The declaration of an argument that is no configuration field (a building block's rate limit or time step,
+    given by the configuration that builds it): the same :class:`Setting` a field gets, declared once beside the
+    code that takes it and checked by :meth:`Setting.check` (a named bound reads the ``owner`` passed there)."""
+    bounds = None if lo is None and hi is None else Bounds(lo, hi, lo_open, hi_open)
+    return Setting(group, meaning, unit, kind, bounds)
+
+
 def declared(cls: type, name: str) -> Setting:
     """The :class:`Setting` of field ``name`` of the dataclass ``cls``."""
     return cls.__dataclass_fields__[name].metadata[SETTING]
