@@ -36,6 +36,7 @@ from cosim.pour_scene import (
     CatcherSettings, ControllerSettings, LiquidSettings, PlacementSettings, PourScene, TrajectorySettings,
     VesselSettings, VesselsSettings,
 )
+from cosim.sweep.spec import POURS, SEED, parse_sweep
 from cosim.trajectory.generator import GeneratorSettings
 from cosim.trajectory.limits import JointLimits
 from cosim.trajectory.pour_motion import PourMotionSpec
@@ -279,6 +280,9 @@ ARGUMENTS = [
     (CLEARANCE, lambda v, _: MotionChecker(_robot_scene(), clearance=v), "collision.clearance", None),
     (MAX_JOINT_STEP, lambda v, _: MotionChecker(_robot_scene(), max_joint_step=v), "collision.max_joint_step", None),
     (PARTICLE_RADIUS, _recorder, "recording.particle_radius", None),
+    (SEED, lambda v, folder: parse_sweep({"seed": v, "axes": {"liquid.fill_depth": [0.1]}}, folder, "s"), "seed", None),
+    (POURS, lambda v, folder: parse_sweep({"axes": {"fluid.particles_across": {"start": 16, "stop": 32, "num": v}}},
+                                          folder, "s"), "axes.fluid.particles_across.num", None),
 ]
 
 
