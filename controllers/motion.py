@@ -12,7 +12,21 @@ import math
 import numpy as np
 import ruckig
 
-from controllers.checks import check_range
+from declared_settings.setting import argument
+
+# The building blocks' arguments, declared once (the configurations that build them declare their own, narrower
+# ranges); a limit's unit is the coordinate's per second, per second squared or per second cubed.
+MOTION = "motion"
+MAX_RATE = argument(MOTION, "Rate limit, the coordinate's unit per second.", "", 0.0, None, lo_open=True)
+MAX_ACCEL = argument(MOTION, "Acceleration limit, the coordinate's unit per second squared.", "", 0.0, None,
+                     lo_open=True)
+MAX_JERK = argument(MOTION, "Jerk limit, the coordinate's unit per second cubed.", "", 0.0, None, lo_open=True)
+STOP_ACCEL = argument(MOTION, "Acceleration limit in the direction that slows a move toward its target.", "", 0.0,
+                      "max_accel", lo_open=True)
+TIME_STEP = argument(MOTION, "Sample time.", "s", 0.0, 1.0, lo_open=True)
+BANDWIDTH = argument(MOTION, "Each low-pass's corner frequency, 1 / its time constant.", "rad/s", 0.0, None,
+                     lo_open=True)
+STAGES = argument(MOTION, "First-order low-passes in series.", "", 1, None, kind="int")
 
 
 class RateLimitedTracker:
@@ -20,9 +34,9 @@ class RateLimitedTracker:
     velocity that would stop exactly at the target under max_accel, itself capped by max_rate."""
 
     def __init__(self, max_rate: float, max_accel: float, dt: float, position: float = 0.0) -> None:
-        self.max_rate = check_range("tracker.max_rate", max_rate, 0.0, None, lo_open=True)
-        self.max_accel = check_range("tracker.max_accel", max_accel, 0.0, None, lo_open=True)
-        self.dt = check_range("tracker.dt", dt, 0.0, 1.0, "s", lo_open=True)
+        self.max_rate = MAX_RATE.check("tracker.max_rate", max_rate)
+        self.max_accel = MAX_ACCEL.check("tracker.max_accel", max_accel)
+        self.dt = TIME_STEP.check("tracker.dt", dt)
         self.position = float(position)
         self.velocity = 0.0
 
@@ -53,10 +67,10 @@ class JerkLimitedMove:
 
     def __init__(self, position: float, velocity: float, target: float, max_rate: float, max_accel: float,
                  max_jerk: float, stop_accel: float | None = None) -> None:
-        check_range("move.max_rate", max_rate, 0.0, None, lo_open=True)
-        check_range("move.max_accel", max_accel, 0.0, None, lo_open=True)
-        check_range("move.max_jerk", max_jerk, 0.0, None, lo_open=True)
-        stop = max_accel if stop_accel is None else check_range("move.stop_accel", stop_accel, 0.0, max_accel, lo_open=True)
+        MAX_RATE.check("move.max_rate", max_rate)
+        self.max_accel = MAX_ACCEL.check("move.max_accel", max_accel)
+        MAX_JERK.check("move.max_jerk", max_jerk)
+        stop = max_accel if stop_accel is None else STOP_ACCEL.check("move.stop_accel", stop_accel, self)
         inp = ruckig.InputParameter(1)
         inp.current_position, inp.current_velocity, inp.current_acceleration = [position], [velocity], [0.0]
         inp.target_position, inp.target_velocity, inp.target_acceleration = [target], [0.0], [0.0]
@@ -87,14 +101,14 @@ class CriticallyDampedSmoother:
     whose transfer function (:meth:`transfer_function_coefficients`) a feedback design can include: its
     low-frequency delay is stages / bandwidth and its output's acceleration stays bounded for bounded input steps.
     Its impulse response is positive with unit sum, so its output's differences of any order are never larger than
-    the input's largest (what limits a path's sampled rates holds after it). ``bandwidth`` in rad/s, ``dt`` in s,
-    ``stages`` >= 1 (default 2); units of x and y are the caller's.
+    the input's largest (what limits a path's sampled rates holds after it). ``bandwidth`` (:data:`BANDWIDTH`),
+    ``dt`` (:data:`TIME_STEP`), ``stages`` (:data:`STAGES`, default 2); units of x and y are the caller's.
     """
 
     def __init__(self, bandwidth: float, dt: float, stages: int = 2) -> None:
-        check_range("smoother.bandwidth", bandwidth, 0.0, None, "rad/s", lo_open=True)
-        check_range("smoother.dt", dt, 0.0, 1.0, "s", lo_open=True)
-        check_range("smoother.stages", stages, 1, None)
+        BANDWIDTH.check("smoother.bandwidth", bandwidth)
+        TIME_STEP.check("smoother.dt", dt)
+        STAGES.check("smoother.stages", stages)
         self.gain = 1.0 - math.exp(-bandwidth * dt)
         self.dt = float(dt)
         self._stages = [0.0] * int(stages)

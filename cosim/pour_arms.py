@@ -17,7 +17,6 @@ limits (:func:`joint_limit_overrides`), under a scene's ``trajectory.limits``, w
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -71,21 +70,17 @@ class ArmSettings:
     rated_payload: float | None = setting(None, ARM, "The arm's rated payload, against the vessel, its liquid and the "
                                           "mount.", "kg", 0.0, 1000.0, lo_open=True,
                                           none_means=f"the UR10e's {UR10E_PAYLOAD_KG:g} kg (a user's arm must give it)")
-    base_pos: tuple[float, ...] = setting((), ARM, "The arm base's world position [x, y, z].", "m", kind="vector",
-                                          none_means="the project's cell (the UR10e's place by the table)")
-    base_yaw: float | None = setting(None, ARM, "The base's rotation about world z.", "rad", -2.0 * math.pi,
-                                     2.0 * math.pi, none_means="the cell's (pi for the pour arm, 0 for the catch arm) "
-                                     "unless base_quat is given")
+    base_pos: tuple[float, ...] = like(ArmPlacement, "base_pos", (), "the project's cell (the UR10e's place by the "
+                                       "table)")
+    base_yaw: float | None = like(ArmPlacement, "base_yaw", None, "the cell's (pi for the pour arm, 0 for the catch "
+                                  "arm) unless base_quat is given")
     base_quat: tuple[float, ...] = ()
-    home_seed: tuple[float, ...] = setting(
-        (), ARM, "The configuration the home posture is solved from (picks the inverse kinematics' branch: elbow up or "
-        "down).", "rad", -100.0, 100.0, kind="per_joint", none_means="the UR10e's seed for the UR10e, zeros (the "
-        "file's reference posture) for a user's arm")
-    grasp_pos: tuple[float, ...] = setting(
-        (), ARM, "Where the vessel sits on the flange: its frame's origin (the centre of its inner floor) in the flange "
-        "site's frame [x, y, z].", "m", kind="vector", none_means="the held wall's outer face (a mesh vessel's "
-        "outermost point on that side: a mug's handle) on the 10 mm mount plate, the flange at half the wall height "
-        "(the pour arm holds the back wall, the catch arm the front wall)")
+    home_seed: tuple[float, ...] = like(ArmPlacement, "home_seed", (), "the UR10e's seed for the UR10e, zeros (the "
+                                        "file's reference posture) for a user's arm")
+    grasp_pos: tuple[float, ...] = like(ArmPlacement, "grasp_pos", (), "the held wall's outer face (a mesh vessel's "
+                                        "outermost point on that side: a mug's handle) on the 10 mm mount plate, the "
+                                        "flange at half the wall height (the pour arm holds the back wall, the catch "
+                                        "arm the front wall)")
     grasp_quat: tuple[float, ...] = ()
 
     @property

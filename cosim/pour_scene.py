@@ -201,7 +201,7 @@ class LoggingSettings:
     """
 
     enabled: bool = True
-    recording: RecordingConfig = field(default_factory=lambda: RecordingConfig(particle_rate_hz=30.0))
+    recording: RecordingConfig = field(default_factory=RecordingConfig)
 
 
 @documented
@@ -210,7 +210,8 @@ class VesselSettings:
     """An open vessel standing on its floor: a box, a cylinder or the walls of a mesh file.
 
     mesh: a 'mesh' vessel's file: OBJ or STL, one watertight solid of the walls, in metres, its opening up (+z);
-      relative to the scene file. Its bounding box within [0.005, 2] m.
+      relative to the scene file. Its size is a vessel's an arm pours from, in metres: a file outside the allowed
+      sizes (one in millimetres, say) is refused with a message naming them.
     """
 
     shape: VesselShape = setting(VesselSpec.shape, VESSEL, "'box' or 'cylinder', an open vessel standing on its floor; "
@@ -332,7 +333,7 @@ class PourScene:
     liquid: LiquidSettings = field(default_factory=LiquidSettings)
     fluid: FluidSettings = field(default_factory=FluidSettings)
     controller: ControllerSettings = field(default_factory=ControllerSettings)
-    coupling: CouplingSettings = field(default_factory=lambda: CouplingSettings(max_duration=60.0))
+    coupling: CouplingSettings = field(default_factory=CouplingSettings)
     trajectory: TrajectorySettings = field(default_factory=TrajectorySettings)
     logging: LoggingSettings = field(default_factory=LoggingSettings)
     vessels: VesselsSettings = field(default_factory=VesselsSettings)

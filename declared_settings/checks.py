@@ -40,8 +40,9 @@ def check_range(
 ) -> float:
     """Check ``lo <= value <= hi`` (bounds optional, open with ``lo_open``/``hi_open``); return it as float."""
     v = check_number(field, value)
-    below = lo is not None and (v <= lo if lo_open else v < lo)
-    above = hi is not None and (v >= hi if hi_open else v > hi)
+    x = value if isinstance(value, int) else v  # an integer compared exactly: 2**63 - 1 has no float
+    below = lo is not None and (x <= lo if lo_open else x < lo)
+    above = hi is not None and (x >= hi if hi_open else x > hi)
     if below or above:
         suffix = f" {unit}" if unit else ""
         raise InputError(f"{field}: must be in {interval_text(lo, hi, lo_open, hi_open)}{suffix}, got {v:g}")

@@ -24,7 +24,8 @@ from declared_settings.errors import InputError
 
 SETTING = "setting"  # the metadata key of a field's Setting
 REQUIRED = dataclasses.MISSING  # the default of a setting that has none: every configuration must give it
-LISTS = ("vector", "per_joint")  # the kinds whose value is a list (an empty one: not set, where that is allowed)
+LISTS = ("vector", "components", "per_joint")  # the kinds whose value is a list (an empty one: not set, where that is
+# allowed)
 
 Bound = float | str | None  # a number, the name of another field (or property) of the same object, or unbounded
 
@@ -57,9 +58,10 @@ class Setting:
     group: the concern it belongs to (a reference lists fields group by group).
     meaning: what it is and why it matters (equations and references where physics), one or a few sentences.
     unit: SI unit, '' where dimensionless.
-    kind: 'float', 'int', 'bool', 'choice' (an :class:`enum.Enum`, ``choices``), 'vector' (3 numbers) or
-      'per_joint' (a number per joint of the arm the setting belongs to: as many as its ``joint_count``).
-    bounds: a number's allowed interval; a vector's magnitude's; each of a per-joint setting's numbers'.
+    kind: 'float', 'int', 'bool', 'choice' (an :class:`enum.Enum`, ``choices``), 'vector' (``length`` numbers),
+      'components' (``length`` numbers, each bounded, e.g. a box's half sizes) or 'per_joint' (a number per joint of
+      the arm the setting belongs to: as many as its ``joint_count``).
+    bounds: a number's allowed interval; a vector's magnitude's; each of a per-joint setting's or components' numbers'.
     choices: the Enum of a 'choice'.
     optional: not setting it is allowed too (None; an empty list for a vector or a per-joint setting), ``none_means``
       saying what that stands for.
@@ -73,6 +75,7 @@ class Setting:
     choices: type[Enum] | None = None
     optional: bool = False
     none_means: str = ""
+    length: int = 3
 
     def allowed(self) -> str:
         """The allowed values in words, e.g. ``(0, 0.05] m``, ``one of 'wcsph', 'dfsph'``, ``true or false``."""
@@ -82,7 +85,10 @@ class Setting:
         elif self.kind == "choice":
             text = "one of " + ", ".join(repr(m.value) for m in self.choices)
         elif self.kind == "vector":
-            text = f"3 numbers, magnitude in {self.bounds.text()}{unit}" if self.bounds else f"3 numbers ({self.unit})"
+            numbers = f"{self.length} numbers"
+            text = f"{numbers}, magnitude in {self.bounds.text()}{unit}" if self.bounds else f"{numbers} ({self.unit})"
+        elif self.kind == "components":
+            text = f"{self.length} numbers, each in {(self.bounds or Bounds()).text()}{unit}"
         elif self.kind == "per_joint":
             text = f"a number per joint, each in {(self.bounds or Bounds()).text()}{unit}"
         else:
@@ -104,12 +110,12 @@ class Setting:
         if self.kind == "choice":
             return check_choice(name, value, self.choices)
         if self.kind == "vector":
-            vector = check_vector(name, value, 3)
+            vector = check_vector(name, value, self.length)
             if self.bounds is not None:
                 check_range(f"{name} magnitude", math.hypot(*vector), b.lo, b.hi, self.unit, b.lo_open, b.hi_open)
             return vector
-        if self.kind == "per_joint":
-            vector = check_vector(name, value, owner.joint_count)
+        if self.kind in ("per_joint", "components"):
+            vector = check_vector(name, value, owner.joint_count if self.kind == "per_joint" else self.length)
             for i, v in enumerate(vector):
                 check_range(f"{name}[{i}]", v, b.lo, b.hi, self.unit, b.lo_open, b.hi_open)
             return vector
@@ -129,7 +135,7 @@ def setting(
     lo_open: bool = False, hi_open: bool = False, kind: str | None = None, none_means: str = "",
 ) -> Any:
     """A dataclass field with ``default`` declared as a :class:`Setting` (``kind`` from the default where not given:
-    a bool, an Enum member, a tuple (vector), an int or a float; a None default, or an empty tuple for a list kind,
+    a bool, an Enum member, a tuple (vector, of the tuple's length), an int or a float; a None default, or an empty tuple for a list kind,
     makes it optional, ``none_means`` saying what not setting it stands for; :data:`REQUIRED`: no default, a float
     unless ``kind`` says otherwise). A bound given as a name is that attribute of the object the setting belongs to
     (:meth:`Bounds.of`)."""
@@ -138,8 +144,19 @@ def setting(
                 else "vector" if isinstance(default, tuple) else "int" if isinstance(default, int) else "float")
     bounds = None if lo is None and hi is None else Bounds(lo, hi, lo_open, hi_open)
     optional = default is None or (kind in LISTS and default == ())
-    spec = Setting(group, meaning, unit, kind, bounds, type(default) if kind == "choice" else None, optional, none_means)
+    length = len(default) if isinstance(default, tuple) and default else 3
+    spec = Setting(group, meaning, unit, kind, bounds, type(default) if kind == "choice" else None, optional, none_means,
+                   length)
     return dataclasses.field(default=default, metadata={SETTING: spec})
+
+
+def argument(group: str, meaning: str, unit: str = "", lo: Bound = None, hi: Bound = None, lo_open: bool = False,
+             hi_open: bool = False, kind: str = "float") -> Setting:
+    """The declaration of an argument that is no configuration field (a building block's rate limit or time step,
+    given by the configuration that builds it): the same :class:`Setting` a field gets, declared once beside the
+    code that takes it and checked by :meth:`Setting.check` (a named bound reads the ``owner`` passed there)."""
+    bounds = None if lo is None and hi is None else Bounds(lo, hi, lo_open, hi_open)
+    return Setting(group, meaning, unit, kind, bounds)
 
 
 def declared(cls: type, name: str) -> Setting:

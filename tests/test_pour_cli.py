@@ -17,11 +17,12 @@ from cosim.io.rerun_framing import VIEW_FILL
 from cosim.io.rerun_read import (
     blueprint_camera, entity_paths, read_component, read_scalar_series, recording_properties, series_names,
 )
-from cosim.pour_scene import PourScene, load_scene
+from cosim.pour_scene import LiquidSettings, PourScene, load_scene
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.csv_file import read_trajectory_csv
 from cosim.trajectory.json_file import read_trajectory_json
+from declared_settings.setting import declared
 from tests.support.view_projection import image_coordinates
 
 COARSE = """
@@ -227,7 +228,7 @@ def test_a_recording_without_rerun_sdk_is_one_line_exit_2_and_writes_nothing(tmp
 def test_scene_dump_round_trips(tmp_path, capsys):
     assert main(["scene", "--dump"]) == 0
     text = capsys.readouterr().out
-    assert "particles_across" in text and "# m, liquid depth" in text
+    assert "particles_across" in text and f"# {declared(LiquidSettings, 'fill_depth').meaning}" in text
     path = tmp_path / "scene.toml"
     path.write_text(text)
     assert main(["scene", "--check", str(path)]) == 0
@@ -245,8 +246,8 @@ def test_scene_check_refuses_a_numerical_setting_out_of_range(tmp_path, capsys):
 
 @pytest.mark.parametrize("toml", ["[coupling]\nstart_delay = 0.3\n", "[logging.recording]\nparticle_stride = 2\n"])
 def test_a_section_changes_only_its_own_keys_of_the_scene_default(tmp_path, toml):
-    # the scene's defaults for a section (coupling.max_duration 60 s, recording.particle_rate_hz 30 Hz) differ from
-    # the section classes' own defaults; a file that sets one key of the section must keep the scene's others
+    # a file that sets one key of a section keeps the scene's defaults for its others (coupling.max_duration 60 s,
+    # recording.particle_rate_hz 30 Hz: the section classes' own, declared once)
     path = tmp_path / "scene.toml"
     path.write_text(toml)
     scene, default = load_scene(path), PourScene()

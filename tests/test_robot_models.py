@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cosim.robots import assets
-from cosim.robots.generate import generated_files
+from cosim.tools.generate_models import generated_files
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.robots.vessel_mjcf import vessel_inertia, vessel_mjcf
@@ -55,7 +55,7 @@ def test_model_file_loads_and_steps_without_warnings(relative, tmp_path, monkeyp
 def test_committed_file_equals_generator_output(relative):
     generated = mujoco.MjModel.from_xml_string(generated_files()[relative])
     committed = mujoco.MjModel.from_xml_path(str(assets.models_dir() / relative))
-    hint = "run python -m cosim.robots.generate"
+    hint = "run python -m cosim.tools.generate_models"
     assert bytes(generated.names) == bytes(committed.names), f"{relative}: names differ; {hint}"
     assert bytes(generated.text_data) == bytes(committed.text_data), f"{relative}: custom text differs; {hint}"
     for name in COMPARED_FIELDS:

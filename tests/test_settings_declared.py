@@ -1,29 +1,45 @@
-"""The controller's, the coupling's, the scene's and the validation cases' settings are declared once
-(declared_settings.setting): each range is enforced from that declaration, one step outside each bound is refused with
+"""The controller's, the coupling's, the scene's, the robots', the trajectories' and the validation cases' settings
+and the building blocks' arguments are declared once (declared_settings.setting): each range is enforced from that declaration, one step outside each bound is refused with
 one line naming the field and the range, the bound itself is accepted, each class's reference lists every setting,
 and ``cosim scene --dump`` shows each scene setting with the allowed values from the same declaration."""
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import re
+import types
 
+import numpy as np
 import pytest
 
 from controllers.config import ApproachConfig, CatcherConfig, CfsConfig, PourConfig, ReturnConfig, SimConfig
 from controllers.geometry import VesselGeometry
 from controllers.model_plant import ModelPlantConfig
+from controllers.motion import (
+    BANDWIDTH, MAX_ACCEL, MAX_JERK, MAX_RATE, STAGES, STOP_ACCEL, TIME_STEP, CriticallyDampedSmoother, JerkLimitedMove,
+    RateLimitedTracker,
+)
 from cosim.cli.main import main
+from cosim.coupling import tracking_filter
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
+from cosim.coupling.tracking_filter import TrackingFilter
 from cosim.errors import InputError
+from cosim.io.recording import PARTICLE_RADIUS, PourRecorder
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmSettings, ArmsSettings
-from cosim.robots.scene_config import ArmModel
+from cosim.robots.collision import CLEARANCE, MAX_JOINT_STEP, MotionChecker
+from cosim.robots.ik import IKSettings
+from cosim.robots.scene import RobotScene
+from cosim.robots.scene_config import ArmModel, ArmPlacement, MountSpec, TableSpec, default_scene_config
 from cosim.pour_scene import (
-    CatcherSettings, ControllerSettings, LiquidSettings, PlacementSettings, TrajectorySettings, VesselSettings,
-    VesselsSettings,
+    CatcherSettings, ControllerSettings, LiquidSettings, PlacementSettings, PourScene, TrajectorySettings,
+    VesselSettings, VesselsSettings,
 )
+from cosim.sweep.spec import POURS, SEED, parse_sweep
+from cosim.trajectory.generator import GeneratorSettings
 from cosim.trajectory.limits import JointLimits
+from cosim.trajectory.pour_motion import PourMotionSpec
 from cosim.vessel import VesselSpec
 from cosim.validation import coupling_static, dam_break, free_fall, hydrostatic, moving_vessel, slosh, slosh_plant, weir
 from declared_settings.setting import REQUIRED, declared, declared_fields
@@ -81,6 +97,12 @@ CLASSES = [
     (JointLimits, _joint, "limits.arm/joint."),
     (ArmModel, _arm_model, "arms.pour."),
     (ArmSettings, _arm_settings, "arms.pour."),
+    (ArmPlacement, lambda **v: dataclasses.replace(default_scene_config().pour, **v), "pour_arm."),
+    (TableSpec, TableSpec, "table."),
+    (MountSpec, MountSpec, "mount."),
+    (IKSettings, IKSettings, "ik."),
+    (GeneratorSettings, GeneratorSettings, "trajectory."),
+    (PourMotionSpec, PourMotionSpec, "pour."),
     # the validation cases name their parameters as their command-line options, with no prefix
     (coupling_static.Params, coupling_static.Params, ""),
     (dam_break.Params, dam_break.Params, ""),
@@ -105,18 +127,21 @@ def _owner(build, cls):
 
 
 def _given(spec, value, owner):
-    """``value`` as the setting is given: itself, or for a per-joint setting at the first joint, the others inside."""
-    if spec.kind != "per_joint":
+    """``value`` as the setting is given: itself, or for a per-joint setting (or a vector bounded component by
+    component) at the first joint (component), the others inside."""
+    if spec.kind not in EACH:
         return value
-    return (value,) + (inside(spec, owner)[0],) * (owner.joint_count - 1)
+    count = owner.joint_count if spec.kind == "per_joint" else spec.length
+    return (value,) + (inside(spec, owner)[0],) * (count - 1)
 
 
 def _field(spec, name: str) -> str:
-    return f"{name}[0]" if spec.kind == "per_joint" else name
+    return f"{name}[0]" if spec.kind in EACH else name
 
 
+EACH = ("per_joint", "components")  # the kinds whose every number is bounded
 BOUNDED = [(cls, build, prefix, name, spec) for cls, build, prefix in CLASSES for name, spec in declared_fields(cls)
-           if spec.bounds is not None and spec.kind in ("float", "int", "per_joint")]
+           if spec.bounds is not None and spec.kind in ("float", "int") + EACH]
 IDS = [f"{prefix or cls.__module__.rsplit('.', 1)[-1] + '.'}{name}" for cls, _, prefix, name, _ in BOUNDED]
 
 
@@ -177,6 +202,18 @@ def test_the_scene_takes_the_controllers_declarations_and_defaults():
     assert LiquidSettings().fill_depth == _pour().fill_depth == coupling_static.Params().fill
 
 
+def test_the_scene_keeps_each_sections_own_defaults():
+    scene = PourScene()
+    assert scene.coupling == CouplingSettings() and scene.logging.recording == RecordingConfig()
+
+
+def test_the_scenes_arm_sections_take_the_placements_declarations():
+    for name in ("base_pos", "base_yaw", "home_seed", "grasp_pos"):
+        placement, section = declared(ArmPlacement, name), declared(ArmSettings, name)
+        assert dataclasses.replace(section, optional=False, none_means="") == dataclasses.replace(
+            placement, optional=False, none_means=""), name
+
+
 # the scene's tables of declared settings, as a scene file names them
 SCENE_TABLES = [("liquid", LiquidSettings, "liquid."), ("controller", ControllerSettings, "controller."),
                 ("controller.sim", SimConfig, "sim."), ("controller.approach", ApproachConfig, "approach."),
@@ -207,3 +244,57 @@ def test_scene_dump_shows_each_scene_setting_with_its_allowed_values(capsys):
         for name, spec in declared_fields(cls):
             lines = [line for line in body.splitlines() if line.startswith((f"{name} = ", f"# {name} = "))]
             assert len(lines) == 1 and lines[0].endswith(f"# {spec.meaning} Allowed: {spec.allowed()}."), (table, name)
+
+
+@functools.cache
+def _robot_scene() -> RobotScene:
+    return RobotScene.load()
+
+
+def _recorder(radius: float, folder) -> None:
+    with PourRecorder(folder / "r.rrd", _robot_scene().model, particle_radius=radius):
+        pass
+
+
+def _move(**values) -> JerkLimitedMove:
+    return JerkLimitedMove(**{"position": 0.0, "velocity": 0.0, "target": 1.0, "max_rate": 1.0, "max_accel": 2.0,
+                              "max_jerk": 10.0, **values})
+
+
+ONES = np.ones(2)
+# the declared arguments of the building blocks: declaration, how to build with the value (and a folder), the name
+# messages give it, the object a named bound reads
+ARGUMENTS = [
+    (MAX_RATE, lambda v, _: RateLimitedTracker(v, 1.0, 0.01), "tracker.max_rate", None),
+    (MAX_ACCEL, lambda v, _: RateLimitedTracker(1.0, v, 0.01), "tracker.max_accel", None),
+    (TIME_STEP, lambda v, _: RateLimitedTracker(1.0, 1.0, v), "tracker.dt", None),
+    (MAX_RATE, lambda v, _: _move(max_rate=v), "move.max_rate", None),
+    (MAX_ACCEL, lambda v, _: _move(max_accel=v), "move.max_accel", None),
+    (MAX_JERK, lambda v, _: _move(max_jerk=v), "move.max_jerk", None),
+    (STOP_ACCEL, lambda v, _: _move(stop_accel=v), "move.stop_accel", types.SimpleNamespace(max_accel=2.0)),
+    (BANDWIDTH, lambda v, _: CriticallyDampedSmoother(v, 0.01), "smoother.bandwidth", None),
+    (TIME_STEP, lambda v, _: CriticallyDampedSmoother(10.0, v), "smoother.dt", None),
+    (STAGES, lambda v, _: CriticallyDampedSmoother(10.0, 0.01, v), "smoother.stages", None),
+    (tracking_filter.BANDWIDTH, lambda v, _: TrackingFilter(ONES, ONES, ONES, v, 0.01), "tracking_filter.bandwidth", None),
+    (TIME_STEP, lambda v, _: TrackingFilter(ONES, ONES, ONES, 35.0, v), "tracking_filter.period", None),
+    (CLEARANCE, lambda v, _: MotionChecker(_robot_scene(), clearance=v), "collision.clearance", None),
+    (MAX_JOINT_STEP, lambda v, _: MotionChecker(_robot_scene(), max_joint_step=v), "collision.max_joint_step", None),
+    (PARTICLE_RADIUS, _recorder, "recording.particle_radius", None),
+    (SEED, lambda v, folder: parse_sweep({"seed": v, "axes": {"liquid.fill_depth": [0.1]}}, folder, "s"), "seed", None),
+    (POURS, lambda v, folder: parse_sweep({"axes": {"fluid.particles_across": {"start": 16, "stop": 32, "num": v}}},
+                                          folder, "s"), "axes.fluid.particles_across.num", None),
+]
+
+
+@pytest.mark.parametrize("spec, build, name, owner", ARGUMENTS, ids=[a[2] for a in ARGUMENTS])
+def test_each_declared_argument_is_refused_one_step_outside_its_bounds_by_what_takes_it(tmp_path, spec, build, name, owner):
+    unit = f" {spec.unit}" if spec.unit else ""
+    for value in outside(spec, owner):
+        with pytest.raises(InputError) as err:
+            build(value, tmp_path)
+        assert str(err.value).startswith(f"{name}: must be in {spec.bounds.of(owner).text()}{unit}, got "), err.value
+        assert "\n" not in str(err.value)
+    # the declaration accepts its bounds (a building block need not work at a rate limit of 5e-324: ruckig finds no
+    # profile there, so what builds it is not asked to)
+    for value in inside(spec, owner):
+        assert spec.check(name, value, owner) == value

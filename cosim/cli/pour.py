@@ -17,7 +17,8 @@ from pathlib import Path
 
 from typing import TYPE_CHECKING
 
-from cosim.checks import check_device, check_positive
+from cosim.checks import check_device
+from cosim.coupling.settings import CouplingSettings
 from cosim.fluid.config import FluidConfig
 from declared_settings.setting import declared
 
@@ -31,7 +32,7 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--out", type=Path, help="output folder (must not exist or be empty; default: a new folder under recordings/)")
     p.add_argument("--device", help="cpu or cuda[:N] (overrides the scene)")
     p.add_argument("--threads", type=int, help="CPU threads the liquid solver splits each substep over, 0: one per core (overrides fluid.cpu_threads)")
-    p.add_argument("--dim", type=int, choices=(2, 3), help="2-D or 3-D liquid (overrides the scene)")
+    p.add_argument("--dim", type=int, help="2: 2-D, 3: 3-D liquid (overrides fluid.dim)")
     p.add_argument("--duration", type=float, help="longest simulated time, s (overrides coupling.max_duration)")
     p.add_argument("--no-log", action="store_true", help="skip the Rerun recording")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -44,7 +45,8 @@ def scene_from_args(args) -> PourScene:
     scene is loaded: a bad value is refused without importing the scene's libraries."""
     device = check_device("--device", args.device) if args.device is not None else None
     threads = declared(FluidConfig, "cpu_threads").check("--threads", args.threads) if args.threads is not None else None
-    duration = check_positive("--duration", args.duration, "s", 600.0) if args.duration is not None else None
+    dim = declared(FluidConfig, "dim").check("--dim", args.dim) if args.dim is not None else None
+    duration = declared(CouplingSettings, "max_duration").check("--duration", args.duration) if args.duration is not None else None
     from cosim.pour_scene import PourScene, load_scene
 
     scene = load_scene(args.scene).named_after(args.scene) if args.scene is not None else PourScene()
@@ -52,8 +54,8 @@ def scene_from_args(args) -> PourScene:
         scene = replace(scene, device=device)
     if threads is not None:
         scene = replace(scene, fluid=replace(scene.fluid, cpu_threads=threads))
-    if args.dim is not None:
-        scene = replace(scene, fluid=replace(scene.fluid, dim=args.dim))
+    if dim is not None:
+        scene = replace(scene, fluid=replace(scene.fluid, dim=dim))
     if duration is not None:
         scene = replace(scene, coupling=replace(scene.coupling, max_duration=duration))
     if args.no_log:

@@ -20,14 +20,14 @@ import math
 
 from typing import TYPE_CHECKING
 
-from cosim.checks import check_positive
 from cosim.robots.payload import PayloadMode
 from cosim.trajectory.feedforward import DEFAULT_TOLERANCE_M, Feedforward
+from declared_settings.setting import argument
 
 if TYPE_CHECKING:
     from cosim.trajectory.replay import ReplayReport
 
-MAX_TOLERANCE_MM = 1000.0
+TOLERANCE_MM = argument("replay", "Largest lip path error that passes.", "mm", 0.0, 1000.0, lo_open=True)
 
 
 def register(subparsers: argparse._SubParsersAction, summary: str) -> None:
@@ -43,7 +43,7 @@ def register(subparsers: argparse._SubParsersAction, summary: str) -> None:
     parser.add_argument("--json", action="store_true", help="print the results as JSON (with verdict and tolerance_m)")
     parser.add_argument(
         "--tolerance-mm", type=float, default=DEFAULT_TOLERANCE_M * 1000.0,
-        help=f"largest lip path error that passes, mm, in (0, {MAX_TOLERANCE_MM:g}] (default {DEFAULT_TOLERANCE_M * 1000:g})",
+        help=f"largest lip path error that passes, in {TOLERANCE_MM.allowed()} (default {DEFAULT_TOLERANCE_M * 1000:g})",
     )
     parser.add_argument("--model", default=None, help="scene MJCF written by cosim.robots (default: the project's scene)")
     parser.add_argument(
@@ -81,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
     from cosim.trajectory.csv_file import read_trajectory_csv
     from cosim.trajectory.replay import replay
 
-    tolerance = check_positive("--tolerance-mm", args.tolerance_mm, "mm", MAX_TOLERANCE_MM) / 1000.0
+    tolerance = TOLERANCE_MM.check("--tolerance-mm", args.tolerance_mm) / 1000.0
     scene = RobotScene.load(args.model, PayloadMode(args.payload))
     joints = [name for arm in scene.arms.values() for name in arm.joints]
     trajectory = read_trajectory_csv(args.trajectory, known_joints=joints)

@@ -16,14 +16,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from cosim.atomic_files import check_output_folder
-from cosim.checks import check_int
 from cosim.errors import InputError
+from declared_settings.setting import argument
 
 if TYPE_CHECKING:
     from cosim.sweep.plan import SweepPlan
 
 DEFAULT_ROOT = Path("recordings")
-MAX_PARALLEL = 100_000
+MAX_PARALLEL = argument("sweep", "Most pours running at once.", "", 1, 100_000, kind="int")
 
 
 def register(subparsers, summary: str) -> None:
@@ -71,7 +71,7 @@ def run(args) -> int:
     from cosim.sweep.spec import load_sweep
 
     if args.max_parallel is not None:
-        check_int("--max-parallel", args.max_parallel, 1, MAX_PARALLEL)
+        MAX_PARALLEL.check("--max-parallel", args.max_parallel)
     spec = load_sweep(args.sweep)
     out = args.out if args.out is not None else DEFAULT_ROOT / f"sweep-{spec.name}"
     check_output_folder(out, "--out")

@@ -25,6 +25,7 @@ from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.validation import CASES, DEFAULT_CASES
+from declared_settings.setting import declared
 
 if TYPE_CHECKING:
     from cosim.validation.common import CaseResult
@@ -47,7 +48,7 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--shape", choices=("box", "cylinder"), help="slosh-plant's vessel: box or cylinder (3-D only) (default box)")
     p.add_argument("--scene", help="a scene file whose pourer (a box, cylinder or mesh) is the vessel (hydrostatic, tilt, shake)")
     p.add_argument("--spacing", type=float, help="particle spacing dx, m (default: each case's resolution)")
-    p.add_argument("--dim", type=int, choices=(2, 3), default=FluidConfig.dim, help=f"2-D (pour plane) or 3-D (default {FluidConfig.dim})")
+    p.add_argument("--dim", type=int, default=FluidConfig.dim, help=f"2: 2-D (pour plane), 3: 3-D (default {FluidConfig.dim})")
     p.add_argument("--device", default="cpu", help="cpu or cuda[:N] (default cpu)")
     p.add_argument("--solver", choices=[s.value for s in PressureSolver],
                    help="pressure solver: wcsph (weakly compressible) or dfsph (divergence-free) (default: the default scene's "
@@ -72,7 +73,7 @@ def _case_params(name: str, args) -> list:
     numerics = (("density_iteration", args.density_iteration or scene.density_iteration.value),)
     if args.density_tolerance is not None:
         numerics += (("density_tolerance", args.density_tolerance),)
-    common = {"dim": args.dim, "device": args.device, "spacing": args.spacing, "solver": solver, "numerics": numerics}
+    common = {"dim": declared(FluidConfig, "dim").check("--dim", args.dim), "device": args.device, "spacing": args.spacing, "solver": solver, "numerics": numerics}
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
     if name in ("tilt", "shake", "free-fall", "coupling-static"):

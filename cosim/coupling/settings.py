@@ -48,7 +48,7 @@ class CouplingSettings:
                                  "liquid lands).", "s", 0.0, 10.0)
     stop_when_done: bool = setting(True, COUPLING, "End the run settle_time after the pour is done (false: always run "
                                    "to max_duration).")
-    max_duration: float = setting(120.0, COUPLING, "The run stops here even if the pour is not done.", "s", 0.0, 600.0,
+    max_duration: float = setting(60.0, COUPLING, "The run stops here even if the pour is not done.", "s", 0.0, 600.0,
                                   lo_open=True)
 
     def __post_init__(self) -> None:

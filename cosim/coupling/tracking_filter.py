@@ -35,19 +35,25 @@ import math
 
 import numpy as np
 
-from cosim.checks import check_positive, check_range
+from controllers.motion import TIME_STEP
+from declared_settings.setting import argument
+
+# The closed loop's triple pole w (the filter's period is a time step, controllers.motion.TIME_STEP).
+BANDWIDTH = argument("tracking filter", "Triple pole of the sampled closed loop, z = exp(-w h).", "rad/s", 0.0, None,
+                     lo_open=True)
 
 
 class TrackingFilter:
     """Linear tracking of a target vector within limits (see the module docstring), one coordinate per entry.
 
-    velocity, acceleration, jerk: the limits per coordinate (units/s, /s^2, /s^3), each > 0; bandwidth: w (rad/s),
-    the closed loop's triple pole; period: h (s), the time between calls. The path's state is the caller's."""
+    velocity, acceleration, jerk: the limits per coordinate (units/s, /s^2, /s^3), each > 0; bandwidth: w
+    (:data:`BANDWIDTH`); period: h, the time between calls (:data:`controllers.motion.TIME_STEP`). The path's state is
+    the caller's."""
 
     def __init__(self, velocity: np.ndarray, acceleration: np.ndarray, jerk: np.ndarray, bandwidth: float, period: float):
         import control  # here, so that reading a scene and refusing bad input stay fast
-        check_positive("tracking_filter.bandwidth", bandwidth, "rad/s", None)
-        check_range("tracking_filter.period", period, 0.0, 1.0, "s", lo_open=True)
+        BANDWIDTH.check("tracking_filter.bandwidth", bandwidth)
+        TIME_STEP.check("tracking_filter.period", period)
         self.velocity_limit, self.acceleration_limit, self.jerk_limit = (np.asarray(x, dtype=float) for x in (velocity, acceleration, jerk))
         self.period = float(period)
         h = self.period

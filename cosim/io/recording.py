@@ -38,16 +38,19 @@ import numpy as np
 import rerun as rr
 from matplotlib import colormaps
 
-from cosim.checks import check_positive
 from cosim.errors import InputError
 from cosim.io import rerun_paths
 from cosim.io.rerun_blueprint import Camera, build_blueprint, colour_scale_text
-from cosim.io.recording_config import RecordingConfig
+from cosim.io.recording_config import RECORDING, RecordingConfig
 from cosim.io.rerun_geometry import body_paths, geom_visuals, log_static_geometry, xyzw_from_wxyz
+from declared_settings.setting import argument
 
 # Bytes of buffered data per entity before it is sent as one chunk (bounds memory; a 2-D pour's particles fill
 # one chunk in about a minute of simulated time at 30 Hz, its scalars never do).
 FLUSH_BYTES = 32 * 2**20
+# The drawn particles' size, given by the run that records.
+PARTICLE_RADIUS = argument(RECORDING, "Drawn radius of a liquid particle (e.g. half the particle spacing).", "m",
+                           0.0, 0.1, lo_open=True)
 # Matplotlib colormap of the particle speed, from 0 (bottom) to RecordingConfig.speed_color_max (top).
 SPEED_COLORMAP = "viridis"
 # Matplotlib colormap the series of one plot take their colours from (up to 10 distinct ones).
@@ -118,7 +121,7 @@ class PourRecorder:
     path: where the finished recording goes (its folder must exist; an existing file there is replaced at close).
     model: the MuJoCo model whose visible geoms are drawn (groups 0-2, see :mod:`cosim.io.rerun_geometry`).
     config: :class:`RecordingConfig`.
-    particle_radius: m, drawn radius of a liquid particle (e.g. half the particle spacing). (0, 0.1]
+    particle_radius: :data:`PARTICLE_RADIUS`.
     application_id: Rerun application id (the viewer groups recordings by it).
     name: the recording's name in the viewer (e.g. the run's name); None leaves it unnamed.
     properties: shown with the recording (``rr.send_property``): name -> text or number (e.g. the scene's TOML).
@@ -147,7 +150,7 @@ class PourRecorder:
         if not self.path.parent.is_dir():
             raise InputError(f"recording path {self.path}: folder {self.path.parent} does not exist")
         self.config = config
-        self.particle_radius = check_positive("recording.particle_radius", particle_radius, "m", 0.1)
+        self.particle_radius = PARTICLE_RADIUS.check("recording.particle_radius", particle_radius)
         self.camera = camera
         self.liquid_note = liquid_note
         self._tmp = self.path.with_name(f".{self.path.name}.{uuid.uuid4().hex}.part")

@@ -17,14 +17,18 @@ from enum import Enum
 import mujoco
 import numpy as np
 
-from cosim.checks import check_positive, check_range
 from cosim.errors import InputError
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from declared_settings.setting import argument
 
 # Default largest joint change between two checked configurations, rad (1 deg: with links up to ~1.3 m from the
 # base, points move at most ~23 mm between checks, below the smallest collision geom radius of 43 mm).
 DEFAULT_MAX_JOINT_STEP = np.radians(1.0)
+COLLISION = "collision check"
+CLEARANCE = argument(COLLISION, "Added to every geom's margin: parts closer than this count as touching.", "m", 0.0, 0.2)
+MAX_JOINT_STEP = argument(COLLISION, "Largest joint change between two checked configurations.", "rad", 0.0, 0.5,
+                          lo_open=True)
 
 
 class PartKind(Enum):
@@ -68,12 +72,13 @@ class Collision:
 
 
 class MotionChecker:
-    """Collision checks on a private model/data copy of ``scene`` (``clearance`` m added to every geom margin)."""
+    """Collision checks on a private model/data copy of ``scene`` (``clearance``: :data:`CLEARANCE`,
+    ``max_joint_step``: :data:`MAX_JOINT_STEP`)."""
 
     def __init__(self, scene: RobotScene, clearance: float = 0.0, max_joint_step: float = DEFAULT_MAX_JOINT_STEP):
         self.scene = scene
-        self.clearance = check_range("collision.clearance", clearance, 0.0, 0.2, "m")
-        self.max_joint_step = check_positive("collision.max_joint_step", max_joint_step, "rad", 0.5)
+        self.clearance = CLEARANCE.check("collision.clearance", clearance)
+        self.max_joint_step = MAX_JOINT_STEP.check("collision.max_joint_step", max_joint_step)
         self.model = self._model_with_margin(scene, self.clearance)
         self.data = mujoco.MjData(self.model)
         self._kinds = self._classify_bodies()

@@ -24,51 +24,41 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from cosim.checks import check_int, check_positive, check_range
 from cosim.errors import InputError
 from cosim.frames import vector_norm
+from declared_settings.setting import check_settings, documented, setting
 
 # Regularisation of J J^T in the nullspace projector (full-rank rows assumed; only guards exact singularity).
 _NULLSPACE_REG = 1e-12
 
 
+IK = "inverse kinematics"
+
+
+@documented
 @dataclass(frozen=True)
 class IKSettings:
-    """Solver settings.
+    """Solver settings."""
 
-    position_tolerance: m, converged when the site position error is below this. (0, 0.01]
-    rotation_tolerance: rad, and the rotation error below this. (0, 0.1]
-    max_iterations: iterations before giving up. [1, 10000]
-    damping: lambda of the damped least squares, in units of the (weighted) error, m. (0, 1]
-    max_step: rad, largest joint change per iteration. (0, 3.15]
-    rotation_length: m, weight L of the rotation error against the position error. (0, 10]
-    posture_gain: fraction of the home-posture error pulled in per iteration in the task nullspace (redundant arms,
-        n > 6). [0, 1]
-    posture_tolerance: rad, a redundant arm's solve ends when the nullspace pull toward home is below this (or at
-        max_iterations with the task reached). (0, 1]
-    stall_iterations: stop early when the error has not dropped by 1% in this many iterations. [1, 10000]
-    """
-
-    position_tolerance: float = 1e-6
-    rotation_tolerance: float = 1e-6
-    max_iterations: int = 100
-    damping: float = 1e-4
-    max_step: float = 0.4
-    rotation_length: float = 0.2
-    posture_gain: float = 0.5
-    posture_tolerance: float = 1e-3
-    stall_iterations: int = 8
+    position_tolerance: float = setting(1e-6, IK, "Converged when the site position error is below this.", "m", 0.0,
+                                        0.01, lo_open=True)
+    rotation_tolerance: float = setting(1e-6, IK, "And the rotation error below this.", "rad", 0.0, 0.1, lo_open=True)
+    max_iterations: int = setting(100, IK, "Iterations before giving up.", "", 1, 10000)
+    damping: float = setting(1e-4, IK, "lambda of the damped least squares, in units of the (weighted) error.", "m",
+                             0.0, 1.0, lo_open=True)
+    max_step: float = setting(0.4, IK, "Largest joint change per iteration.", "rad", 0.0, 3.15, lo_open=True)
+    rotation_length: float = setting(0.2, IK, "Weight L of the rotation error against the position error.", "m", 0.0,
+                                     10.0, lo_open=True)
+    posture_gain: float = setting(0.5, IK, "Fraction of the home-posture error pulled in per iteration in the task "
+                                  "nullspace (redundant arms, n > 6).", "", 0.0, 1.0)
+    posture_tolerance: float = setting(1e-3, IK, "A redundant arm's solve ends when the nullspace pull toward home is "
+                                       "below this (or at max_iterations with the task reached).", "rad", 0.0, 1.0,
+                                       lo_open=True)
+    stall_iterations: int = setting(8, IK, "Stop early when the error has not dropped by 1% in this many iterations.",
+                                    "", 1, 10000)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "position_tolerance", check_positive("ik.position_tolerance", self.position_tolerance, "m", 0.01))
-        object.__setattr__(self, "rotation_tolerance", check_positive("ik.rotation_tolerance", self.rotation_tolerance, "rad", 0.1))
-        check_int("ik.max_iterations", self.max_iterations, 1, 10000)
-        object.__setattr__(self, "damping", check_positive("ik.damping", self.damping, "m", 1.0))
-        object.__setattr__(self, "max_step", check_positive("ik.max_step", self.max_step, "rad", 3.15))
-        object.__setattr__(self, "rotation_length", check_positive("ik.rotation_length", self.rotation_length, "m", 10.0))
-        object.__setattr__(self, "posture_gain", check_range("ik.posture_gain", self.posture_gain, 0.0, 1.0))
-        object.__setattr__(self, "posture_tolerance", check_positive("ik.posture_tolerance", self.posture_tolerance, "rad", 1.0))
-        check_int("ik.stall_iterations", self.stall_iterations, 1, 10000)
+        check_settings(self, "ik")
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass, field
 from enum import Enum
 
-from cosim.checks import check_choice, check_number, check_positive, check_vector
+from cosim.checks import check_choice, check_vector
 from cosim.errors import InputError
 from cosim.robots.ur10e import UR10E_DRIVER_JOINTS, UR10E_JOINTS, UR10E_MAX_JOINT_SPEED
 from cosim.vessel import VesselSpec, default_catching_vessel, seed_pouring_vessel
@@ -135,22 +135,16 @@ def ur10e_arm() -> ArmModel:
     return ArmModel("ur10e/ur10e.xml", UR10E_JOINTS, "flange", UR10E_MAX_JOINT_SPEED, UR10E_DRIVER_JOINTS)
 
 
+@documented
 @dataclass(frozen=True)
 class ArmPlacement:
     """One arm in the scene and the vessel it holds.
 
     role: :class:`ArmRole`.
     arm: :class:`ArmModel`.
-    base_pos: (3,) m, world position of the arm's base frame.
-    base_yaw: rad, rotation of the base frame about world z. [-2 pi, 2 pi]
     vessel: the held vessel's :class:`VesselSpec`.
-    vessel_home: (3,) m, world position of the vessel frame origin at home (y must be 0: the pour plane).
     mount_side: :class:`MountSide`, the wall the flange holds.
-    home_seed: (n,) rad, the joint configuration the home posture is solved from (picks the IK branch).
     base_quat: (4,) [w, x, y, z], the base frame's orientation in the world, instead of ``base_yaw``; None: the yaw.
-    grasp_pos: (3,) m, the vessel frame's origin in the flange site's frame; None: the held wall's outer face (a mesh
-        vessel's outermost point on that side) on the mount plate, the flange at half the wall height
-        (:func:`cosim.robots.scene_builder.vessel_in_site`).
     grasp_quat: (4,) [w, x, y, z], the vessel frame's orientation in the flange site's frame; None: the mount side's
         (the flange's z axis into the held wall, the vessel's z along the site's x).
     home_field: the setting a home posture out of reach is blamed on in the message (a scene file's
@@ -159,73 +153,82 @@ class ArmPlacement:
 
     role: ArmRole
     arm: ArmModel
-    base_pos: tuple[float, float, float]
-    base_yaw: float
+    base_pos: tuple[float, float, float] = setting(REQUIRED, ARM, "The arm base's world position [x, y, z].", "m",
+                                                   kind="vector")
+    base_yaw: float = setting(REQUIRED, ARM, "The base's rotation about world z.", "rad", -2.0 * math.pi, 2.0 * math.pi)
     vessel: VesselSpec
-    vessel_home: tuple[float, float, float]
+    vessel_home: tuple[float, float, float] = setting(
+        REQUIRED, ARM, "World position [x, y, z] of the held vessel's frame origin at home (y = 0: the pour plane).",
+        "m", kind="vector")
     mount_side: MountSide
-    home_seed: tuple[float, ...]
+    home_seed: tuple[float, ...] = setting(
+        REQUIRED, ARM, "The configuration the home posture is solved from (picks the inverse kinematics' branch: elbow "
+        "up or down).", "rad", -100.0, 100.0, kind="per_joint")
     base_quat: tuple[float, float, float, float] | None = None
-    grasp_pos: tuple[float, float, float] | None = None
+    grasp_pos: tuple[float, float, float] | None = setting(
+        None, ARM, "Where the vessel sits on the flange: its frame's origin (the centre of its inner floor) in the "
+        "flange site's frame [x, y, z].", "m", kind="vector", none_means="the held wall's outer face (a mesh vessel's "
+        "outermost point on that side) on the mount plate, the flange at half the wall height "
+        "(cosim.robots.scene_builder.vessel_in_site)")
     grasp_quat: tuple[float, float, float, float] | None = None
     home_field: str = "placement"
 
     def __post_init__(self) -> None:
         p = self.arm.label if isinstance(self.arm, ArmModel) and self.arm.label else f"{getattr(self.role, 'value', self.role)}"
-        object.__setattr__(self, "role", check_choice(f"{p}.role", self.role, ArmRole))
-        object.__setattr__(self, "mount_side", check_choice(f"{p}.mount_side", self.mount_side, MountSide))
-        object.__setattr__(self, "base_pos", check_vector(f"{p}.base_pos", self.base_pos, 3))
-        yaw = check_number(f"{p}.base_yaw", self.base_yaw)
-        if abs(yaw) > 2 * math.pi:
-            raise InputError(f"{p}.base_yaw: must be in [-6.28319, 6.28319] rad, got {yaw:g}")
-        object.__setattr__(self, "base_yaw", yaw)
-        home = check_vector(f"{p}.vessel_home", self.vessel_home, 3)
-        if abs(home[1]) > 1e-9:
-            raise InputError(f"{p}.vessel_home[1]: the vessel must start in the pour plane y = 0, got {home[1]:g} m")
-        object.__setattr__(self, "vessel_home", home)
-        object.__setattr__(self, "home_seed", check_vector(f"{p}.home_seed", self.home_seed, len(self.arm.joints)))
+        if not isinstance(self.arm, ArmModel):
+            raise InputError(f"{p}.arm: must be an ArmModel, got {type(self.arm).__name__}")
         if not isinstance(self.vessel, VesselSpec):
             raise InputError(f"{p}.vessel: must be a VesselSpec, got {type(self.vessel).__name__}")
+        object.__setattr__(self, "role", check_choice(f"{p}.role", self.role, ArmRole))
+        object.__setattr__(self, "mount_side", check_choice(f"{p}.mount_side", self.mount_side, MountSide))
+        check_settings(self, p)
+        if abs(self.vessel_home[1]) > 1e-9:
+            raise InputError(f"{p}.vessel_home[1]: the vessel must start in the pour plane y = 0, got {self.vessel_home[1]:g} m")
         if self.base_quat is not None:
             object.__setattr__(self, "base_quat", check_quat(f"{p}.base_quat", self.base_quat))
-        if self.grasp_pos is not None:
-            object.__setattr__(self, "grasp_pos", check_vector(f"{p}.grasp_pos", self.grasp_pos, 3))
         if self.grasp_quat is not None:
             object.__setattr__(self, "grasp_quat", check_quat(f"{p}.grasp_quat", self.grasp_quat))
 
+    @property
+    def joint_count(self) -> int:
+        """The held arm's number of joints (the home seed gives one angle per joint)."""
+        return self.arm.joint_count
 
+
+TABLE = "table"
+
+
+@documented
 @dataclass(frozen=True)
 class TableSpec:
-    """The table the arms stand on: a box. top: m, height of the top surface; centre_xy, half_size (3,) m."""
+    """The table the arms stand on: a box."""
 
-    top: float = 0.75
-    centre_xy: tuple[float, float] = (0.15, 0.0)
-    half_size: tuple[float, float, float] = (1.2, 0.6, 0.375)
+    top: float = setting(0.75, TABLE, "Height of the table's top surface.", "m", 0.0, 3.0, lo_open=True)
+    centre_xy: tuple[float, float] = setting((0.15, 0.0), TABLE, "The table's centre in the horizontal plane [x, y].",
+                                             "m")
+    half_size: tuple[float, float, float] = setting((1.2, 0.6, 0.375), TABLE, "The box's half sizes [x, y, z].", "m",
+                                                    0.0, 10.0, lo_open=True, kind="components")
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "top", check_positive("table.top", self.top, "m", 3.0))
-        object.__setattr__(self, "centre_xy", check_vector("table.centre_xy", self.centre_xy, 2))
-        half = check_vector("table.half_size", self.half_size, 3)
-        for i, v in enumerate(half):
-            check_positive(f"table.half_size[{i}]", v, "m", 10.0)
-        object.__setattr__(self, "half_size", half)
+        check_settings(self, "table")
 
 
+MOUNT = "mount"
+
+
+@documented
 @dataclass(frozen=True)
 class MountSpec:
-    """The adapter plate between the tool flange and the vessel wall (aluminium, square).
+    """The adapter plate between the tool flange and the vessel wall (aluminium, square)."""
 
-    thickness: m, along the flange axis. (0, 0.05]; half_width: m. (0, 0.2]; density: kg/m^3. (0, 25000]
-    """
-
-    thickness: float = 0.01
-    half_width: float = 0.04
-    density: float = 2700.0
+    thickness: float = setting(0.01, MOUNT, "The plate's thickness along the flange axis.", "m", 0.0, 0.05,
+                               lo_open=True)
+    half_width: float = setting(0.04, MOUNT, "Half the plate's side.", "m", 0.0, 0.2, lo_open=True)
+    density: float = setting(2700.0, MOUNT, "The plate's density (aluminium's).", "kg/m^3", 0.0, 25000.0,
+                             lo_open=True)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "thickness", check_positive("mount.thickness", self.thickness, "m", 0.05))
-        object.__setattr__(self, "half_width", check_positive("mount.half_width", self.half_width, "m", 0.2))
-        object.__setattr__(self, "density", check_positive("mount.density", self.density, "kg/m^3", 25000.0))
+        check_settings(self, "mount")
 
 
 @dataclass(frozen=True)

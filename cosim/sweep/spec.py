@@ -27,14 +27,19 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from cosim.checks import check_int
 from cosim.config_mapping import read_toml_file
 from cosim.errors import InputError
+from declared_settings.setting import argument
 
 MODES = ("grid", "sample")
 MAX_POURS = 100_000  # more pours than any cluster runs in one sweep: a typo (a range's num) is refused early
 TOP_LEVEL_KEYS = ("scene", "mode", "samples", "seed", "axes")
 RANGE_DIGITS = 12  # significant digits of a range's float values: clears linspace's last-bit noise
+SWEEP = "sweep"
+SEED = argument(SWEEP, "Seeds every random draw (a uniform axis's values, the sample points).", "", 0, 2**63 - 1,
+                kind="int")
+# a count of pours or of an axis's values: mode 'sample''s samples, a range's num, a uniform axis's samples
+POURS = argument(SWEEP, "How many pours (or an axis's values).", "", 1, MAX_POURS, kind="int")
 
 
 @dataclass(frozen=True)
@@ -62,7 +67,7 @@ class SweepSpec:
     axes: the swept keys, in the file's order.
     mode: 'grid' or 'sample'.
     samples: pours drawn in mode 'sample' (0 in mode 'grid').
-    seed: seed of every random draw. [0, 2^63)
+    seed: :data:`SEED`.
     """
 
     name: str
@@ -112,7 +117,7 @@ def _range_values(field: str, table: dict) -> tuple:
     and every step is a whole number (a range of particle counts stays a range of integers), else floats rounded to
     :data:`RANGE_DIGITS` significant digits (0.11, not 0.11000000000000001, as a user would write it)."""
     start, stop = _number(f"{field}.start", table["start"]), _number(f"{field}.stop", table["stop"])
-    num = check_int(f"{field}.num", table["num"], 1, MAX_POURS)
+    num = POURS.check(f"{field}.num", table["num"])
     if num == 1:
         return (start,)
     if isinstance(start, int) and isinstance(stop, int) and (stop - start) % (num - 1) == 0:
@@ -153,8 +158,8 @@ def parse_axis(key: str, value: Any, mode: str, seed: int, index: int) -> Axis:
                 raise InputError(f"{field}.samples: only in mode 'grid' (in mode 'sample' each pour draws its own value)")
             return Axis(key, None, interval)
         if "samples" not in value:
-            raise InputError(f"{field}.samples: a uniform axis in mode 'grid' needs its number of values, in [1, {MAX_POURS}]")
-        count = check_int(f"{field}.samples", value["samples"], 1, MAX_POURS)
+            raise InputError(f"{field}.samples: a uniform axis in mode 'grid' needs its number of values, in {POURS.allowed()}")
+        count = POURS.check(f"{field}.samples", value["samples"])
         import numpy as np
 
         draws = np.random.default_rng([seed, index]).uniform(*interval, size=count)
@@ -185,12 +190,12 @@ def parse_sweep(table: dict, folder: Path, name: str) -> SweepSpec:
     mode = table.get("mode", "grid")
     if mode not in MODES:
         raise InputError(f"mode: must be one of {', '.join(map(repr, MODES))}, got {mode!r}")
-    seed = check_int("seed", table.get("seed", 0), 0, 2**63 - 1)
+    seed = SEED.check("seed", table.get("seed", 0))
     if mode == "grid" and "samples" in table:
         raise InputError("samples: only in mode 'sample' (mode 'grid' runs every combination of the axes)")
     if mode == "sample" and "samples" not in table:
-        raise InputError(f"samples: mode 'sample' needs the number of pours, in [1, {MAX_POURS}]")
-    samples = check_int("samples", table["samples"], 1, MAX_POURS) if mode == "sample" else 0
+        raise InputError(f"samples: mode 'sample' needs the number of pours, in {POURS.allowed()}")
+    samples = POURS.check("samples", table["samples"]) if mode == "sample" else 0
     axes_table = table.get("axes")
     if not isinstance(axes_table, dict) or not axes_table:
         raise InputError("axes: needs at least one axis, e.g. [axes] \"liquid.fill_depth\" = [0.08, 0.12]")

@@ -21,14 +21,16 @@ from cosim.trajectory.pour_motion import Pivot, PourMotionSpec, plan_pour_trajec
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description="Write a smooth two-arm pour motion as a trajectory CSV.")
     parser.add_argument("--out", required=True, help="CSV file to write")
-    parser.add_argument("--duration", type=float, default=10.0, help="s (default 10)")
-    parser.add_argument("--tilt-deg", type=float, default=120.0, help="peak tilt, deg (default 120)")
-    parser.add_argument("--pivot", choices=[p.value for p in Pivot], default=Pivot.LIP.value)
-    parser.add_argument("--catcher-dx", type=float, default=0.15, help="catcher travel at peak, m (default 0.15)")
+    parser.add_argument("--duration", type=float, help=f"s (default {PourMotionSpec.duration:g})")
+    parser.add_argument("--tilt-deg", type=float, help=f"peak tilt, deg (default {math.degrees(PourMotionSpec.max_tilt):g})")
+    parser.add_argument("--pivot", choices=[p.value for p in Pivot], help=f"(default {PourMotionSpec.pivot.value})")
+    parser.add_argument("--catcher-dx", type=float, help=f"catcher travel at peak, m (default {PourMotionSpec.catcher_dx:g})")
     parser.add_argument("--model", default=None, help="scene MJCF (default: the project's scene)")
     args = parser.parse_args(argv)
+    given = {"duration": args.duration, "max_tilt": None if args.tilt_deg is None else math.radians(args.tilt_deg),
+             "pivot": args.pivot, "catcher_dx": args.catcher_dx}
     try:
-        spec = PourMotionSpec(args.duration, math.radians(args.tilt_deg), Pivot(args.pivot), args.catcher_dx)
+        spec = PourMotionSpec(**{k: v for k, v in given.items() if v is not None})
         trajectory = plan_pour_trajectory(RobotScene.load(args.model), spec)
         write_trajectory_csv(args.out, trajectory)
     except InputError as exc:

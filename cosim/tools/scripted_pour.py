@@ -1,7 +1,6 @@
 """The checked trajectory files of a scripted pour, written without a simulation.
 
-    python -m cosim.tools.scripted_pour --out DIR [--duration 10] [--tilt-deg 100] [--catcher-dx 0.15]
-                                        [--sample-rate 500]
+    python -m cosim.tools.scripted_pour --out DIR [--duration S] [--tilt-deg DEG] [--catcher-dx M] [--sample-rate HZ]
 
 writes ``DIR/trajectory.csv``, ``.json`` and ``.mcap`` of a smooth pour (:mod:`cosim.trajectory.pour_motion`: tilt
 about the lip and back, the catcher moving along x) generated as the coupling does
@@ -32,10 +31,11 @@ from cosim.trajectory.scripted import generate_scripted, pour_path, pour_poses
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description="Write the checked trajectory CSV, JSON and MCAP of a scripted pour.")
     parser.add_argument("--out", required=True, help="folder for trajectory.csv, trajectory.json and trajectory.mcap")
-    parser.add_argument("--duration", type=float, default=10.0, help="s (default 10)")
+    parser.add_argument("--duration", type=float, default=PourMotionSpec.duration, help=f"s (default {PourMotionSpec.duration:g})")
     parser.add_argument("--tilt-deg", type=float, default=100.0, help="peak tilt about the lip, deg (default 100)")
-    parser.add_argument("--catcher-dx", type=float, default=0.15, help="catcher travel at peak, m (default 0.15)")
-    parser.add_argument("--sample-rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help="Hz (default 500)")
+    parser.add_argument("--catcher-dx", type=float, default=PourMotionSpec.catcher_dx,
+                        help=f"catcher travel at peak, m (default {PourMotionSpec.catcher_dx:g})")
+    parser.add_argument("--sample-rate", type=float, default=DEFAULT_SAMPLE_RATE_HZ, help=f"Hz (default {DEFAULT_SAMPLE_RATE_HZ:g})")
     args = parser.parse_args(argv)
     try:
         scene = RobotScene.load()

@@ -82,9 +82,9 @@ from dataclasses import dataclass
 import numpy as np
 import ruckig
 
-from cosim.checks import check_positive
 from cosim.errors import InputError, SimulationError
 from cosim.trajectory.limits import ArmLimits
+from declared_settings.setting import check_settings, documented, setting
 
 # Times closer than this (s) count as equal when matching sample times to generator steps: far below any cycle time,
 # far above the round-off of summing cycle times over an hour.
@@ -103,26 +103,24 @@ SPLINE_TOLERANCE = 1e-9
 STREAM_DELAY_PERIODS = 2
 
 
+GENERATOR = "trajectory generator"
+
+
+@documented
 @dataclass(frozen=True)
 class GeneratorSettings:
-    """cycle_time: s, the generator's step (the MuJoCo time step). (0, 0.1]
-    control_period: s, expected interval between targets; used as the first target's minimum duration. [cycle_time, 1]
-    stop_beyond_velocity_limit: raise :class:`UntrackablePathError` when a target path moves a joint faster than its
-        ``max_velocity`` (an arm that must stay on its path); False: clip the path's velocity and catch up (a filter).
-    """
+    """The generator's timing and what it does with a path it cannot follow."""
 
-    cycle_time: float = 0.002
-    control_period: float = 0.01
-    stop_beyond_velocity_limit: bool = False
+    cycle_time: float = setting(0.002, GENERATOR, "The generator's step (the MuJoCo time step).", "s", 0.0, 0.1,
+                                lo_open=True)
+    control_period: float = setting(0.01, GENERATOR, "Expected interval between targets; used as the first target's "
+                                    "minimum duration.", "s", "cycle_time", 1.0)
+    stop_beyond_velocity_limit: bool = setting(
+        False, GENERATOR, "Raise UntrackablePathError when a target path moves a joint faster than its max_velocity (an "
+        "arm that must stay on its path); false: clip the path's velocity and catch up (a filter).")
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "cycle_time", check_positive("trajectory.cycle_time", self.cycle_time, "s", 0.1))
-        period = check_positive("trajectory.control_period", self.control_period, "s", 1.0)
-        if period < self.cycle_time:
-            raise InputError(
-                f"trajectory.control_period: must be in [{self.cycle_time:g}, 1] s (at least the cycle time), got {period:g}"
-            )
-        object.__setattr__(self, "control_period", period)
+        check_settings(self, "trajectory")
 
 
 class UntrackablePathError(SimulationError):

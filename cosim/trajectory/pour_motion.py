@@ -24,13 +24,13 @@ from enum import Enum
 
 import numpy as np
 
-from cosim.checks import check_choice, check_positive, check_range
 from cosim.errors import InputError
 from cosim.robots.ik import IKSettings
 from cosim.robots.planar import PlanarPose, tilt_about_pivot
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 from cosim.trajectory.joint_trajectory import JointTrajectory
+from declared_settings.setting import check_settings, documented, setting
 
 # Joint acceleration and jerk limits for generated motions, rad/s^2 and rad/s^3. UR publishes no per-joint
 # acceleration limit for the UR10e; PolyScope's default joint acceleration is 80 deg/s^2 (1.4 rad/s^2) and its
@@ -48,23 +48,25 @@ class Pivot(Enum):
     LIP = "lip"  # the pour lip (their pivot in the constant-flow stage)
 
 
+SCRIPTED_POUR = "scripted pour"
+
+
+@documented
 @dataclass(frozen=True)
 class PourMotionSpec:
-    """duration: s (1, 120]. max_tilt: rad [0, 2.1]. pivot: :class:`Pivot`. catcher_dx: m [-0.3, 0.3].
-    period: s, sample period of the trajectory (0.001, 0.1]."""
+    """A scripted pour: the pourer tilts up and back about a pivot while the catcher moves under the stream."""
 
-    duration: float = 10.0
-    max_tilt: float = math.radians(120.0)
-    pivot: Pivot = Pivot.LIP
-    catcher_dx: float = 0.15
-    period: float = 0.01
+    duration: float = setting(10.0, SCRIPTED_POUR, "Length of the whole motion, tilt up and back.", "s", 1.0, 120.0)
+    max_tilt: float = setting(math.radians(120.0), SCRIPTED_POUR, "The pourer's largest tilt, at half the duration.",
+                              "rad", 0.0, 2.1)
+    pivot: Pivot = setting(Pivot.LIP, SCRIPTED_POUR, "The tilt's pivot: 'lip' (the pour lip) or 'bottom' (the bottom "
+                           "middle).")
+    catcher_dx: float = setting(0.15, SCRIPTED_POUR, "How far the catcher moves along the pour direction at the "
+                                "largest tilt.", "m", -0.3, 0.3)
+    period: float = setting(0.01, SCRIPTED_POUR, "Sample period of the trajectory.", "s", 0.0, 0.1, lo_open=True)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "duration", check_range("pour.duration", self.duration, 1.0, 120.0, "s"))
-        object.__setattr__(self, "max_tilt", check_range("pour.max_tilt", self.max_tilt, 0.0, 2.1, "rad"))
-        object.__setattr__(self, "pivot", check_choice("pour.pivot", self.pivot, Pivot))
-        object.__setattr__(self, "catcher_dx", check_range("pour.catcher_dx", self.catcher_dx, -0.3, 0.3, "m"))
-        object.__setattr__(self, "period", check_positive("pour.period", self.period, "s", 0.1))
+        check_settings(self, "pour")
 
 
 def phase(t: float, duration: float) -> float:

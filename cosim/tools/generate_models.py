@@ -1,17 +1,16 @@
 """Regenerate the MJCF files derived from code: ``models/vessels/<name>.xml`` and ``models/scene.xml``.
 
-Run ``python -m cosim.robots.generate`` after changing :mod:`cosim.vessel`, :mod:`cosim.robots.scene_config`,
+Run ``python -m cosim.tools.generate_models`` after changing :mod:`cosim.vessel`, :mod:`cosim.robots.scene_config`,
 :mod:`cosim.robots.scene_builder` or ``models/ur10e/ur10e.xml``; ``tests/test_robot_models.py`` fails while the
-committed files differ from what this produces. Files are written atomically (temporary file + rename).
+committed files differ from what this produces. Files are written atomically (:mod:`cosim.atomic_files`).
 """
 
 from __future__ import annotations
 
 import argparse
-import os
-import tempfile
 from pathlib import Path
 
+from cosim.atomic_files import atomic_path
 from cosim.robots import assets
 from cosim.robots.scene_builder import scene_mjcf
 from cosim.robots.scene_config import default_scene_config
@@ -26,26 +25,14 @@ def generated_files() -> dict[str, str]:
     return files
 
 
-def _write_atomic(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        os.chmod(tmp, 0o644)
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--models", type=Path, default=None, help="models directory (default: the package's)")
     args = parser.parse_args(argv)
     root = args.models or assets.models_dir()
     for relative, text in generated_files().items():
-        _write_atomic(root / relative, text)
+        with atomic_path(root / relative) as tmp:
+            tmp.write_text(text, encoding="utf-8")
         print(f"wrote {root / relative}")
     return 0
 
