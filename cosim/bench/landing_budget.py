@@ -50,7 +50,7 @@ from cosim.coupling.outflow import RATE_WINDOW
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig
 from cosim.io.pour_series import read_series_csv, write_series_csv
-from cosim.setting import declared
+from declared_settings.setting import declared
 
 PARTICLES_FILE = "particles.npz"
 SERIES_FILE = "series.csv"
