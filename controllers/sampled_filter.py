@@ -10,7 +10,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-import scipy.signal
 
 from controllers.errors import ControllerInputError
 
@@ -20,6 +19,8 @@ class SampledFilter:
     filter started at rest on a value holds it. Units of x and y are the caller's."""
 
     def __init__(self, numerator: Sequence[float], denominator: Sequence[float]) -> None:
+        import scipy.signal  # seconds to load: only where a filter is built, so that reading a configuration stays fast
+
         b, a = np.asarray(numerator, dtype=float), np.asarray(denominator, dtype=float)
         if a.size == 0 or a[0] == 0.0 or b.size > a.size:
             raise ControllerInputError("sampled filter: needs a proper b(z) / a(z) with a nonzero leading denominator")
@@ -29,6 +30,7 @@ class SampledFilter:
         self._a = a / a[0]
         self._rest = scipy.signal.lfilter_zi(self._b, self._a) if self._a.size > 1 else np.zeros(0)  # a gain has no state
         self._state = np.zeros(self._a.size - 1)
+        self._lfilter = scipy.signal.lfilter
 
     def reset(self, value: float) -> None:
         """At rest on ``value``: every later sample of ``value`` outputs ``value``."""
@@ -36,5 +38,5 @@ class SampledFilter:
 
     def step(self, x: float) -> float:
         """One sample of input ``x``; returns the filtered output."""
-        y, self._state = scipy.signal.lfilter(self._b, self._a, [float(x)], zi=self._state)
+        y, self._state = self._lfilter(self._b, self._a, [float(x)], zi=self._state)
         return float(y[0])
