@@ -12,13 +12,14 @@ Reported: the first mode's frequency (the spectrum's peak), and the content abov
 pour needs, five times the slosh frequency): its RMS and its share per 2.5 Hz band, both as recorded (2 ms, up to
 250 Hz) and as the controller samples it (every 10 ms, so content above its 50 Hz Nyquist frequency folds back
 below it). Above the shortest surface gravity wave the particle lattice resolves (wavelength two spacings, angular
-frequency sqrt(g pi / spacing): 11.4 Hz at 32 across 0.191 m) the liquid's surface carries no gravity wave; a peak
-there is the weakly compressible liquid's acoustic motion. The lowest acoustic mode that tilts the surface (rigid
-walls and floor, free surface) is f_a = (c0 / 2) sqrt(1 / B^2 + 1 / (2 A)^2), 61 Hz for c0 = 20 m/s. The report
-gives the largest band above that gravity-wave limit in each record; the 10 ms record's is where the acoustic
-motion reaches the controller, and its lower edge is the noise band's lower edge that the PID's measurement filter
-(:class:`controllers.pid_spec.PidDesignSpec`, ``noise_frequency``) has to stop, its cut-off lying between it and
-the slosh mode.
+frequency sqrt(g pi / spacing): 11.4 Hz at 32 across 0.191 m) the surface's motion is no gravity wave: particle-scale
+motion just above that limit, and in a weakly compressible liquid its acoustic modes. The lowest acoustic mode
+that tilts the surface (rigid walls and floor, free surface) is f_a = (c0 / 2) sqrt(1 / B^2 + 1 / (2 A)^2), 61 Hz
+for c0 = 20 m/s. The report gives that mode and the largest band above the gravity-wave limit in each record (read
+the bands too: the particle-scale content next to the limit can be as large); where the 10 ms record holds the
+acoustic peak is where it reaches the controller, and that band's lower edge is the noise band's lower edge that
+the PID's measurement filter (:class:`controllers.pid_spec.PidDesignSpec`, ``noise_frequency``) has to stop, its
+cut-off lying between it and the slosh mode.
 
 Both records are detrended by the least-squares damped sinusoid at the first mode before the spectrum (the
 ring-down's leakage would otherwise fill the bands), with a Hann window.
