@@ -132,11 +132,15 @@ def test_filtered_pid_has_zero_steady_state_error() -> None:
 
 @pytest.mark.slow
 def test_designs_across_sim_fills_are_stable() -> None:
-    """SIM runs for h_e <= (B/2) tan 20 deg, i.e. A >= 156 mm in the paper's vessel; also lower fills."""
+    """SIM runs for h_e <= (B/2) tan 20 deg, i.e. A >= 156 mm in the paper's vessel; also lower fills. The loop that
+    runs is the sampled one with the smoother, the delay and the measurement filter: stable, within the margins.
+    (The continuous C Gp alone, without the filter the gains were chosen with, is not that loop: this non-minimum
+    phase plant's loop is conditionally stable, and taking the filter's lag out can destabilise it.)"""
     for fill in (0.12, 0.156, 0.1591, 0.175, 0.189):
         design = design_filtered_pid(potential_flow_model(0.191, fill), dt=DT)
-        assert np.max(design.closed_loop_poles.real) < 0
         assert np.max(np.abs(design.discrete_poles)) < 1.0
+        assert design.gain_margin >= MIN_GAIN_MARGIN_DB and design.phase_margin >= MIN_PHASE_MARGIN_DEG
+        assert design.decay_rate > 0.0
 
 
 def test_too_slow_control_rate_is_a_one_line_error() -> None:
