@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from cosim.bench.slosh_angle_spectrum import band_powers, gravity_wave_limit, largest_band, ring_down_residual
+from cosim.bench.slosh_angle_spectrum import acoustic_mode, band_powers, gravity_wave_limit, largest_band, ring_down_residual
 
 
 def test_the_ring_down_comes_out_and_a_fast_mode_stays() -> None:
@@ -25,3 +25,8 @@ def test_the_ring_down_comes_out_and_a_fast_mode_stays() -> None:
 def test_shortest_gravity_wave_of_the_pour_lattice() -> None:
     """Wavelength two spacings at 32 across 0.191 m: sqrt(g pi / dx) / 2 pi = 11.4 Hz."""
     assert gravity_wave_limit(0.191 / 32) == pytest.approx(11.43, abs=0.01)
+
+
+def test_lowest_surface_tilting_acoustic_mode_of_the_pourer() -> None:
+    """c0 = 20 m/s in the default pourer (0.191 m) filled to 0.1591 m: 10 sqrt(1 / 0.191^2 + 1 / 0.3182^2) Hz."""
+    assert acoustic_mode(20.0, 0.191, 0.1591) == pytest.approx(61.06, abs=0.01)

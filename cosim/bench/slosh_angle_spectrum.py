@@ -84,6 +84,13 @@ def gravity_wave_limit(spacing: float) -> float:
     return math.sqrt(GRAVITY * math.pi / spacing) / (2.0 * math.pi)
 
 
+def acoustic_mode(sound_speed: float, width: float, depth: float) -> float:
+    """Hz, the lowest acoustic mode of a liquid of ``depth`` (m) in a box of ``width`` (m) that tilts its surface:
+    pressure cos(pi x / B) sin(pi z / 2A) (rigid walls and floor, free surface at z = A), sound speed c0 (m/s),
+    f_a = (c0 / 2) sqrt(1 / B^2 + 1 / (2 A)^2)."""
+    return 0.5 * sound_speed * math.hypot(1.0 / width, 0.5 / depth)
+
+
 def largest_band(bands: list[tuple[float, float]], above: float) -> tuple[float, float]:
     """(lower edge Hz, share) of the largest band starting at or above ``above`` Hz."""
     return max(((lo, share) for lo, share in bands if lo >= above), key=lambda b: b[1])
@@ -111,7 +118,7 @@ def measure(solver: PressureSolver, across: int, hold: float, above: float) -> d
         "solver": solver.value, "across": across, "c0": cfg.sound_speed,
         "slosh_frequency": peak_frequency(t, sigma), "record_interval": record_dt,
         "rms_above": rms, "bands": bands, "rms_above_control_rate": rms_c, "bands_control_rate": bands_c,
-        "gravity_wave_limit": limit, "acoustic_mode": 0.5 * cfg.sound_speed * math.hypot(1.0 / spec.inner_width, 0.5 / POURER_FILL),
+        "gravity_wave_limit": limit, "acoustic_mode": acoustic_mode(cfg.sound_speed, spec.inner_width, POURER_FILL),
         "largest_band": largest_band(bands, limit), "largest_band_control_rate": largest_band(bands_c, limit),
         "failure": run.failure,
     }
