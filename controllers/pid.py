@@ -18,6 +18,10 @@ Loop: unity negative feedback, theta = C(s) (r - theta1), theta1 = Gp(s) theta, 
   at +33 rad/s. :func:`design_filtered_pid` therefore places the poles for a family of bandwidths and keeps the
   design whose sampled loop with the delay (:func:`delayed_loop`) decays fastest while keeping the gain and phase
   margins the spec asks for (6 dB and 45 deg by default, the usual robustness floor), verified with python-control.
+* The PID reads theta1 through a low-pass (:func:`measurement_filter`) that passes the first slosh mode and stops
+  the liquid's own faster motion (a weakly compressible liquid's acoustic modes, the particles' passage), which
+  the derivative term would otherwise pass to the tilt. Its phase lag at omega1 is part of the loop the design
+  searches (:func:`loop_chain`), so the margins hold with it.
 * :class:`DiscretePid` runs that compensator at the control rate: forward-Euler integrator, backward-Euler
   derivative filter acting on the measurement (no derivative kick), output and output-rate limits, and
   back-calculation anti-windup. :meth:`PidGains.discrete_tf` is its exact z-domain transfer function.
@@ -109,9 +113,11 @@ class PidDesign:
     min_damping: smallest -Re(p)/|p| over them, and settling_time (s, 2 % band of that closed-loop step response),
     for a placed design (nan for a searched one, which is judged on its sampled loop). With a sample time ``dt``:
     delay_steps, the actuation delay in control periods; discrete_poles, the z-plane poles of :func:`delayed_loop`
-    (with the smoother and the delay, :func:`actuator`)
+    (with the smoother, the delay and the measurement filter, :func:`loop_chain`)
     in unity feedback; decay_rate (1/s), -ln(max |z|) / dt, the slowest closed-loop decay; gain_margin (dB) and
-    phase_margin (deg) of that loop (python-control's stability_margins).
+    phase_margin (deg) of that loop (python-control's stability_margins); measurement_cutoff (rad/s, nan: none) and
+    measurement, the (numerator, denominator) in z of the filter through which the PID reads theta1
+    (:func:`measurement_filter`).
     """
 
     gains: PidGains
@@ -126,6 +132,8 @@ class PidDesign:
     decay_rate: float = math.nan
     gain_margin: float = math.nan
     phase_margin: float = math.nan
+    measurement_cutoff: float = math.nan
+    measurement: Coefficients | None = None
 
     def closed_loop(self) -> ct.TransferFunction:
         """theta1 / r of the continuous loop."""
@@ -157,14 +165,56 @@ def _pole_mismatch(poles: np.ndarray, target: np.ndarray) -> float:
     return worst
 
 
-Actuator = tuple[list[float], list[float]]  # (numerator, denominator) in z of the chain from PID output to tilt
+Coefficients = tuple[list[float], list[float]]  # (numerator, denominator) in z, highest power first
 
 
-def actuator(spec: PidDesignSpec, dt: float) -> Actuator:
+def actuator(spec: PidDesignSpec, dt: float) -> Coefficients:
     """The chain from the PID's output to the vessel's tilt at sample time ``dt`` (s): the smoother's F(z)
     (:class:`controllers.motion.CriticallyDampedSmoother`) times z^-n, n = the actuation delay in whole periods."""
     num, den = CriticallyDampedSmoother(spec.smoothing_bandwidth, dt).transfer_function_coefficients()
     return num, list(np.polymul(den, [1.0] + [0.0] * delay_steps_of(spec, dt)))
+
+
+def measurement_cutoff(spec: PidDesignSpec, model: SloshModel) -> float:
+    """rad/s, the measurement filter's cut-off: the geometric mean sqrt(omega1 w_n) of the first slosh mode and the
+    lower edge w_n of the measurement's noise band (``spec.noise_frequency``); nan without a filter. On a log
+    frequency scale it lies midway, so the filter's relative distance to the mode it must pass (which sets its phase
+    lag there) equals its relative distance to the band it must stop (which sets its attenuation there)."""
+    if spec.noise_frequency is None:
+        return math.nan
+    if not spec.noise_frequency > model.omega1:
+        raise ControllerInputError(f"pid.noise_frequency: must be above the slosh frequency omega1 = {model.omega1:.4g} "
+                                   f"rad/s, got {spec.noise_frequency:g} rad/s")
+    return math.sqrt(model.omega1 * spec.noise_frequency)
+
+
+def measurement_filter(spec: PidDesignSpec, model: SloshModel, dt: float) -> ct.TransferFunction:
+    """M(z), the filter through which the PID reads theta1 at sample time ``dt`` (s): the second-order Butterworth
+    low-pass M(s) = wc^2 / (s^2 + sqrt(2) wc s + wc^2) at wc = :func:`measurement_cutoff`, by the bilinear transform
+    prewarped at wc (so its -3 dB point stays at wc, and its double zero at z = -1 stops the Nyquist frequency
+    entirely); 1 without a filter. Unit DC gain: a steady theta1 is read as it is."""
+    import control as ct
+
+    wc = measurement_cutoff(spec, model)
+    if math.isnan(wc):
+        return ct.tf([1.0], [1.0], dt)
+    if not wc < 0.5 * math.pi / dt:
+        raise ControllerInputError(f"pid.noise_frequency: the measurement filter's cut-off {wc:.4g} rad/s must stay under "
+                                   f"half the Nyquist frequency {math.pi / dt:.4g} rad/s of the control rate")
+    return ct.c2d(ct.tf([wc * wc], [1.0, math.sqrt(2.0) * wc, wc * wc]), dt, "tustin", prewarp_frequency=wc)
+
+
+def coefficients(tf: ct.TransferFunction) -> Coefficients:
+    """(numerator, denominator) of a SISO transfer function, highest power first."""
+    return list(np.asarray(tf.num[0][0], dtype=float)), list(np.asarray(tf.den[0][0], dtype=float))
+
+
+def loop_chain(spec: PidDesignSpec, model: SloshModel, dt: float) -> Coefficients:
+    """Everything the loop holds besides the PID and the plant, at sample time ``dt`` (s): the :func:`actuator` chain
+    (smoother, delay) times the :func:`measurement_filter`. In the loop's product their order does not matter."""
+    num, den = actuator(spec, dt)
+    m_num, m_den = coefficients(measurement_filter(spec, model, dt))
+    return list(np.polymul(num, m_num)), list(np.polymul(den, m_den))
 
 
 def delay_steps_of(spec: PidDesignSpec, dt: float) -> int:
@@ -172,8 +222,9 @@ def delay_steps_of(spec: PidDesignSpec, dt: float) -> int:
     return math.ceil(spec.actuation_delay / dt - 1e-9)
 
 
-def delayed_loop(gains: PidGains, model: SloshModel, dt: float, chain: Actuator) -> ct.TransferFunction:
-    """The open loop C(z) A(z) Gz(z) the controller closes at sample time ``dt`` (s), A the actuation ``chain``."""
+def delayed_loop(gains: PidGains, model: SloshModel, dt: float, chain: Coefficients) -> ct.TransferFunction:
+    """The open loop C(z) A(z) Gz(z) the controller closes at sample time ``dt`` (s), A the ``chain``
+    (:func:`loop_chain`: the actuation and the measurement filter)."""
     import control as ct
 
     return gains.discrete_tf(dt) * sampled_plant(model, dt) * ct.tf(chain[0], chain[1], dt)
@@ -202,7 +253,7 @@ def place_filtered_pid(model: SloshModel, target: np.ndarray) -> PidGains | None
     return PidGains(kp=float(kp), ki=float(w), kd=float(u - kp * tf), tf=float(tf))
 
 
-def delayed_loop_figures(gains: PidGains, model: SloshModel, dt: float, chain: Actuator) -> tuple[float, float, float]:
+def delayed_loop_figures(gains: PidGains, model: SloshModel, dt: float, chain: Coefficients) -> tuple[float, float, float]:
     """(decay rate 1/s, gain margin dB, phase margin deg) of :func:`delayed_loop` in unity feedback: -ln(max |z|)/dt
     over the closed-loop poles (-inf if unstable); the margins from python-control's crossings as distances from
     the critical point: the gain margin closest to 0 dB (up or down) over every phase crossover, the phase margin
@@ -219,7 +270,7 @@ def delayed_loop_figures(gains: PidGains, model: SloshModel, dt: float, chain: A
     return -math.log(radius) / dt, gm_db, pm
 
 
-def _fast_loop_figures(gains: PidGains, plant: tuple[np.ndarray, np.ndarray], dt: float, chain: Actuator,
+def _fast_loop_figures(gains: PidGains, plant: tuple[np.ndarray, np.ndarray], dt: float, chain: Coefficients,
                        frequencies: np.ndarray) -> tuple[float, float, float]:
     """:func:`delayed_loop_figures` in numpy, for the design search: closed-loop roots of den + num, and the margins
     from the loop's response at ``frequencies`` (rad/sample) as python-control defines them (the gain margin closest
@@ -248,7 +299,7 @@ def _crossings(values: np.ndarray) -> np.ndarray:
     return np.flatnonzero(change & (np.abs(values[1:] - values[:-1]) < math.pi))
 
 
-def _search(model: SloshModel, spec: PidDesignSpec, dt: float, chain: Actuator) -> tuple[PidGains, np.ndarray]:
+def _search(model: SloshModel, spec: PidDesignSpec, dt: float, chain: Coefficients) -> tuple[PidGains, np.ndarray]:
     """The gains whose delayed sampled loop decays fastest within the spec's margins: the best pole placement over
     the damping and bandwidth grid, refined by Nelder-Mead on (kp, ki, kd, ln tf) with the margins as penalties.
     Returns the gains and the placement's target poles it started from."""
@@ -304,7 +355,7 @@ def design_filtered_pid(model: SloshModel, spec: PidDesignSpec = PidDesignSpec()
     if dt is not None:
         check_range("control_rate period", dt, 0.0, 0.1, "s", lo_open=True)
     delay_steps = delay_steps_of(spec, dt) if dt is not None else 0
-    chain = actuator(spec, dt) if dt is not None else None
+    chain = loop_chain(spec, model, dt) if dt is not None else None
     if searched:
         gains, target = _search(model, spec, dt, chain)
     else:
@@ -339,7 +390,8 @@ def design_filtered_pid(model: SloshModel, spec: PidDesignSpec = PidDesignSpec()
             f"pid: no design reaches {spec.min_gain_margin:g} dB and {spec.min_phase_margin:g} deg of margin with an "
             f"actuation delay of {spec.actuation_delay:g} s at {1.0 / dt:g} Hz (best: {gm_db:.2f} dB, {pm:.1f} deg)"
         )
-    return PidDesign(gains, model, target, poles, min_damping, settling, dt, dpoles, delay_steps, decay, gm_db, pm)
+    return PidDesign(gains, model, target, poles, min_damping, settling, dt, dpoles, delay_steps, decay, gm_db, pm,
+                     measurement_cutoff(spec, model), coefficients(measurement_filter(spec, model, dt)))
 
 
 class DiscretePid:

@@ -15,6 +15,8 @@ from controllers.checks import check_range
 if TYPE_CHECKING:
     import numpy as np
 
+NOISE_FREQUENCY = 2.0 * math.pi * 40.0  # rad/s, PidDesignSpec.noise_frequency's default (its docstring)
+
 
 @dataclass(frozen=True)
 class PidDesignSpec:
@@ -34,6 +36,13 @@ class PidDesignSpec:
       rounded up to whole control periods in the design. [0, 0.5] The default is the coupled pour's, fitted from
       its series (docs/controller.md).
     min_gain_margin: dB. [0, 40]   min_phase_margin: deg. [0, 90]
+    noise_frequency: rad/s, the lower edge of the band in which the measured slosh angle theta1 carries the liquid's
+      own motion rather than its first slosh mode (the weakly compressible liquid's acoustic modes, the particles'
+      passage), as the controller samples it. The PID reads theta1 through a second-order Butterworth low-pass
+      (:func:`controllers.pid.measurement_filter`) at the geometric mean of omega1 and this frequency, and its design
+      includes that filter. Default: 2 pi 40 Hz, measured with ``python -m cosim.bench.slosh_angle_spectrum`` on the
+      default vessel and resolution (docs/controller.md). [20, 10000]; None (in code: a scene file that leaves it
+      out gets the default): theta1 is read unfiltered.
     """
 
     damping: float | None = None
@@ -42,6 +51,7 @@ class PidDesignSpec:
     actuation_delay: float = 0.04
     min_gain_margin: float = 6.0
     min_phase_margin: float = 45.0
+    noise_frequency: float | None = NOISE_FREQUENCY
 
     def __post_init__(self) -> None:
         if self.damping is not None:
@@ -52,6 +62,8 @@ class PidDesignSpec:
         check_range("pid.actuation_delay", self.actuation_delay, 0.0, 0.5, "s")
         check_range("pid.min_gain_margin", self.min_gain_margin, 0.0, 40.0, "dB")
         check_range("pid.min_phase_margin", self.min_phase_margin, 0.0, 90.0, "deg")
+        if self.noise_frequency is not None:
+            check_range("pid.noise_frequency", self.noise_frequency, 20.0, 10000.0, "rad/s")
 
     def target_poles(self, omega1: float, damping: float, bandwidth_ratio: float) -> np.ndarray:
         """The four target poles (rad/s) for a slosh frequency ``omega1`` (rad/s)."""

@@ -36,6 +36,7 @@ from controllers.geometry import PlanarPose, static_tilt_for_h_q
 from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
 from controllers.motion import CriticallyDampedSmoother, JerkLimitedMove, RateLimitedTracker, fitted_delay
 from controllers.pid import DiscretePid, PidDesign, design_filtered_pid
+from controllers.sampled_filter import SampledFilter
 from controllers.slosh_induction import excitation_duration, excitation_tilt, sim_needed
 
 # Delay (s) of the filter on the measured outflow rate d(poured)/dt: a fifth of the paper's vessel's slosh period,
@@ -96,10 +97,12 @@ class PourController:
         self.pid_design: PidDesign | None = None
         self._pid: DiscretePid | None = None
         self._smoother: CriticallyDampedSmoother | None = None  # between the PID and the arm (SIM_DAMP)
+        self._theta1_filter: SampledFilter | None = None  # through which the PID reads theta1, from the first step
         if self.use_sim:
             self.pid_design = design_filtered_pid(self.model, sim.pid, self.dt)
             self._pid = DiscretePid(self.pid_design.gains, self.dt, 0.0, config.cfs.max_tilt, sim.max_tilt_rate)
             self._smoother = CriticallyDampedSmoother(sim.pid.smoothing_bandwidth, self.dt)
+            self._theta1_filter = SampledFilter(*self.pid_design.measurement)
         self.sim_frequency = sim.frequency_ratio * self.model.omega1  # alpha, rad/s
         self.sim_amplitude = math.nan  # phi, rad; set from the first measurement's volume
         self._approach = RateLimitedTracker(config.approach.max_rate, config.approach.max_accel, self.dt)
@@ -125,8 +128,9 @@ class PourController:
         self._volume_stages = [math.nan] * OUTFLOW_FILTER_STAGES  # m^3, the volume left for the deepest tilt
         self._tilt_rate = 0.0  # rad/s, of the commanded tilt over the last step
         self._cfs_head = 0.0  # m, the measured h_q through CFS's head filter (cfs.head_filter_fraction)
-        self._theta1_rate = 0.0  # rad/s, of the measured free-surface angle over the last step
+        self._theta1_rate = 0.0  # rad/s, of the free-surface angle the PID reads (filtered) over the last step
         self._last_theta1 = 0.0
+        self._theta1 = 0.0  # rad, theta1 as the PID reads it: through its measurement filter
         self._last_poured = 0.0
         self._sigma_prev = 0.0
         self._since = math.nan  # start of the current settle (SIM_DAMP) or max-tilt (CFS) interval, s
@@ -189,8 +193,10 @@ class PourController:
             self._h_q = _low_pass(self._head_stages, max(m.h_q, 0.0), gain)
             gain = min(OUTFLOW_FILTER_STAGES * (m.t - self._last_t) / DEEPEST_TILT_FILTER_TIME, 1.0)
             _low_pass(self._volume_stages, m.volume_in_pourer, gain)
-            self._theta1_rate = (m.theta1 - self._last_theta1) / (m.t - self._last_t)
-        self._last_theta1 = m.theta1
+        self._theta1 = self._theta1_filter.step(m.theta1) if self._theta1_filter is not None else m.theta1
+        if self._last_t is not None:
+            self._theta1_rate = (self._theta1 - self._last_theta1) / (m.t - self._last_t)
+        self._last_theta1 = self._theta1
         self._last_t, self._last_poured = m.t, m.poured_volume
 
         for _ in Phase:  # a step may pass several phases; each at most once
@@ -223,6 +229,8 @@ class PourController:
         self._head_stages = [self._h_q] * OUTFLOW_FILTER_STAGES
         self._volume_stages = [m.volume_in_pourer] * OUTFLOW_FILTER_STAGES
         self._initial_volume = m.volume_in_pourer + m.poured_volume
+        if self._theta1_filter is not None:
+            self._theta1_filter.reset(m.theta1)
         if not self._initial_volume > 0.0:
             raise MeasurementError("measurement.volume_in_pourer: the pourer is empty at the first step")
         contact = static_tilt_for_h_q(self.config.vessel, 0.0, self._area(m))
@@ -248,7 +256,7 @@ class PourController:
             # Bumpless in rate too: the PID's first outputs continue the command's motion (at rest in the hold) with
             # the measured surface moving at its current rate; a PID started at rest with the surface moving steps
             # its output's rate, which the arm can only follow at its jerk limit.
-            self._pid.reset(u0=self.pose.theta, y0=m.theta1, r0=self._reference, y_rate=self._theta1_rate,
+            self._pid.reset(u0=self.pose.theta, y0=self._theta1, r0=self._reference, y_rate=self._theta1_rate,
                             u_rate=self._tilt_rate)
             self._smoother.reset(self.pose.theta, self._tilt_rate)
             self._held_tilt = self.pose.theta
@@ -440,7 +448,7 @@ class PourController:
         self._reference = self._damp_reference(m)
         sim = self.config.sim
         if sim.damping is Damping.PID:
-            command = self._pid.step(self._reference, m.theta1)
+            command = self._pid.step(self._reference, self._theta1)
         else:  # the same reference at the PID's rate limit, without feedback
             step = sim.max_tilt_rate * self.dt
             command = self._held_tilt = min(max(self._reference, self._held_tilt - step), self._held_tilt + step)

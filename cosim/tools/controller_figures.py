@@ -103,13 +103,14 @@ def figure_step(path: Path, design: PidDesign, spec: PidDesignSpec) -> None:
     a1.plot(t, y)
     a1.axhline(0.5, color="grey", ls="--", lw=0.8)
     a1.set(ylabel="theta1 (rad per rad)", title="Gp in unity feedback: undamped, mean 1/2 (error 1/2)")
-    sampled = ct.feedback(delayed_loop(design.gains, design.model, design.dt, actuator(spec, design.dt)), 1)
+    measured = ct.tf(*design.measurement, design.dt)  # theta1 as the PID reads it, through its measurement filter
+    sampled = ct.feedback(delayed_loop(design.gains, design.model, design.dt, actuator(spec, design.dt)), measured)
     ts, y = ct.step_response(sampled, T=np.arange(0.0, 3.0, design.dt))
     a2.step(ts, y, where="post")
     a2.axhline(1.0, color="grey", ls="--", lw=0.8)
     g = design.gains
     a2.set(xlabel="t (s)", ylabel="theta1 (rad per rad)",
-           title=f"C Gp at {1 / design.dt:g} Hz with the smoother and {1e3 * spec.actuation_delay:g} ms: Kp={g.kp:.3f}, "
+           title=f"C Gp at {1 / design.dt:g} Hz, smoother, {1e3 * spec.actuation_delay:g} ms, theta1 filter: Kp={g.kp:.3f}, "
            f"Ki={g.ki:.3f}/s, Kd={g.kd:.4f} s, Tf={1e3 * g.tf:.1f} ms; decays at {design.decay_rate:.1f} /s")
     a2.title.set_fontsize(9)
     fig.tight_layout()
