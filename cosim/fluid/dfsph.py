@@ -86,19 +86,20 @@ from cosim.fluid.diagnostics import (
     DIAG_PAIR_OVERFLOW,
 )
 from cosim.fluid.lanes import lane_item
-from cosim.fluid.neighbors import GridSpec, block_cell, neighbor_cells
+from cosim.fluid.neighbors import GridSpec, Neighborhood, first_neighbor, next_neighbor
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
-    add_wall_density,
     add_wall_reaction,
     diag_slot,
     finish_particle,
     inside_any_vessel,
     kernel_gradient,
+    neighbor_mass,
     next_free_state,
+    pair_code,
     pair_wall,
+    summation_term,
     viscous_pair,
-    wall_pair,
 )
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -198,22 +199,15 @@ def compute_density_factor(
     lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
-    g: GridSpec,
     vessels: wp.array(dtype=VesselGeometry),
     b_volume: wp.array(dtype=float),
     capacity: int,
     free_liquid: int,
     # State in
     motions: wp.array(dtype=VesselMotion),
-    x: wp.array(dtype=wp.vec3),
+    nb: Neighborhood,
     active: wp.array(dtype=wp.int32),
     mass: wp.array(dtype=float),
-    cell_start: wp.array(dtype=wp.int32),
-    cell_end: wp.array(dtype=wp.int32),
-    bx: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    b_cell_start: wp.array(dtype=wp.int32),
-    b_cell_end: wp.array(dtype=wp.int32),
     row: wp.array(dtype=wp.int32),
     # State in/out
     kappa_divergence: wp.array(dtype=float),
@@ -255,48 +249,27 @@ def compute_density_factor(
         increment_per_rho[i] = 0.0
         return
     wp.atomic_add(solve_stats, stat_slot(prm, i, STAT_COUNT), wp.int64(1))
-    xi = x[i]
-    support2 = prm.support * prm.support
+    xi = nb.x[i]
     mi = mass[i]
     density = mi * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     grad_sum = wp.vec3(0.0)
     grad_sq = float(0.0)
     count = int(0)
-    cells = neighbor_cells(g, xi)
-    for k_cell in range(cells.count):
-        cell = block_cell(g, cells, k_cell)
-        for j in range(cell_start[cell], cell_end[cell]):
-            r = xi - x[j]
-            r2 = wp.dot(r, r)
-            if r2 >= support2 or r2 < 1.0e-24:
-                continue
-            mj = mass[j]
-            density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-            gw = kernel_gradient(prm, r, r2)
-            gm = mj * gw
-            grad_sum += gm
+    walk = first_neighbor(nb, xi, prm.support)
+    while walk.index >= 0:
+        mj = neighbor_mass(prm, mass, b_volume, walk)
+        density += summation_term(prm, mj, walk)
+        gw = kernel_gradient(prm, walk.r, walk.r2)
+        gm = mj * gw
+        grad_sum += gm
+        if walk.wall == 0:
             grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
-            if count < capacity:
-                pair_index[i, count] = j
-                pair_grad[i, count] = gw
-                pair_mass_grad[i, count] = gm
-            count += 1
-        for kk in range(b_cell_start[cell], b_cell_end[cell]):
-            b = b_order[kk]
-            r = xi - bx[b]
-            r2 = wp.dot(r, r)
-            if r2 >= support2 or r2 < 1.0e-24:
-                continue
-            mw = prm.rest_density * b_volume[b]
-            density += mw * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-            gw = kernel_gradient(prm, r, r2)
-            gm = mw * gw
-            grad_sum += gm
-            if count < capacity:
-                pair_index[i, count] = wall_pair(b)
-                pair_grad[i, count] = gw
-                pair_mass_grad[i, count] = gm
-            count += 1
+        if count < capacity:
+            pair_index[i, count] = pair_code(walk)
+            pair_grad[i, count] = gw
+            pair_mass_grad[i, count] = gm
+        count += 1
+        walk = next_neighbor(nb, walk)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
@@ -487,19 +460,12 @@ def compute_wall_density_factor(
     lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
-    g: GridSpec,
     b_volume: wp.array(dtype=float),
     b_wetted: wp.array(dtype=wp.int32),
     capacity: int,
     # State in
-    x: wp.array(dtype=wp.vec3),
+    nb: Neighborhood,
     mass: wp.array(dtype=float),
-    cell_start: wp.array(dtype=wp.int32),
-    cell_end: wp.array(dtype=wp.int32),
-    bx: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    b_cell_start: wp.array(dtype=wp.int32),
-    b_cell_end: wp.array(dtype=wp.int32),
     row: wp.array(dtype=wp.int32),
     # Out
     b_rho: wp.array(dtype=float),
@@ -521,29 +487,22 @@ def compute_wall_density_factor(
     b_alpha[b] = 0.0
     if b_wetted[b] == 0:
         return
-    xb = bx[b]
     mb = prm.rest_density * b_volume[b]
-    support2 = prm.support * prm.support
     density = mb * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     grad_sq = float(0.0)
     count = int(0)
-    cells = neighbor_cells(g, xb)
-    for k_cell in range(cells.count):
-        cell = block_cell(g, cells, k_cell)
-        for j in range(cell_start[cell], cell_end[cell]):
-            r = xb - x[j]
-            r2 = wp.dot(r, r)
-            if r2 >= support2 or r2 < 1.0e-24:
-                continue
-            mj = mass[j]
-            density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-            gw = kernel_gradient(prm, r, r2)
+    walk = first_neighbor(nb, nb.bx[b], prm.support)
+    while walk.index >= 0:
+        mj = neighbor_mass(prm, mass, b_volume, walk)
+        density += summation_term(prm, mj, walk)
+        if walk.wall == 0:
+            gw = kernel_gradient(prm, walk.r, walk.r2)
             grad_sq += mj * mb * wp.dot(gw, gw)
             if count < capacity:
-                b_pair_index[b, count] = j
+                b_pair_index[b, count] = walk.index
                 b_pair_mass_grad[b, count] = mj * gw
             count += 1
-        density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xb, density)
+        walk = next_neighbor(nb, walk)
     if count == 0:
         return
     if count > capacity:
