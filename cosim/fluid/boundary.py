@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import warp as wp
 
-from cosim.fluid.lanes import lane_item
+from cosim.fluid.lanes import item_kernel
 from cosim.fluid.mesh_boundary import SHAPE_MESH, mesh_guard, mesh_inside
 from cosim.fluid.neighbors import Neighborhood, first_liquid_neighbor, next_neighbor
 from cosim.fluid.params import SPHParams
@@ -104,9 +104,8 @@ def advance_vessel_poses(
     motions[k] = m
 
 
-@wp.kernel
+@item_kernel
 def place_wall_particles(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     local_pos: wp.array(dtype=wp.vec3),
     vessel_of: wp.array(dtype=wp.int32),
@@ -117,16 +116,15 @@ def place_wall_particles(
     v: wp.array(dtype=wp.vec3),
 ):
     """World position and velocity of each wall sample at the current substep's start pose."""
-    b = lane_item(wp.tid(), lane)
+    b = wp.tid()
     m = motions[vessel_of[b]]
     arm = m.r_now @ local_pos[b]
     x[b] = m.p_now + arm
     v[b] = m.lin_vel + wp.cross(m.ang_vel, arm)
 
 
-@wp.kernel
+@item_kernel
 def extrapolate_wall_state(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     b_vessel: wp.array(dtype=wp.int32),
@@ -143,7 +141,7 @@ def extrapolate_wall_state(
     b_v_noslip: wp.array(dtype=wp.vec3),
 ):
     """Pressure, density and no-slip velocity of each dummy wall particle from the liquid around it."""
-    b = lane_item(wp.tid(), lane)
+    b = wp.tid()
     xb = nb.bx[b]
     m = motions[b_vessel[b]]
     arm = xb - m.p_now

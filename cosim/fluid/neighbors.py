@@ -172,7 +172,6 @@ def next_neighbor(nb: Neighborhood, walk: NeighborWalk) -> NeighborWalk:
         else:
             w.index = -1
             return w
-    return w
 
 
 @wp.func

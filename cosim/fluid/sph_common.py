@@ -21,7 +21,7 @@ from cosim.fluid.diagnostics import (
     DIAG_MAX_SPEED,
     DIAG_NONFINITE,
 )
-from cosim.fluid.lanes import lane_item
+from cosim.fluid.lanes import item_kernel
 from cosim.fluid.neighbors import NeighborWalk
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_dw, kernel_w
@@ -240,9 +240,8 @@ def diag_slot(prm: SPHParams, row: int, i: int) -> int:
     return row * prm.atomic_replicas + i % prm.atomic_replicas
 
 
-@wp.kernel
+@item_kernel
 def gather_particles(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     order: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
@@ -268,7 +267,7 @@ def gather_particles(
     mass_out: wp.array(dtype=float),
 ):
     """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     src = order[i]
     x_out[i] = x[src]
     v_out[i] = v[src]

@@ -32,7 +32,7 @@ import warp as wp
 
 from cosim.fluid.boundary import VesselGeometry, VesselMotion
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
-from cosim.fluid.lanes import lane_item
+from cosim.fluid.lanes import item_kernel
 from cosim.fluid.neighbors import Neighborhood, first_neighbor, next_neighbor
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
@@ -83,9 +83,8 @@ def tait_internal_energy(prm: SPHParams, rho: float) -> float:
     return tait_elastic_energy(prm, rt) + prm.max_tension * (1.0 / rho - 1.0 / rt)
 
 
-@wp.kernel
+@item_kernel
 def update_free_liquid(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -110,7 +109,7 @@ def update_free_liquid(
     the vessel it left). It becomes bound when its summation density reaches rho0 inside a
     vessel; the continuity equation then continues from that density, so the pressure is continuous and the
     caught liquid keeps no memory of the loose packing it arrived in."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if active[i] == 0:
         return
     xi = nb.x[i]
@@ -134,9 +133,8 @@ def update_free_liquid(
     p[i] = tait_pressure(prm, rhoi)
 
 
-@wp.kernel
+@item_kernel
 def compute_forces(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -174,7 +172,7 @@ def compute_forces(
     the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``:
     grad_i W), in the order of the neighbour loop, which compute_density_rate sums over instead of searching the
     cells again; more than ``capacity`` neighbours count as an overflow, an instability."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
@@ -238,9 +236,8 @@ def compute_forces(
     wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_ACCEL, wp.length(a))
 
 
-@wp.kernel
+@item_kernel
 def compute_density_rate(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     b_volume: wp.array(dtype=float),
@@ -265,7 +262,7 @@ def compute_density_rate(
     delta h c0 sum_j V_j [2 (rho_i - rho_j) r_ij . grad W / (r^2 + eta^2) - (<grad rho>_i + <grad rho>_j) . grad W],
     which vanishes for any linear density field (a resting column) and conserves mass between pairs. Sums over
     compute_forces' pair list, in its order (the neighbours have not moved since)."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if active[i] == 0:
         drho[i] = 0.0
         return
@@ -294,9 +291,8 @@ def compute_density_rate(
     drho[i] = dr
 
 
-@wp.kernel
+@item_kernel
 def integrate(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -324,7 +320,7 @@ def integrate(
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
 ):
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if active[i] == 0:
         return
     s = diag_slot(prm, row[0], i)
