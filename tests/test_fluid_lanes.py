@@ -18,7 +18,7 @@ from cosim.errors import InputError
 from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
 from cosim.fluid.diagnostics import DIAG_KINETIC_ENERGY, DIAG_MAX_SPEED, N_DIAG_FLOAT, combine_lanes
 from cosim.fluid import lanes
-from cosim.fluid.lanes import LANE_CHUNK, MIN_PARTICLES_PER_LANE, available_cores, lane_count, lane_item, lane_sizes
+from cosim.fluid.lanes import LANE_CHUNK, MIN_PARTICLES_PER_LANE, available_cores, item_kernel, lane_count, lane_sizes
 from cosim.fluid.solver import FluidSolver
 from tests.support.shaken_tank import SOLVER_VARIANTS, shake, tank
 
@@ -85,21 +85,22 @@ def test_lanes_that_sleep_at_every_barrier_give_the_same_run(monkeypatch):
     _assert_same_run(fluid, one)
 
 
-@wp.kernel
-def _mark_items(lane: wp.vec2i, hits: wp.array(dtype=wp.int32), owner: wp.array(dtype=wp.int32)):
-    i = lane_item(wp.tid(), lane)
+@item_kernel
+def _mark_items(hits: wp.array(dtype=wp.int32), owner: wp.array(dtype=wp.int32), mark: int):
+    i = wp.tid()
     hits[i] += 1
-    owner[i] = lane[0]
+    owner[i] = mark
 
 
 def test_lanes_compute_every_item_once():
+    assert [arg.label for arg in _mark_items.adj.args] == ["lane", "hits", "owner", "mark"]
     for count in (1, 7, LANE_CHUNK, 864, 1001):
         for lanes in (1, 2, 3, 8):
             hits = wp.zeros(count, dtype=wp.int32, device="cpu")
             owner = wp.zeros(count, dtype=wp.int32, device="cpu")
             sizes = lane_sizes(count, lanes)
             for lane, size in enumerate(sizes):
-                wp.launch(_mark_items, dim=size, inputs=[wp.vec2i(lane, lanes), hits, owner], device="cpu")
+                wp.launch(_mark_items, dim=size, inputs=[wp.vec2i(lane, lanes), hits, owner, lane], device="cpu")
             np.testing.assert_array_equal(hits.numpy(), 1)
             # chunks of LANE_CHUNK items dealt out in turn; the shares differ by at most one chunk
             np.testing.assert_array_equal(owner.numpy(), (np.arange(count) // LANE_CHUNK) % lanes)

@@ -21,9 +21,9 @@ from __future__ import annotations
 
 import warp as wp
 
-from cosim.fluid.lanes import lane_item
+from cosim.fluid.lanes import item_kernel
 from cosim.fluid.mesh_boundary import SHAPE_MESH, mesh_guard, mesh_inside
-from cosim.fluid.neighbors import GridSpec, block_cell, neighbor_cells
+from cosim.fluid.neighbors import Neighborhood, first_liquid_neighbor, next_neighbor
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -104,9 +104,8 @@ def advance_vessel_poses(
     motions[k] = m
 
 
-@wp.kernel
+@item_kernel
 def place_wall_particles(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     local_pos: wp.array(dtype=wp.vec3),
     vessel_of: wp.array(dtype=wp.int32),
@@ -117,59 +116,49 @@ def place_wall_particles(
     v: wp.array(dtype=wp.vec3),
 ):
     """World position and velocity of each wall sample at the current substep's start pose."""
-    b = lane_item(wp.tid(), lane)
+    b = wp.tid()
     m = motions[vessel_of[b]]
     arm = m.r_now @ local_pos[b]
     x[b] = m.p_now + arm
     v[b] = m.lin_vel + wp.cross(m.ang_vel, arm)
 
 
-@wp.kernel
+@item_kernel
 def extrapolate_wall_state(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
-    g: GridSpec,
     b_vessel: wp.array(dtype=wp.int32),
     # State in
     motions: wp.array(dtype=VesselMotion),
-    bx: wp.array(dtype=wp.vec3),
+    nb: Neighborhood,
     bv: wp.array(dtype=wp.vec3),
-    x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
     rho: wp.array(dtype=float),
     p: wp.array(dtype=float),
-    cell_start: wp.array(dtype=wp.int32),
-    cell_end: wp.array(dtype=wp.int32),
     # Out
     b_p: wp.array(dtype=float),
     b_rho: wp.array(dtype=float),
     b_v_noslip: wp.array(dtype=wp.vec3),
 ):
     """Pressure, density and no-slip velocity of each dummy wall particle from the liquid around it."""
-    b = lane_item(wp.tid(), lane)
-    xb = bx[b]
+    b = wp.tid()
+    xb = nb.bx[b]
     m = motions[b_vessel[b]]
     arm = xb - m.p_now
     a_wall = m.lin_acc + wp.cross(m.ang_acc, arm) + wp.cross(m.ang_vel, wp.cross(m.ang_vel, arm))
-    support2 = prm.support * prm.support
     sum_w = float(0.0)
     sum_pw = float(0.0)
     sum_rho_r = wp.vec3(0.0)
     sum_v = wp.vec3(0.0)
-    cells = neighbor_cells(g, xb)
-    for k_cell in range(cells.count):
-        cell = block_cell(g, cells, k_cell)
-        for f in range(cell_start[cell], cell_end[cell]):
-            r = xb - x[f]
-            r2 = wp.dot(r, r)
-            if r2 >= support2:
-                continue
-            w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-            sum_w += w
-            sum_pw += p[f] * w
-            sum_rho_r += (rho[f] * w) * r
-            sum_v += w * v[f]
+    walk = first_liquid_neighbor(nb, xb, prm.support)
+    while walk.index >= 0:
+        f = walk.index
+        w = kernel_w(wp.sqrt(walk.r2), prm.inv_h, prm.sigma, prm.kernel)
+        sum_w += w
+        sum_pw += p[f] * w
+        sum_rho_r += (rho[f] * w) * walk.r
+        sum_v += w * v[f]
+        walk = next_neighbor(nb, walk)
     pw = float(0.0)
     v_noslip = bv[b]
     if sum_w > 0.0:

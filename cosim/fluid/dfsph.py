@@ -85,20 +85,21 @@ from cosim.fluid.diagnostics import (
     DIAG_MAX_DENSITY_ERROR,
     DIAG_PAIR_OVERFLOW,
 )
-from cosim.fluid.lanes import lane_item
-from cosim.fluid.neighbors import GridSpec, block_cell, neighbor_cells
+from cosim.fluid.lanes import item_kernel
+from cosim.fluid.neighbors import GridSpec, Neighborhood, first_neighbor, next_neighbor
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
-    add_wall_density,
     add_wall_reaction,
     diag_slot,
     finish_particle,
     inside_any_vessel,
     kernel_gradient,
+    neighbor_mass,
     next_free_state,
+    pair_code,
     pair_wall,
+    summation_term,
     viscous_pair,
-    wall_pair,
 )
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -193,27 +194,19 @@ def bound_or_free_density(
     return summation + offset
 
 
-@wp.kernel
+@item_kernel
 def compute_density_factor(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
-    g: GridSpec,
     vessels: wp.array(dtype=VesselGeometry),
     b_volume: wp.array(dtype=float),
     capacity: int,
     free_liquid: int,
     # State in
     motions: wp.array(dtype=VesselMotion),
-    x: wp.array(dtype=wp.vec3),
+    nb: Neighborhood,
     active: wp.array(dtype=wp.int32),
     mass: wp.array(dtype=float),
-    cell_start: wp.array(dtype=wp.int32),
-    cell_end: wp.array(dtype=wp.int32),
-    bx: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    b_cell_start: wp.array(dtype=wp.int32),
-    b_cell_end: wp.array(dtype=wp.int32),
     row: wp.array(dtype=wp.int32),
     # State in/out
     kappa_divergence: wp.array(dtype=float),
@@ -241,7 +234,7 @@ def compute_density_factor(
     the divergence solve's warm start (increment = a fraction of the last substep's stiffness, applied by the first
     iteration; ``increment_per_rho`` = increment / rho, as the neighbours read it) and its counters. More than
     ``capacity`` neighbours (impossible below ~2x compression) count as an overflow, an instability."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)
         keep_going[0] = 1
@@ -255,48 +248,27 @@ def compute_density_factor(
         increment_per_rho[i] = 0.0
         return
     wp.atomic_add(solve_stats, stat_slot(prm, i, STAT_COUNT), wp.int64(1))
-    xi = x[i]
-    support2 = prm.support * prm.support
+    xi = nb.x[i]
     mi = mass[i]
     density = mi * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     grad_sum = wp.vec3(0.0)
     grad_sq = float(0.0)
     count = int(0)
-    cells = neighbor_cells(g, xi)
-    for k_cell in range(cells.count):
-        cell = block_cell(g, cells, k_cell)
-        for j in range(cell_start[cell], cell_end[cell]):
-            r = xi - x[j]
-            r2 = wp.dot(r, r)
-            if r2 >= support2 or r2 < 1.0e-24:
-                continue
-            mj = mass[j]
-            density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-            gw = kernel_gradient(prm, r, r2)
-            gm = mj * gw
-            grad_sum += gm
+    walk = first_neighbor(nb, xi, prm.support)
+    while walk.index >= 0:
+        mj = neighbor_mass(prm, mass, b_volume, walk)
+        density += summation_term(prm, mj, walk)
+        gw = kernel_gradient(prm, walk.r, walk.r2)
+        gm = mj * gw
+        grad_sum += gm
+        if walk.wall == 0:
             grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
-            if count < capacity:
-                pair_index[i, count] = j
-                pair_grad[i, count] = gw
-                pair_mass_grad[i, count] = gm
-            count += 1
-        for kk in range(b_cell_start[cell], b_cell_end[cell]):
-            b = b_order[kk]
-            r = xi - bx[b]
-            r2 = wp.dot(r, r)
-            if r2 >= support2 or r2 < 1.0e-24:
-                continue
-            mw = prm.rest_density * b_volume[b]
-            density += mw * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-            gw = kernel_gradient(prm, r, r2)
-            gm = mw * gw
-            grad_sum += gm
-            if count < capacity:
-                pair_index[i, count] = wall_pair(b)
-                pair_grad[i, count] = gw
-                pair_mass_grad[i, count] = gm
-            count += 1
+        if count < capacity:
+            pair_index[i, count] = pair_code(walk)
+            pair_grad[i, count] = gw
+            pair_mass_grad[i, count] = gm
+        count += 1
+        walk = next_neighbor(nb, walk)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
@@ -358,9 +330,8 @@ def wall_density_rate(
     return rate
 
 
-@wp.kernel
+@item_kernel
 def apply_stiffness(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # State in
     increment: wp.array(dtype=float),
     increment_per_rho: wp.array(dtype=float),
@@ -379,7 +350,7 @@ def apply_stiffness(
     which the stage that set the increments wrote); kappa_i += k_i. The first iteration of a solve applies its warm
     start; once a solve has converged, the increments its last iteration measured are not applied (the loop ends
     before this stage)."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if active[i] == 0:
         return
     ki = increment_per_rho[i]
@@ -396,9 +367,8 @@ def apply_stiffness(
     kappa[i] = kappa[i] + increment[i]
 
 
-@wp.kernel
+@item_kernel
 def compute_solve_error(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     mode: int,
@@ -421,7 +391,7 @@ def compute_solve_error(
     dt Drho/Dt; only compression: e_i >= 0), its next stiffness increment omega e_i alpha_i / dt^2 (omega:
     ``prm.jacobi_relaxation``, 1 unless the support holds so many neighbours that plain Jacobi would diverge) and the
     error sum."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if active[i] == 0:
         increment[i] = 0.0
         increment_per_rho[i] = 0.0
@@ -482,24 +452,16 @@ def check_convergence(
     diag_i[s, it_col] = int(iterations)
 
 
-@wp.kernel
+@item_kernel
 def compute_wall_density_factor(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
-    g: GridSpec,
     b_volume: wp.array(dtype=float),
     b_wetted: wp.array(dtype=wp.int32),
     capacity: int,
     # State in
-    x: wp.array(dtype=wp.vec3),
+    nb: Neighborhood,
     mass: wp.array(dtype=float),
-    cell_start: wp.array(dtype=wp.int32),
-    cell_end: wp.array(dtype=wp.int32),
-    bx: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    b_cell_start: wp.array(dtype=wp.int32),
-    b_cell_end: wp.array(dtype=wp.int32),
     row: wp.array(dtype=wp.int32),
     # Out
     b_rho: wp.array(dtype=float),
@@ -515,35 +477,28 @@ def compute_wall_density_factor(
     rho0 V_b' W_bb') / s, its factor alpha_b = rho_b / sum_j m_j rho0 V_b |grad W_bj|^2 (the density change its
     stiffness causes by pushing its liquid neighbours away; bounded below as the liquid's) and its list of liquid
     neighbours with m grad_b W. Other wall particles carry no stiffness (rho_b = rho0, no pairs)."""
-    b = lane_item(wp.tid(), lane)
+    b = wp.tid()
     b_pair_count[b] = 0
     b_rho[b] = prm.rest_density
     b_alpha[b] = 0.0
     if b_wetted[b] == 0:
         return
-    xb = bx[b]
     mb = prm.rest_density * b_volume[b]
-    support2 = prm.support * prm.support
     density = mb * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     grad_sq = float(0.0)
     count = int(0)
-    cells = neighbor_cells(g, xb)
-    for k_cell in range(cells.count):
-        cell = block_cell(g, cells, k_cell)
-        for j in range(cell_start[cell], cell_end[cell]):
-            r = xb - x[j]
-            r2 = wp.dot(r, r)
-            if r2 >= support2 or r2 < 1.0e-24:
-                continue
-            mj = mass[j]
-            density += mj * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-            gw = kernel_gradient(prm, r, r2)
+    walk = first_neighbor(nb, nb.bx[b], prm.support)
+    while walk.index >= 0:
+        mj = neighbor_mass(prm, mass, b_volume, walk)
+        density += summation_term(prm, mj, walk)
+        if walk.wall == 0:
+            gw = kernel_gradient(prm, walk.r, walk.r2)
             grad_sq += mj * mb * wp.dot(gw, gw)
             if count < capacity:
-                b_pair_index[b, count] = j
+                b_pair_index[b, count] = walk.index
                 b_pair_mass_grad[b, count] = mj * gw
             count += 1
-        density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xb, density)
+        walk = next_neighbor(nb, walk)
     if count == 0:
         return
     if count > capacity:
@@ -555,9 +510,8 @@ def compute_wall_density_factor(
     wp.atomic_add(solve_stats, stat_slot(prm, b, STAT_COUNT), wp.int64(1))
 
 
-@wp.kernel
+@item_kernel
 def start_wall_solve(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     warm_start: float,
     warm_start_applied: int,
     # State in
@@ -573,16 +527,15 @@ def start_wall_solve(
     the stiffness when its first iteration has applied it (:func:`compute_wall_solve_error`); with
     ``warm_start_applied`` (the Gauss-Seidel density solve, whose warm start is applied before its sweeps) it
     counts from here."""
-    b = lane_item(wp.tid(), lane)
+    b = wp.tid()
     warm = warm_start * b_kappa[b]
     b_increment[b] = warm
     b_increment_per_rho[b] = warm / b_rho[b]
     b_kappa[b] = wp.where(warm_start_applied != 0, warm, 0.0)
 
 
-@wp.kernel
+@item_kernel
 def compute_wall_solve_error(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     mode: int,
@@ -604,7 +557,7 @@ def compute_wall_solve_error(
     """The wall layer's side of one iteration: adds the increment the liquid just received from it to its
     stiffness, then its remaining error e_b (dt Drho_b/Dt, plus rho_b - rho0 in the density solve; compression
     only), with Drho_b/Dt = sum_j m_j (v_b - v_j) . grad W_bj, and its next increment omega e_b alpha_b / dt^2."""
-    b = lane_item(wp.tid(), lane)
+    b = wp.tid()
     b_kappa[b] = b_kappa[b] + b_increment[b]
     n = b_pair_count[b]
     if n == 0:
@@ -727,9 +680,8 @@ def task_cell(g: GridSpec, n: int, t: int, keys: wp.array(dtype=wp.int32), b_key
     return cell
 
 
-@wp.kernel
+@item_kernel
 def list_sweep_cells(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     g: GridSpec,
     n: int,
@@ -749,7 +701,7 @@ def list_sweep_cells(
     their colours (:func:`cell_color`): the thread takes every threads-th of the ``items`` items and the cells they
     start (:func:`task_cell`). Listed once per substep, so that each colour's launch visits its own cells instead of
     testing every item (for a colour with few cells, the test would be most of its launch)."""
-    thread = lane_item(wp.tid(), lane)
+    thread = wp.tid()
     count = int(0)
     for t in range(thread, items, threads):
         cell = task_cell(g, n, t, keys, b_keys, cell_start, cell_end)
@@ -760,9 +712,8 @@ def list_sweep_cells(
     sweep_count[thread] = count
 
 
-@wp.kernel
+@item_kernel
 def gauss_seidel_density_sweep(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     color: int,
@@ -804,7 +755,7 @@ def gauss_seidel_density_sweep(
     h = dt[0]
     total = wp.int64(0)
     worst = wp.int64(0)
-    thread = lane_item(wp.tid(), lane)
+    thread = wp.tid()
     for k in range(sweep_count[thread]):
         if sweep_color[thread, k] != color:
             continue
@@ -830,9 +781,8 @@ def wall_pair_viscosity(prm: SPHParams, alpha: float, volume: float, r: wp.vec3,
     return viscous_pair(prm, alpha, prm.rest_density * volume, r, r2, gw, v_rel, v_rel, rho_i, prm.rest_density)
 
 
-@wp.kernel
+@item_kernel
 def compute_nonpressure(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     b_volume: wp.array(dtype=float),
@@ -862,7 +812,7 @@ def compute_nonpressure(
 ):
     """v* = v + dt (g + viscosity) over the substep's pair list (walls: their own velocity, rest density;
     :func:`wall_pair_viscosity`); the density solve's warm start (and it over rho) and counters."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)
         keep_going[0] = 1
@@ -896,9 +846,8 @@ def compute_nonpressure(
     wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_ACCEL, wp.length(a))
 
 
-@wp.kernel
+@item_kernel
 def compute_wall_reaction(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -935,7 +884,7 @@ def compute_wall_reaction(
     centre of mass. Also adds this substep's share (``substep_weight`` = 1 / substeps of the interval) of the
     reported pressure p_i = rho_i kappa_i (Pa): the pressure is the interval's average, as the wrenches are (one
     substep's stiffness is the multiplier of that substep's residual, noisy from substep to substep)."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
@@ -961,9 +910,8 @@ def compute_wall_reaction(
         add_wall_reaction(prm, vessels, motions, b_vessel[b], i, xb, ab, wall_force, wall_torque)
 
 
-@wp.kernel
+@item_kernel
 def integrate(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -990,7 +938,7 @@ def integrate(
     diag_i: wp.array2d(dtype=wp.int32),
 ):
     """x += dt v* (the velocity both solves corrected), then the shared guard, deactivation and diagnostics."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if active[i] == 0:
         return
     x_old = x[i]

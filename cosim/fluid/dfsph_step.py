@@ -77,10 +77,9 @@ def compute_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
     """Summation density (held to the seeded offset or free), the DFSPH factor, the substep's pair list, and the
     divergence solve's warm start and counters."""
     rec.launch(
-        dfsph.compute_density_factor, m.n_particles, prm=m.params, g=m.grid.spec, vessels=m.vessels, b_volume=m.b_volume,
-        capacity=sh.pair_capacity, free_liquid=int(m.config.free_liquid), motions=sh.motions, x=st.x, active=st.active, mass=st.mass,
-        cell_start=m.grid.cell_start, cell_end=m.grid.cell_end, bx=sh.bx, b_order=m.b_grid.order, b_cell_start=m.b_grid.cell_start,
-        b_cell_end=m.b_grid.cell_end, row=sh.row, kappa_divergence=st.kappa_divergence, free=st.free, rest_offset=st.rest_offset,
+        dfsph.compute_density_factor, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume,
+        capacity=sh.pair_capacity, free_liquid=int(m.config.free_liquid), motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active,
+        mass=st.mass, row=sh.row, kappa_divergence=st.kappa_divergence, free=st.free, rest_offset=st.rest_offset,
         rho=st.rho, alpha=sc.alpha, increment=sc.increment, increment_per_rho=sc.increment_per_rho,
         pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, pair_mass_grad=sc.pair_mass_grad,
         solve_stats=sc.lane_stats, keep_going=sc.keep_going, diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
@@ -90,9 +89,8 @@ def compute_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
 def compute_wall_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: DFSPHScratch) -> None:
     """The wall layer's summation density, factor and list of liquid neighbours."""
     rec.launch(
-        dfsph.compute_wall_density_factor, m.n_boundary, prm=m.params, g=m.grid.spec, b_volume=m.b_volume, b_wetted=m.b_wetted,
-        capacity=sh.pair_capacity, x=st.x, mass=st.mass, cell_start=m.grid.cell_start, cell_end=m.grid.cell_end, bx=sh.bx,
-        b_order=m.b_grid.order, b_cell_start=m.b_grid.cell_start, b_cell_end=m.b_grid.cell_end, row=sh.row, b_rho=sc.b_rho, b_alpha=sc.b_alpha,
+        dfsph.compute_wall_density_factor, m.n_boundary, prm=m.params, b_volume=m.b_volume, b_wetted=m.b_wetted,
+        capacity=sh.pair_capacity, nb=sh.neighborhood(m, st), mass=st.mass, row=sh.row, b_rho=sc.b_rho, b_alpha=sc.b_alpha,
         b_pair_count=sc.b_pair_count, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
         solve_stats=sc.lane_stats, diag_i=sh.diagnostics.lane_i,
     )

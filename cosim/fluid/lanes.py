@@ -2,7 +2,7 @@
 own the solver leaves every other core idle.
 
 Each lane launches the particle kernels over its own share of the particles (chunks dealt out in turn,
-:func:`lane_item`; the kernels take their lane as first argument) and every lane waits for the others between stages
+:func:`lane_item`) and every lane waits for the others between stages
 (:func:`barrier_wait`, a barrier in native code inside the captured graph that spins briefly, then sleeps), so each
 lane's substep is one graph of warp's CPU operation stream that its own thread replays. The split changes no result:
 every kernel computes each particle as before, and what the lanes accumulate together (the solves' error sums, the
@@ -14,16 +14,20 @@ the lanes' shares run one after the other on the calling thread.
 
 A stage is the unit between two barriers: :class:`Stage` (the operations each lane runs) or :class:`Loop` (a
 ``wp.capture_while`` loop of stages on a device flag); the stage functions of the physics record them without
-knowing of lanes (``cosim.fluid.program``).
+knowing of lanes (``cosim.fluid.program``). Nor do the kernels: a kernel of independent items is declared
+:func:`item_kernel`, its body computes item ``wp.tid()``, and the split is compiled in from outside.
 """
 
 from __future__ import annotations
 
+import ast
 import ctypes
 import functools
+import inspect
 import os
 import platform
 import sys
+import textwrap
 import threading
 import time
 import weakref
@@ -157,6 +161,41 @@ def lane_item(tid: int, lane: wp.vec2i) -> int:
     """The item the ``tid``-th thread of lane ``lane[0]`` of ``lane[1]`` computes: the items are dealt out to the
     lanes in turn in chunks of :data:`LANE_CHUNK`."""
     return ((tid // LANE_CHUNK) * lane[1] + lane[0]) * LANE_CHUNK + tid % LANE_CHUNK
+
+
+class _ItemOfLane(ast.NodeTransformer):
+    """A kernel's function definition rewritten for a share of its items: a first parameter ``lane`` (wp.vec2i:
+    the launch's lane, lane count) and every ``wp.tid()`` read through ``lane_item``."""
+
+    def visit_FunctionDef(self, node: ast.FunctionDef) -> ast.FunctionDef:
+        node.decorator_list = []
+        node.args.args.insert(0, ast.arg("lane", annotation=ast.Attribute(ast.Name("wp", ast.Load()), "vec2i", ast.Load())))
+        self.generic_visit(node)
+        return node
+
+    def visit_Call(self, node: ast.Call) -> ast.AST:
+        self.generic_visit(node)
+        tid = node.func
+        if isinstance(tid, ast.Attribute) and tid.attr == "tid" and isinstance(tid.value, ast.Name) and tid.value.id == "wp":
+            return ast.Call(ast.Name("lane_item", ast.Load()), [node, ast.Name("lane", ast.Load())], [])
+        return node
+
+
+def item_kernel(func):
+    """``@wp.kernel`` for a one-dimensional kernel whose threads compute independent items (particles, wall
+    particles, sweep threads), which :meth:`cosim.fluid.program.Recorder.launch` splits over the lanes: in its body
+    ``wp.tid()`` is the item. It is compiled from its own source with a first parameter ``lane`` (the launch's lane,
+    lane count), which the recorder supplies (one lane of one on CUDA), and each ``wp.tid()`` read as
+    ``lane_item(wp.tid(), lane)`` (:func:`lane_item`): the physics never names the lanes, and computes each item as
+    a plain kernel would. (warp cannot add a parameter to a kernel from outside, nor offset or stride its thread
+    index at launch, so the split is compiled in; the generated code is that of the same kernel written with the
+    ``lane`` parameter by hand.)"""
+    source = ast.unparse(ast.fix_missing_locations(_ItemOfLane().visit(ast.parse(textwrap.dedent(inspect.getsource(func))))))
+    # the kernel's function defined in its own module's namespace, with lane_item from here as a closure variable
+    factory = f"def define_kernel(lane_item):\n{textwrap.indent(source, '    ')}\n    return {func.__name__}\n"
+    scope: dict = {}
+    exec(compile(factory, inspect.getsourcefile(func), "exec"), func.__globals__, scope)
+    return wp.Kernel(scope["define_kernel"](lane_item), key=func.__name__, module=wp.get_module(func.__module__), source=source)
 
 
 def lane_sizes(count: int, lanes: int) -> list[int]:

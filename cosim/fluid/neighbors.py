@@ -11,6 +11,11 @@ The cell ranges must be reset before each build. :attr:`GridReset.OCCUPIED` clea
 build occupied (from its sorted keys): O(points), so the grid costs what the region holding the liquid (or the
 walls) needs, however large the domain. :attr:`GridReset.WHOLE` clears every cell of the domain: O(cells). Both
 leave the same ranges, so the neighbour lists, and every result, are identical.
+
+Every SPH sum over neighbours is one walk (:func:`first_neighbor`, :func:`next_neighbor`, in the manner of warp's
+``hash_grid_query``/``hash_grid_query_next``) over a :class:`Neighborhood`, the liquid and the wall particles in one
+grid: the walk owns the order of the cells, the liquid before the walls in each cell, and the support test, so
+every kernel adds its terms in the same order and only says what a neighbour contributes.
 """
 
 from __future__ import annotations
@@ -76,19 +81,137 @@ def neighbor_cells(g: GridSpec, x: wp.vec3) -> CellBlock:
 
 @wp.func
 def block_cell(g: GridSpec, block: CellBlock, k: int) -> int:
-    """Grid index of the k-th cell of ``block`` (0 <= k < ``block.count``), x fastest, then y, then z: every
-    neighbour loop visits the cells, and so sums its neighbours, in this one order. The neighbour loop reads
-
-        cells = neighbor_cells(g, x)
-        for k in range(cells.count):
-            cell = block_cell(g, cells, k)
-            for j in range(cell_start[cell], cell_end[cell]): ..."""
+    """Grid index of the k-th cell of ``block`` (0 <= k < ``block.count``), x fastest, then y, then z: the
+    neighbour walk (:func:`first_neighbor`) visits the cells, and so sums the neighbours, in this one order."""
     sx = block.size[0]
     sy = block.size[1]
     cx = block.first[0] + k % sx
     cy = block.first[1] + (k // sx) % sy
     cz = block.first[2] + k // (sx * sy)
     return grid_index(g, cx, cy, cz)
+
+
+@wp.struct
+class Neighborhood:
+    """The liquid and the wall particles sorted into one cell grid ``spec``, as the neighbour walk reads them: the
+    liquid in cell order (``x``, m; ``cell_start``/``cell_end``: each cell's range of it), the wall particles by
+    indirection (``b_order``: their indices in cell order; ``b_cell_start``/``b_cell_end``: each cell's range of
+    ``b_order``; ``bx``, m)."""
+
+    spec: GridSpec
+    cell_start: wp.array(dtype=wp.int32)
+    cell_end: wp.array(dtype=wp.int32)
+    x: wp.array(dtype=wp.vec3)
+    b_order: wp.array(dtype=wp.int32)
+    b_cell_start: wp.array(dtype=wp.int32)
+    b_cell_end: wp.array(dtype=wp.int32)
+    bx: wp.array(dtype=wp.vec3)
+
+
+@wp.struct
+class NeighborWalk:
+    """A walk over the neighbours of the point ``x``: every liquid particle, and with ``walls`` every wall
+    particle, at a squared distance r2 with ``min_r2`` <= r2 < ``radius2``, cell by cell in :func:`block_cell`'s
+    order, in each cell the liquid first (in cell order), then the wall particles (in cell order). Where it stands:
+    the neighbour ``index`` (a liquid particle, or with ``wall`` 1 a wall particle; -1 once the walk is done), its
+    offset ``r`` = x - x_neighbour (m) and ``r2`` = r . r; and, for the next step, the block of cells, the open
+    cell ``k`` and its range [``item``, ``end``) of the liquid (``wall`` 0) or of ``b_order`` (``wall`` 1)."""
+
+    x: wp.vec3
+    radius2: float
+    min_r2: float
+    walls: int
+    cells: CellBlock
+    k: int
+    cell: int
+    wall: int
+    item: int
+    end: int
+    index: int
+    r: wp.vec3
+    r2: float
+
+
+# Below this squared distance (m^2) a point is taken to be at x itself (the particle whose neighbours are walked),
+# where the pair's direction is undefined
+COINCIDENT_R2 = wp.constant(1.0e-24)
+
+
+@wp.func
+def next_neighbor(nb: Neighborhood, walk: NeighborWalk) -> NeighborWalk:
+    """The walk advanced to its next neighbour (``index`` -1 once there is none)."""
+    w = walk
+    while True:
+        if w.item < w.end:
+            item = w.item
+            w.item = item + 1
+            index = item
+            p = wp.vec3(0.0)
+            if w.wall == 0:
+                p = nb.x[item]
+            else:
+                index = nb.b_order[item]
+                p = nb.bx[index]
+            r = w.x - p
+            r2 = wp.dot(r, r)
+            if not (r2 >= w.radius2 or r2 < w.min_r2):
+                w.index = index
+                w.r = r
+                w.r2 = r2
+                return w
+        elif w.wall == 0 and w.walls != 0 and w.k >= 0:
+            w.wall = 1
+            w.item = nb.b_cell_start[w.cell]
+            w.end = nb.b_cell_end[w.cell]
+        elif w.k + 1 < w.cells.count:
+            w.k = w.k + 1
+            w.cell = block_cell(nb.spec, w.cells, w.k)
+            w.wall = 0
+            w.item = nb.cell_start[w.cell]
+            w.end = nb.cell_end[w.cell]
+        else:
+            w.index = -1
+            return w
+
+
+@wp.func
+def start_walk(nb: Neighborhood, x: wp.vec3, radius: float, walls: int, min_r2: float) -> NeighborWalk:
+    """The walk over the neighbours of ``x`` within ``radius`` (m), the wall particles too where ``walls`` != 0,
+    none nearer than sqrt(``min_r2``), standing at its first neighbour."""
+    w = NeighborWalk()
+    w.x = x
+    w.radius2 = radius * radius
+    w.min_r2 = min_r2
+    w.walls = walls
+    w.cells = neighbor_cells(nb.spec, x)
+    w.k = -1
+    w.cell = -1
+    w.wall = 0
+    w.item = 0
+    w.end = 0
+    w.index = -1
+    w.r = wp.vec3(0.0)
+    w.r2 = 0.0
+    return next_neighbor(nb, w)
+
+
+@wp.func
+def first_neighbor(nb: Neighborhood, x: wp.vec3, radius: float) -> NeighborWalk:
+    """The walk over the liquid and wall neighbours of the particle at ``x`` within ``radius`` (m), the particle
+    itself left out (:data:`COINCIDENT_R2`), standing at the first. Every neighbour loop reads
+
+        walk = first_neighbor(nb, x, radius)
+        while walk.index >= 0:
+            ... walk.index, walk.wall, walk.r, walk.r2 ...
+            walk = next_neighbor(nb, walk)"""
+    return start_walk(nb, x, radius, 1, COINCIDENT_R2)
+
+
+@wp.func
+def first_liquid_neighbor(nb: Neighborhood, x: wp.vec3, radius: float) -> NeighborWalk:
+    """The walk over the liquid within ``radius`` (m) of a point that is not a liquid particle (a wall
+    particle's), every liquid particle counted however near, standing at the first."""
+    return start_walk(nb, x, radius, 0, 0.0)
 
 
 @wp.kernel
@@ -215,3 +338,18 @@ class CellGrid:
         """Sort the first ``n`` points by cell and record the cell ranges (one-off; loops use build_commands)."""
         for op in self.build_commands(x, active, n):
             op()
+
+
+def neighborhood(grid: CellGrid, x: wp.array, wall_grid: CellGrid, bx: wp.array) -> Neighborhood:
+    """The :class:`Neighborhood` of the liquid at ``x`` (in the cell order of ``grid``) and of the wall particles
+    at ``bx`` (sorted by ``wall_grid``, which must have the same cells)."""
+    nb = Neighborhood()
+    nb.spec = grid.spec
+    nb.cell_start = grid.cell_start
+    nb.cell_end = grid.cell_end
+    nb.x = x
+    nb.b_order = wall_grid.order
+    nb.b_cell_start = wall_grid.cell_start
+    nb.b_cell_end = wall_grid.cell_end
+    nb.bx = bx
+    return nb

@@ -7,8 +7,9 @@ buffer parity records it as a program of stages with the arguments bound (:class
 :class:`cosim.fluid.lanes.Loop`), which ``cosim.fluid.runner`` runs operation by operation, captures as graphs or
 replays on CPU threads: the stage functions know nothing of either.
 
-A particle kernel is launched with :meth:`Recorder.launch`: the recorder splits its items over the CPU lanes
-(``cosim.fluid.lanes``; the kernel's first parameter, ``lane``, is supplied here) and puts a barrier after it. A
+A particle kernel (``cosim.fluid.lanes.item_kernel``) is launched with :meth:`Recorder.launch`: the recorder splits
+its items over the CPU lanes (``cosim.fluid.lanes``; the kernel's ``lane`` parameter, which the decorator adds, is
+supplied here) and puts a barrier after it. A
 bookkeeping kernel of a few threads runs on one lane (:meth:`Recorder.launch_on_lane`), so do warp's memsets and
 sorts (:meth:`Recorder.call`). Stages recorded inside :meth:`Recorder.together` share their barriers; inside
 :meth:`Recorder.loop` they repeat while a device flag is set (``wp.capture_while``).
@@ -35,8 +36,8 @@ class Recorder:
         self._group: list[Stage] | None = None  # the stages of an open together()
 
     def launch(self, kernel, items: int, /, **args: Any) -> None:
-        """``kernel`` over ``items`` items, each lane its share (``cosim.fluid.lanes.lane_item``); ``args`` by the
-        kernel's parameter names, a :class:`PerLane` value giving each lane its own."""
+        """``kernel`` (an ``item_kernel``) over ``items`` items, each lane its share (``cosim.fluid.lanes.lane_item``);
+        ``args`` by the kernel's parameter names, a :class:`PerLane` value giving each lane its own."""
         parts = []
         for lane, size in enumerate(lane_sizes(items, self.lanes.count)):
             if size == 0:

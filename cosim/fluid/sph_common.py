@@ -1,4 +1,5 @@
-"""Warp functions and kernels both pressure solvers share: the pair kernel gradient, the viscous pair terms, the
+"""Warp functions and kernels both pressure solvers share: what a walked neighbour brings into the sums (its mass,
+its share of the summation density, its pair-list code), the pair kernel gradient, the viscous pair terms, the
 end of a particle's substep (wall guard, deactivation outside the domain, the substep's common diagnostics), the
 reorder of the particle state into cell order and the fixed-order reduction of the wall wrenches."""
 
@@ -20,7 +21,8 @@ from cosim.fluid.diagnostics import (
     DIAG_MAX_SPEED,
     DIAG_NONFINITE,
 )
-from cosim.fluid.lanes import lane_item
+from cosim.fluid.lanes import item_kernel
+from cosim.fluid.neighbors import NeighborWalk
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_dw, kernel_w
 
@@ -58,30 +60,6 @@ def next_free_state(free_now: int, inside: bool, summation: float, rest_density:
 
 
 @wp.func
-def add_wall_density(
-    prm: SPHParams,
-    b_volume: wp.array(dtype=float),
-    bx: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    start: int,
-    end: int,
-    x: wp.vec3,
-    density: float,
-) -> float:
-    """``density`` (kg/m^3) plus the summation density sum_b rho0 V_b W(x - x_b) of the wall particles of one grid
-    cell (``b_order[start:end]``; a wall particle at x itself excluded), added one by one in cell order."""
-    support2 = prm.support * prm.support
-    for kk in range(start, end):
-        b = b_order[kk]
-        r = x - bx[b]
-        r2 = wp.dot(r, r)
-        if r2 >= support2 or r2 < 1.0e-24:
-            continue
-        density += prm.rest_density * b_volume[b] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-    return density
-
-
-@wp.func
 def wall_pair(b: int) -> int:
     """Pair-list code of wall particle b (fluid neighbours are stored as their index j >= 0)."""
     return -1 - b
@@ -91,6 +69,28 @@ def wall_pair(b: int) -> int:
 def pair_wall(j: int) -> int:
     """The wall particle of pair-list code j < 0 (the inverse of :func:`wall_pair`)."""
     return -1 - j
+
+
+@wp.func
+def pair_code(walk: NeighborWalk) -> int:
+    """The pair-list code of the neighbour a walk stands at: liquid particle j itself, wall particle b as
+    :func:`wall_pair`."""
+    return wp.where(walk.wall == 0, walk.index, wall_pair(walk.index))
+
+
+@wp.func
+def neighbor_mass(prm: SPHParams, mass: wp.array(dtype=float), b_volume: wp.array(dtype=float), walk: NeighborWalk) -> float:
+    """The mass the neighbour a walk stands at brings into the SPH sums (kg, or kg/m in 2-D): its own m_j for a
+    liquid particle, rho0 V_b for a wall particle (the liquid it stands for)."""
+    if walk.wall == 0:
+        return mass[walk.index]
+    return prm.rest_density * b_volume[walk.index]
+
+
+@wp.func
+def summation_term(prm: SPHParams, m_pair: float, walk: NeighborWalk) -> float:
+    """The neighbour's share m W(|r|) of the summation density (kg/m^3), ``m_pair`` from :func:`neighbor_mass`."""
+    return m_pair * kernel_w(wp.sqrt(walk.r2), prm.inv_h, prm.sigma, prm.kernel)
 
 
 @wp.func
@@ -240,9 +240,8 @@ def diag_slot(prm: SPHParams, row: int, i: int) -> int:
     return row * prm.atomic_replicas + i % prm.atomic_replicas
 
 
-@wp.kernel
+@item_kernel
 def gather_particles(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     order: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec3),
     v: wp.array(dtype=wp.vec3),
@@ -268,7 +267,7 @@ def gather_particles(
     mass_out: wp.array(dtype=float),
 ):
     """Reorder the particle state into cell order (``order`` from the neighbour grid)."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     src = order[i]
     x_out[i] = x[src]
     v_out[i] = v[src]

@@ -28,6 +28,7 @@ from cosim.fluid.device_layout import DeviceLayout, ReductionLevel, reduction_le
 from cosim.fluid.diagnostics import DiagnosticBuffers
 from cosim.fluid.lanes import Lanes
 from cosim.fluid.model import FluidModel, FluidState
+from cosim.fluid.neighbors import Neighborhood, neighborhood
 from cosim.fluid.program import Recorder
 from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, pair_capacity, sum_wall_wrench_chunks
 from cosim.frames import Pose
@@ -100,6 +101,11 @@ class SubstepScratch:
         """(V, 6): each vessel's force (N) and torque (N m) summed over the interval, over ``substeps``."""
         wrench = np.concatenate(self._wrench_views or (self.force_sum.numpy(), self.torque_sum.numpy()), axis=1)[:n_vessels]
         return wrench.astype(np.float64) * (1.0 / substeps)
+
+    def neighborhood(self, model: FluidModel, st: FluidState) -> Neighborhood:
+        """The liquid of ``st`` and the wall particles in the model's cell grids, as the neighbour walk reads them
+        (``cosim.fluid.neighbors.first_neighbor``)."""
+        return neighborhood(model.grid, st.x, model.b_grid, self.bx)
 
     def guard_args(self, model: FluidModel) -> dict:
         """The arguments both solvers' integrate kernels take for the shared end of a particle's substep

@@ -32,20 +32,21 @@ import warp as wp
 
 from cosim.fluid.boundary import VesselGeometry, VesselMotion
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
-from cosim.fluid.lanes import lane_item
-from cosim.fluid.neighbors import GridSpec, block_cell, neighbor_cells
+from cosim.fluid.lanes import item_kernel
+from cosim.fluid.neighbors import Neighborhood, first_neighbor, next_neighbor
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
-    add_wall_density,
     add_wall_reaction,
     diag_slot,
     finish_particle,
     inside_any_vessel,
     kernel_gradient,
+    neighbor_mass,
     next_free_state,
+    pair_code,
     pair_wall,
+    summation_term,
     viscous_pair,
-    wall_pair,
 )
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -82,25 +83,17 @@ def tait_internal_energy(prm: SPHParams, rho: float) -> float:
     return tait_elastic_energy(prm, rt) + prm.max_tension * (1.0 / rho - 1.0 / rt)
 
 
-@wp.kernel
+@item_kernel
 def update_free_liquid(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
-    g: GridSpec,
     vessels: wp.array(dtype=VesselGeometry),
     b_volume: wp.array(dtype=float),
     # State in
     motions: wp.array(dtype=VesselMotion),
-    x: wp.array(dtype=wp.vec3),
+    nb: Neighborhood,
     active: wp.array(dtype=wp.int32),
     mass: wp.array(dtype=float),
-    cell_start: wp.array(dtype=wp.int32),
-    cell_end: wp.array(dtype=wp.int32),
-    bx: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    b_cell_start: wp.array(dtype=wp.int32),
-    b_cell_end: wp.array(dtype=wp.int32),
     # State in/out
     free: wp.array(dtype=wp.int32),
     rho: wp.array(dtype=float),
@@ -116,25 +109,18 @@ def update_free_liquid(
     the vessel it left). It becomes bound when its summation density reaches rho0 inside a
     vessel; the continuity equation then continues from that density, so the pressure is continuous and the
     caught liquid keeps no memory of the loose packing it arrived in."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if active[i] == 0:
         return
-    xi = x[i]
+    xi = nb.x[i]
     inside = inside_any_vessel(prm, vessels, motions, xi)
     if inside and free[i] == 0:
         return
-    support2 = prm.support * prm.support
     density = mass[i] * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
-    cells = neighbor_cells(g, xi)
-    for k_cell in range(cells.count):
-        cell = block_cell(g, cells, k_cell)
-        for j in range(cell_start[cell], cell_end[cell]):
-            r = xi - x[j]
-            r2 = wp.dot(r, r)
-            if r2 >= support2 or r2 < 1.0e-24:
-                continue
-            density += mass[j] * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-        density = add_wall_density(prm, b_volume, bx, b_order, b_cell_start[cell], b_cell_end[cell], xi, density)
+    walk = first_neighbor(nb, xi, prm.support)
+    while walk.index >= 0:
+        density += summation_term(prm, neighbor_mass(prm, mass, b_volume, walk), walk)
+        walk = next_neighbor(nb, walk)
     density = density / prm.lattice_density
     state = next_free_state(free[i], inside, density, prm.rest_density)
     if free[i] == 0 and state == 0:
@@ -147,34 +133,26 @@ def update_free_liquid(
     p[i] = tait_pressure(prm, rhoi)
 
 
-@wp.kernel
+@item_kernel
 def compute_forces(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
-    g: GridSpec,
     vessels: wp.array(dtype=VesselGeometry),
     b_volume: wp.array(dtype=float),
     b_vessel: wp.array(dtype=wp.int32),
     # State in
     motions: wp.array(dtype=VesselMotion),
-    x: wp.array(dtype=wp.vec3),
+    nb: Neighborhood,
     v: wp.array(dtype=wp.vec3),
     rho: wp.array(dtype=float),
     p: wp.array(dtype=float),
     active: wp.array(dtype=wp.int32),
     free: wp.array(dtype=wp.int32),
     mass: wp.array(dtype=float),
-    cell_start: wp.array(dtype=wp.int32),
-    cell_end: wp.array(dtype=wp.int32),
-    bx: wp.array(dtype=wp.vec3),
     bv: wp.array(dtype=wp.vec3),
     b_p: wp.array(dtype=float),
     b_rho: wp.array(dtype=float),
     b_v_noslip: wp.array(dtype=wp.vec3),
-    b_order: wp.array(dtype=wp.int32),
-    b_cell_start: wp.array(dtype=wp.int32),
-    b_cell_end: wp.array(dtype=wp.int32),
     row: wp.array(dtype=wp.int32),
     capacity: int,
     # Out
@@ -194,7 +172,7 @@ def compute_forces(
     the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``:
     grad_i W), in the order of the neighbour loop, which compute_density_rate sums over instead of searching the
     cells again; more than ``capacity`` neighbours count as an overflow, an instability."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
@@ -204,7 +182,7 @@ def compute_forces(
         rho_grad[i] = wp.vec3(0.0)
         return
     count = int(0)
-    xi = x[i]
+    xi = nb.x[i]
     vi = v[i]
     rhoi = rho[i]
     pi_term = p[i] / (rhoi * rhoi)
@@ -213,50 +191,37 @@ def compute_forces(
     pi_wall_term = wp.max(p[i], 0.0) / (rhoi * rhoi)
     free_i = free[i]
     alpha_wall = wp.where(free_i != 0, prm.alpha_free, prm.alpha)
-    support2 = prm.support * prm.support
     a = wp.vec3(0.0)
     moment = wp.mat33(0.0)
     gsum = wp.vec3(0.0)
-    cells = neighbor_cells(g, xi)
-    for k_cell in range(cells.count):
-        cell = block_cell(g, cells, k_cell)
-        for j in range(cell_start[cell], cell_end[cell]):
-            r = xi - x[j]
-            r2 = wp.dot(r, r)
-            if r2 >= support2 or r2 < 1.0e-24:
-                continue
-            gw = kernel_gradient(prm, r, r2)
-            if count < capacity:
-                pair_index[i, count] = j
-                pair_grad[i, count] = gw
-            count += 1
+    walk = first_neighbor(nb, xi, prm.support)
+    while walk.index >= 0:
+        r = walk.r
+        r2 = walk.r2
+        gw = kernel_gradient(prm, r, r2)
+        if count < capacity:
+            pair_index[i, count] = pair_code(walk)
+            pair_grad[i, count] = gw
+        count += 1
+        mj = neighbor_mass(prm, mass, b_volume, walk)
+        if walk.wall == 0:
+            j = walk.index
             vij = vi - v[j]
             rhoj = rho[j]
-            mj = mass[j]
             vol = mj / rhoj
             moment += vol * wp.outer(-r, gw)
             gsum += (vol * (rhoj - rhoi)) * gw
             a -= mj * (pi_term + p[j] / (rhoj * rhoj)) * gw
             alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
             a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
-        for kk in range(b_cell_start[cell], b_cell_end[cell]):
-            b = b_order[kk]
-            xb = bx[b]
-            r = xi - xb
-            r2 = wp.dot(r, r)
-            if r2 >= support2 or r2 < 1.0e-24:
-                continue
-            gw = kernel_gradient(prm, r, r2)
-            if count < capacity:
-                pair_index[i, count] = wall_pair(b)
-                pair_grad[i, count] = gw
-            count += 1
-            mw = prm.rest_density * b_volume[b]
+        else:
+            b = walk.index
             rhob = b_rho[b]
-            ab = -(mw * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
-            ab += viscous_pair(prm, alpha_wall, mw, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
+            ab = -(mj * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
+            ab += viscous_pair(prm, alpha_wall, mj, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
             a += ab
-            add_wall_reaction(prm, vessels, motions, b_vessel[b], i, xb, ab, wall_force, wall_torque)
+            add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
+        walk = next_neighbor(nb, walk)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
@@ -271,9 +236,8 @@ def compute_forces(
     wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_ACCEL, wp.length(a))
 
 
-@wp.kernel
+@item_kernel
 def compute_density_rate(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     b_volume: wp.array(dtype=float),
@@ -298,7 +262,7 @@ def compute_density_rate(
     delta h c0 sum_j V_j [2 (rho_i - rho_j) r_ij . grad W / (r^2 + eta^2) - (<grad rho>_i + <grad rho>_j) . grad W],
     which vanishes for any linear density field (a resting column) and conserves mass between pairs. Sums over
     compute_forces' pair list, in its order (the neighbours have not moved since)."""
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if active[i] == 0:
         drho[i] = 0.0
         return
@@ -327,9 +291,8 @@ def compute_density_rate(
     drho[i] = dr
 
 
-@wp.kernel
+@item_kernel
 def integrate(
-    lane: wp.vec2i,  # (this launch's lane, lane count): which items it computes (cosim.fluid.lanes.lane_item)
     # Model
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
@@ -357,7 +320,7 @@ def integrate(
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
 ):
-    i = lane_item(wp.tid(), lane)
+    i = wp.tid()
     if active[i] == 0:
         return
     s = diag_slot(prm, row[0], i)

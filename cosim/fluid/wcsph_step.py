@@ -47,9 +47,8 @@ def update_free_liquid(rec: Recorder, m: FluidModel, st: FluidState, sh: Substep
     if not m.config.free_liquid:
         return
     rec.launch(
-        wcsph.update_free_liquid, m.n_particles, prm=m.params, g=m.grid.spec, vessels=m.vessels, b_volume=m.b_volume, motions=sh.motions,
-        x=st.x, active=st.active, mass=st.mass, cell_start=m.grid.cell_start, cell_end=m.grid.cell_end,
-        bx=sh.bx, b_order=m.b_grid.order, b_cell_start=m.b_grid.cell_start, b_cell_end=m.b_grid.cell_end, free=st.free, rho=st.rho, p=st.p,
+        wcsph.update_free_liquid, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, motions=sh.motions,
+        nb=sh.neighborhood(m, st), active=st.active, mass=st.mass, free=st.free, rho=st.rho, p=st.p,
     )
 
 
@@ -59,18 +58,17 @@ def extrapolate_wall_state(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
     if not m.n_boundary:
         return
     rec.launch(
-        bd.extrapolate_wall_state, m.n_boundary, prm=m.params, g=m.grid.spec, b_vessel=m.b_vessel, motions=sh.motions, bx=sh.bx, bv=sh.bv,
-        x=st.x, v=st.v, rho=st.rho, p=st.p, cell_start=m.grid.cell_start, cell_end=m.grid.cell_end, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip,
+        bd.extrapolate_wall_state, m.n_boundary, prm=m.params, b_vessel=m.b_vessel, motions=sh.motions, nb=sh.neighborhood(m, st), bv=sh.bv,
+        v=st.v, rho=st.rho, p=st.p, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip,
     )
 
 
 def compute_forces(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: WCSPHScratch) -> None:
     """Each particle's acceleration, its reaction on the vessels, its density gradient and the substep's pair list."""
     rec.launch(
-        wcsph.compute_forces, m.n_particles, prm=m.params, g=m.grid.spec, vessels=m.vessels, b_volume=m.b_volume, b_vessel=m.b_vessel,
-        motions=sh.motions, x=st.x, v=st.v, rho=st.rho, p=st.p, active=st.active, free=st.free, mass=st.mass,
-        cell_start=m.grid.cell_start, cell_end=m.grid.cell_end, bx=sh.bx, bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip,
-        b_order=m.b_grid.order, b_cell_start=m.b_grid.cell_start, b_cell_end=m.b_grid.cell_end, row=sh.row, capacity=sh.pair_capacity,
+        wcsph.compute_forces, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, b_vessel=m.b_vessel,
+        motions=sh.motions, nb=sh.neighborhood(m, st), v=st.v, rho=st.rho, p=st.p, active=st.active, free=st.free, mass=st.mass,
+        bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip, row=sh.row, capacity=sh.pair_capacity,
         acc=sc.acc, rho_grad=sc.rho_grad, wall_force=sh.wall_force, wall_torque=sh.wall_torque,
         pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad,
         diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,

@@ -1,0 +1,115 @@
+"""The neighbour walk (cosim.fluid.neighbors.first_neighbor / next_neighbor) against a brute-force search: it finds
+exactly the points within the radius, in the one order every SPH sum relies on (cell by cell in grid order, in
+each cell the liquid before the wall particles)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import warp as wp
+
+from cosim.fluid.neighbors import CellGrid, Neighborhood, first_liquid_neighbor, first_neighbor, neighborhood, next_neighbor
+
+MAX_FOUND = 64
+DOMAIN = (0.0, 1.0)
+RADIUS = 0.1
+NOT_RECORDED = 2**30  # a slot no neighbour was recorded in
+
+
+@wp.kernel
+def record_walk(nb: Neighborhood, radius: float, liquid_only: int, points: wp.array(dtype=wp.vec3), found: wp.array2d(dtype=wp.int32)):
+    """The neighbours the walk from each point visits, in the order it visits them (liquid particle j as j, wall
+    particle b as -1 - b), after their count in column 0; only neighbours within the radius are recorded."""
+    i = wp.tid()
+    walk = first_neighbor(nb, points[i], radius)
+    if liquid_only != 0:
+        walk = first_liquid_neighbor(nb, points[i], radius)
+    n = int(0)
+    while walk.index >= 0:
+        if n < MAX_FOUND and walk.r2 < radius * radius:
+            found[i, 1 + n] = wp.where(walk.wall == 0, walk.index, -1 - walk.index)
+        n += 1
+        walk = next_neighbor(nb, walk)
+    found[i, 0] = n
+
+
+def sorted_cloud(rng, n: int, dim: int, device) -> tuple[CellGrid, wp.array]:
+    """n random points sorted into a cell grid of one radius per cell (the liquid's layout: cell order)."""
+    x = rng.uniform(*DOMAIN, (n, 3))
+    if dim == 2:
+        x[:, 1] = 0.0
+    grid = CellGrid([DOMAIN[0]] * 3, [DOMAIN[1]] * 3, RADIUS, dim, n, device)
+    ones = wp.ones(n, dtype=wp.int32, device=device)
+    grid.build(wp.array(x, dtype=wp.vec3, device=device), ones, n)
+    x_sorted = wp.array(x[grid.order.numpy()[:n]], dtype=wp.vec3, device=device)
+    grid.build(x_sorted, ones, n)
+    return grid, x_sorted
+
+
+def expected_walk(points, x, bx, b_order, cell_of, b_cell_of, walls: bool, min_r2: float):
+    """Brute force: every point within RADIUS (and at least sqrt(min_r2) away), ordered by (cell, liquid before
+    wall, position in its cell list): (kind, index) pairs, kind 1 for a wall particle."""
+    b_rank = np.empty(len(bx), dtype=int)
+    b_rank[b_order] = np.arange(len(bx))
+    walks = []
+    for p in points:
+        found = []
+        for kind, cloud, cells, rank in ((0, x, cell_of, np.arange(len(x))), (1, bx, b_cell_of, b_rank)):
+            if kind == 1 and not walls:
+                continue
+            d2 = ((p - cloud) ** 2).sum(axis=1)
+            for index in np.flatnonzero((d2 >= min_r2) & (d2 < RADIUS**2)):
+                found.append((cells[index], kind, rank[index], index))
+        walks.append([(kind, int(index)) for _, kind, _, index in sorted(found)])
+    return walks
+
+
+def cell_index(grid: CellGrid, x: np.ndarray) -> np.ndarray:
+    """The grid index of each point's cell, computed in float32 as the kernels do."""
+    spec = grid.spec
+    origin = np.array([spec.origin[0], spec.origin[1], spec.origin[2]], dtype=np.float32)
+    counts = np.array([spec.nx, spec.ny, spec.nz])
+    c = np.clip(np.floor((x.astype(np.float32) - origin) * np.float32(spec.inv_cell)).astype(int), 0, counts - 1)
+    return (c[:, 2] * spec.ny + c[:, 1]) * spec.nx + c[:, 0]
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("liquid_only", [False, True])
+def test_walk_visits_the_points_within_the_radius_in_cell_order(dim, liquid_only):
+    device = "cpu"
+    rng = np.random.default_rng(7 + dim)
+    n = 400 if dim == 2 else 1500
+    grid, x = sorted_cloud(rng, n, dim, device)
+    bx_np = rng.uniform(*DOMAIN, (n // 3, 3))
+    if dim == 2:
+        bx_np[:, 1] = 0.0
+    bx = wp.array(bx_np, dtype=wp.vec3, device=device)
+    wall_grid = CellGrid([DOMAIN[0]] * 3, [DOMAIN[1]] * 3, RADIUS, dim, len(bx_np), device)
+    wall_grid.build(bx, wp.ones(len(bx_np), dtype=wp.int32, device=device), len(bx_np))
+    nb = neighborhood(grid, x, wall_grid, bx)
+
+    x_np = x.numpy().astype(float)
+    # the walk from the liquid particles themselves (each leaves itself out) and from the wall particles
+    # (a wall particle's liquid walk counts a liquid particle put exactly on it)
+    points_np = np.concatenate([x_np[: n // 4], bx_np.astype(np.float32).astype(float)])
+    points_np[-1] = x_np[-1]
+    points = wp.array(points_np, dtype=wp.vec3, device=device)
+    m = len(points_np)
+    found = wp.full((m, 1 + MAX_FOUND), NOT_RECORDED, dtype=wp.int32, device=device)
+    wp.launch(record_walk, m, inputs=[nb, RADIUS, int(liquid_only), points, found], device=device)
+
+    # distances in float32, as the kernel computes them, so that the brute force agrees on points at the radius
+    x32, bx32, points32 = (a.astype(np.float32) for a in (x_np, bx_np, points_np))
+    expected = expected_walk(
+        points32, x32, bx32, wall_grid.order.numpy()[: len(bx_np)], cell_index(grid, x_np), cell_index(grid, bx_np),
+        walls=not liquid_only, min_r2=0.0 if liquid_only else 1.0e-24,
+    )
+    found = found.numpy()
+    count = found[:, 0]
+    assert count.max() <= MAX_FOUND
+    assert count.sum() > 3 * m  # the points have neighbours to find
+    if liquid_only:
+        assert (found[-1, 1 : 1 + count[-1]] == n - 1).any()  # the liquid particle on the last point is counted
+    for k in range(m):
+        codes = found[k, 1 : 1 + count[k]]
+        assert [(1, -1 - c) if c < 0 else (0, c) for c in codes.tolist()] == expected[k], f"point {k}"
