@@ -20,16 +20,18 @@ import mujoco
 import numpy as np
 
 from cosim.coupling.exchange import ROLES
+from cosim.frames import vector_norm
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
 
 
-def rotation_angle(quat_a: np.ndarray, quat_b: np.ndarray) -> float:
-    """rad, the angle of the rotation taking orientation ``quat_a`` to ``quat_b`` (unit quaternions [w, x, y, z])."""
-    inverse, relative = np.empty(4), np.empty(4)
+def rotation_angle(quat_a: np.ndarray, quat_b: np.ndarray, scratch: np.ndarray | None = None) -> float:
+    """rad, the angle of the rotation taking orientation ``quat_a`` to ``quat_b`` (unit quaternions [w, x, y, z]);
+    ``scratch``: (2, 4) floats to work in (None: new ones)."""
+    inverse, relative = np.empty((2, 4)) if scratch is None else scratch
     mujoco.mju_negQuat(inverse, quat_a)
     mujoco.mju_mulQuat(relative, inverse, quat_b)
-    return 2.0 * math.atan2(float(np.linalg.norm(relative[1:])), abs(float(relative[0])))
+    return 2.0 * math.atan2(float(vector_norm(relative[1:])), abs(float(relative[0])))
 
 
 class ArmLoadMonitor:
@@ -44,6 +46,7 @@ class ArmLoadMonitor:
         self.max_position = {role: 0.0 for role in ROLES}  # m
         self.max_rotation = {role: 0.0 for role in ROLES}  # rad
         self.peak_torque = {role: np.zeros(len(scene.arms[role].joints)) for role in ROLES}  # N m
+        self._quaternions = np.empty((2, 4))  # rotation_angle's scratch
 
     def step(self, targets: Mapping[ArmRole, tuple[np.ndarray, np.ndarray | None]]) -> None:
         """Step the twin with ``targets`` (per arm: desired q (n,) rad, qd (n,) rad/s) and update the maxima."""
@@ -55,6 +58,7 @@ class ArmLoadMonitor:
         for role in ROLES:
             arm = scene.arms[role]
             body = arm.vessel_body
-            self.max_position[role] = max(self.max_position[role], float(np.linalg.norm(live.xpos[body] - twin.xpos[body])))
-            self.max_rotation[role] = max(self.max_rotation[role], rotation_angle(twin.xquat[body], live.xquat[body]))
-            np.maximum(self.peak_torque[role], np.abs(live.qfrc_actuator[arm.dof_adr]), out=self.peak_torque[role])
+            self.max_position[role] = max(self.max_position[role], float(vector_norm(live.xpos[body] - twin.xpos[body])))
+            self.max_rotation[role] = max(self.max_rotation[role], rotation_angle(twin.xquat[body], live.xquat[body], self._quaternions))
+            peak = self.peak_torque[role]
+            np.maximum(peak, np.abs(live.qfrc_actuator[arm.dof_adr]), out=peak)
