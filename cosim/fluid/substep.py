@@ -81,8 +81,8 @@ class SubstepScratch:
         if not poses:
             return
         mo = self._motions_view
-        mo["p0"] = mo["p_now"] = mo["p_next"] = [pose.position for pose in poses]
-        mo["r0"] = mo["r_now"] = mo["r_next"] = [pose.rotation for pose in poses]
+        mo["p0"] = mo["p_now"] = mo["p_next"] = np.array([pose.position for pose in poses])  # converted once for the three
+        mo["r0"] = mo["r_now"] = mo["r_next"] = np.array([pose.rotation for pose in poses])
         mo["lin_vel"], mo["ang_vel"], mo["lin_acc"], mo["ang_acc"] = lin_vel, ang_vel, lin_acc, ang_acc
         if self._motions_host is not self.motions:  # copied into the existing array: the recorded launches hold it
             wp.copy(self.motions, self._motions_host)
