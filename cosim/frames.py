@@ -24,8 +24,10 @@ def vector_norm(v) -> np.floating:
 
 
 def quat_wxyz_to_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrix (3, 3) of a unit quaternion [w, x, y, z] (normalised here)."""
-    w, x, y, z = np.asarray(q, dtype=float) / vector_norm(q)
+    """Rotation matrix (3, 3) of a unit quaternion [w, x, y, z] (normalised here). The entries are computed on plain
+    floats (the exchange converts both vessels' quaternions every MuJoCo step, and on numpy scalars each operation
+    costs a dispatch): the same double operations, so the same bits."""
+    w, x, y, z = (np.asarray(q, dtype=float) / vector_norm(q)).tolist()
     return np.array(
         [
             [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],

@@ -124,3 +124,26 @@ def test_a_rated_torque_below_the_need_refuses_the_trajectory_naming_the_joint(r
     with pytest.raises(UnsafeTrajectoryError, match=r"^unsafe trajectory: arm pour_arm, joint elbow, t=[0-9.]+ s: \|required torque\| [0-9.]+ N m above rated_torque [0-9.]+ N m$"):
         check_torques(trajectory, torques, limits)
     assert arm_limits(pour.scene, ArmRole.POUR).joints[2].rated_torque == 150.0
+
+
+def test_vectorised_rotation_angles_are_the_exact_ones_to_round_off():
+    from cosim.coupling.arm_load import rotation_angle, rotation_angles
+
+    rng = np.random.default_rng(0)
+    a = rng.normal(size=(200, 4))
+    a /= np.linalg.norm(a, axis=1)[:, None]
+    b = a + rng.normal(size=(200, 4)) * 10.0 ** rng.uniform(-12, 0, size=(200, 1))  # from 1e-12 rad to large angles
+    b /= np.linalg.norm(b, axis=1)[:, None]
+    exact = np.array([rotation_angle(x, y) for x, y in zip(a, b)])
+    assert np.abs(rotation_angles(a, b) - exact).max() < 1e-14
+
+
+def test_largest_is_the_exact_maximum_where_the_screen_rounds_differently():
+    from cosim.coupling.arm_load import largest
+
+    exact = np.array([1e-4, 3e-4, 3e-4 + 1e-19, 2e-4, np.nan])  # two entries one round-off apart
+    approximate = exact.copy()
+    approximate[1] += 1e-19  # the screen ranks them the other way round
+    approximate[2] -= 1e-19
+    assert largest(approximate, lambda s: float(exact[s])) == exact[2]
+    assert largest(np.full(3, np.nan), lambda s: float("nan")) == 0.0

@@ -134,6 +134,17 @@ def collect_rim_crossing(
         crossing_x[slot] = xi[0]
 
 
+def _packed_scalar(value: object) -> tuple | None:
+    """A launch argument that is a plain int or float as (type, its exact value), to compare with the one a recorded
+    launch holds (a float by its hex digits, so that 0.0 and -0.0 differ); None for anything else (packed every
+    time)."""
+    if type(value) is int:
+        return (int, value)
+    if type(value) is float:
+        return (float, value.hex())
+    return None
+
+
 class LiquidProbe:
     """The controller's measurement of a liquid of ``n_particles`` on ``device`` (scratch arrays allocated once).
 
@@ -153,7 +164,7 @@ class LiquidProbe:
         self._sums = wp.zeros((CHUNKS, STREAM_SUM_COLUMNS), dtype=float, device=device)
         self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
         self._crossing_x = wp.zeros(max(n_particles, 1), dtype=float, device=device)
-        self._commands: dict[tuple, wp.Launch] = {}
+        self._commands: dict[tuple, tuple[wp.Launch, list]] = {}  # the launch and its scalar arguments as packed
         spec = geo.pourer
         self._pourer_frame = PourerFrame()  # the fixed fields once; :meth:`_frame` sets the pose (warp struct fields are costly to set)
         self._pourer_frame.half_width = 0.5 * spec.inner_width
@@ -165,15 +176,22 @@ class LiquidProbe:
     def _launch(self, kernel, dim: int, inputs: list, outputs: list) -> None:
         """``wp.launch(kernel, dim, inputs, outputs)`` through a recorded launch kept per kernel and array set (the
         solver's particle arrays alternate between two): each call packs only the arguments that are not arrays
-        (packing them all was most of the probe's host time)."""
+        (packing them all was most of the probe's host time), and of those only the ones that changed (a plain
+        int or float the launch holds already, to the bit, is not packed again; structs and vectors always are)."""
         key = (kernel.key, dim, *(a.ptr for a in (*inputs, *outputs) if isinstance(a, wp.array)))
-        command = self._commands.get(key)
-        if command is None:
-            command = self._commands[key] = wp.launch(kernel, dim=dim, inputs=inputs, outputs=outputs, device=self.device, record_cmd=True)
+        entry = self._commands.get(key)
+        if entry is None:
+            command = wp.launch(kernel, dim=dim, inputs=inputs, outputs=outputs, device=self.device, record_cmd=True)
+            self._commands[key] = (command, [_packed_scalar(value) for value in inputs])
         else:
+            command, packed = entry
             for k, value in enumerate(inputs):
-                if not isinstance(value, wp.array):
+                if isinstance(value, wp.array):
+                    continue
+                scalar = _packed_scalar(value)
+                if scalar is None or scalar != packed[k]:
                     command.set_param_at_index(k, value)
+                    packed[k] = scalar
         command.launch()
 
     def _frame(self, pose: Pose) -> PourerFrame:

@@ -53,16 +53,24 @@ def replicas_as_lanes(rows: np.ndarray, substeps: int, replicas: int) -> np.ndar
     """The first ``substeps`` rows of every lane from an array (lanes, substeps x replicas, fields) whose rows are
     replicated (``cosim.fluid.device_layout``), as (lanes x replicas, substeps, fields): each replica a lane of its
     own for :func:`combine_lanes` (lane-major; with one replica, the rows themselves)."""
+    if replicas == 1:
+        return rows[:, :substeps]
     lanes, fields = rows.shape[0], rows.shape[2]
     first = rows[:, : substeps * replicas].reshape(lanes, substeps, replicas, fields)
     return first.transpose(0, 2, 1, 3).reshape(lanes * replicas, substeps, fields)
 
 
+_LANE_MAX_COLUMNS = np.array(LANE_MAX_FIELDS)
+
+
 def combine_lanes(lanes_f: np.ndarray, lanes_i: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The rows of all lanes (``cosim.fluid.lanes``; arrays (lanes, substeps, fields)) as one row per substep:
-    maxima by the maximum, the rest summed over the lanes in lane order."""
+    maxima by the maximum, the rest summed over the lanes in lane order. One lane's rows are copied as they are (a
+    sum or maximum over one lane is its value)."""
+    if lanes_f.shape[0] == 1:
+        return lanes_f[0].copy(), lanes_i[0].copy()
     rows_f = lanes_f.sum(axis=0, dtype=lanes_f.dtype)
-    rows_f[:, list(LANE_MAX_FIELDS)] = lanes_f[:, :, list(LANE_MAX_FIELDS)].max(axis=0)
+    rows_f[:, _LANE_MAX_COLUMNS] = lanes_f[:, :, _LANE_MAX_COLUMNS].max(axis=0)
     return rows_f, lanes_i.sum(axis=0, dtype=lanes_i.dtype)
 
 
@@ -179,6 +187,10 @@ class DiagnosticBuffers:
         return True
 
     def zero(self) -> None:
+        if self._views is not None:  # the CPU's arrays through their numpy views: no warp call per interval
+            for view in self._views:
+                view.fill(0)
+            return
         self.f.zero_()
         self.i.zero_()
 

@@ -6,7 +6,10 @@ import numpy as np
 
 from cosim.errors import SimulationError, count_of
 from cosim.fluid.config import FluidConfig
-from cosim.fluid.diagnostics import SubstepRows
+from cosim.fluid.diagnostics import DIAG_BREACHES, DIAG_NONFINITE, DIAG_PAIR_OVERFLOW, SubstepRows
+
+# the int columns of which any nonzero count stops the run
+_STOPPING_COUNTS = np.array([DIAG_NONFINITE, DIAG_BREACHES, DIAG_PAIR_OVERFLOW])
 
 
 class FluidInstabilityError(SimulationError):
@@ -26,8 +29,7 @@ def check_interval(cfg: FluidConfig, rows: SubstepRows, first: int, t0: float, d
     ``max_density_error``; else for the interval's end where the energy the numerics created, ``energy_created``
     (M g L), exceeds ``max_energy_creation``."""
     if not (
-        rows.nonfinite.any() or rows.wall_breaches.any() or rows.pair_overflows.any() or rows.max_compression.max() > cfg.max_density_error
-        or energy_created > cfg.max_energy_creation
+        rows.i[:, _STOPPING_COUNTS].any() or rows.max_compression.max() > cfg.max_density_error or energy_created > cfg.max_energy_creation
     ):  # the usual interval, found in one pass
         return
     checks = [

@@ -73,6 +73,7 @@ class SubstepScratch:
         self.force_sum = wp.zeros(v_count, dtype=wp.vec3, device=d)
         self.torque_sum = wp.zeros(v_count, dtype=wp.vec3, device=d)
         self._wrench_views = (self.force_sum.numpy(), self.torque_sum.numpy()) if d.is_cpu else None  # shared memory
+        self._counter_views = (self.row.numpy(), *self._wrench_views) if d.is_cpu else None  # cleared every interval
         self.diagnostics = DiagnosticBuffers(lanes.count, layout.atomic_replicas, nv, d)
 
     def set_motions(self, poses: list[Pose], lin_vel: np.ndarray, ang_vel: np.ndarray, lin_acc: np.ndarray, ang_acc: np.ndarray) -> None:
@@ -81,8 +82,8 @@ class SubstepScratch:
         if not poses:
             return
         mo = self._motions_view
-        mo["p0"] = mo["p_now"] = mo["p_next"] = [pose.position for pose in poses]
-        mo["r0"] = mo["r_now"] = mo["r_next"] = [pose.rotation for pose in poses]
+        mo["p0"] = mo["p_now"] = mo["p_next"] = np.array([pose.position for pose in poses])  # converted once for the three
+        mo["r0"] = mo["r_now"] = mo["r_next"] = np.array([pose.rotation for pose in poses])
         mo["lin_vel"], mo["ang_vel"], mo["lin_acc"], mo["ang_acc"] = lin_vel, ang_vel, lin_acc, ang_acc
         if self._motions_host is not self.motions:  # copied into the existing array: the recorded launches hold it
             wp.copy(self.motions, self._motions_host)
@@ -92,8 +93,12 @@ class SubstepScratch:
         if dt != self._dt_written:  # the substeps read it on the device; most intervals keep the last one
             self.dt.fill_(dt)
             self._dt_written = dt
-        self.row.zero_()
         self.diagnostics.zero()
+        if self._counter_views is not None:  # the CPU's arrays through their numpy views: no warp call per interval
+            for view in self._counter_views:
+                view.fill(0)
+            return
+        self.row.zero_()
         self.force_sum.zero_()
         self.torque_sum.zero_()
 

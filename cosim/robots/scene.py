@@ -226,6 +226,7 @@ class RobotScene:
         self._ik: dict[ArmRole, ArmIK] = {}
         self._inverse_data: mujoco.MjData | None = None
         self._jacobian_data: mujoco.MjData | None = None
+        self._jacobians: tuple[np.ndarray, np.ndarray] | None = None  # (3, nv) positional and rotational, reused
 
     # ---- construction --------------------------------------------------------------------------------------------
     @classmethod
@@ -333,13 +334,16 @@ class RobotScene:
         if self._jacobian_data is None:
             self._jacobian_data = mujoco.MjData(m)
             self._jacobian_data.qpos[:] = np.nan  # no kinematics computed yet
+            self._jacobians = (np.empty((3, m.nv)), np.empty((3, m.nv)))  # mj_jac writes every entry
         d, live = self._jacobian_data, self.data
-        # the step loop asks for both arms at one configuration: its kinematics once
-        if not (np.array_equal(d.qpos, live.qpos) and np.array_equal(d.mocap_pos, live.mocap_pos) and np.array_equal(d.mocap_quat, live.mocap_quat)):
+        # the step loop asks for both arms at one configuration: its kinematics once (compared as bytes: exact, and
+        # without array_equal's dispatch)
+        if not (d.qpos.tobytes() == live.qpos.tobytes() and d.mocap_pos.tobytes() == live.mocap_pos.tobytes()
+                and d.mocap_quat.tobytes() == live.mocap_quat.tobytes()):
             d.qpos[:], d.mocap_pos[:], d.mocap_quat[:] = live.qpos, live.mocap_pos, live.mocap_quat
             mujoco.mj_kinematics(m, d)
             mujoco.mj_comPos(m, d)
-        jacp, jacr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+        jacp, jacr = self._jacobians
         mujoco.mj_jac(m, d, jacp, jacr, d.xipos[arm.vessel_body], arm.vessel_body)
         return jacp[:, arm.dof_adr].T @ np.asarray(force, dtype=float) + jacr[:, arm.dof_adr].T @ np.asarray(torque, dtype=float)
 
