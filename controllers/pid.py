@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import functools
 import math
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -264,7 +265,11 @@ def delayed_loop_figures(gains: PidGains, model: SloshModel, dt: float, chain: C
     radius = float(np.max(np.abs(ct.poles(ct.feedback(loop, 1)))))
     if radius >= 1.0:
         return -math.inf, -math.inf, -math.inf
-    gms, pms, *_ = ct.stability_margins(loop, returnall=True)
+    with warnings.catch_warnings():
+        # With the slosh-angle filter the loop's order makes python-control fall back from its polynomial crossings to
+        # the frequency response, and say so: that fallback is what 'best' means, not a fault for the user to see.
+        warnings.filterwarnings("ignore", message="stability_margins: Falling back", category=UserWarning)
+        gms, pms, *_ = ct.stability_margins(loop, returnall=True)
     gm_db = min((abs(20.0 * math.log10(g)) for g in np.atleast_1d(gms) if g > 0.0 and math.isfinite(g)), default=math.inf)
     pm = min((abs(float(p)) for p in np.atleast_1d(pms) if math.isfinite(p)), default=math.inf)
     return -math.log(radius) / dt, gm_db, pm
