@@ -65,11 +65,10 @@ def test_the_task_space_chain_follows_a_ramp_at_the_lag_less_the_spline_period()
     rate = 0.05  # rad/s
     pose_filter = PoseFilter("pourer_pose", ("dx", "dz", "theta"), PoseFilterLimits(), PERIOD)
     smoother = PoseSmoother(("dx", "dz", "theta"), PERIOD)
-    lags = []
     for k in range(RAMP_PERIODS):
         pose = smoother(pose_filter(PlanarPose(0.0, 0.0, rate * k * PERIOD), track=True), source="limited")
-        lags.append((rate * (k + 1) * PERIOD - pose.theta) / rate)
-    assert lags[-1] == pytest.approx(follower_lag(PERIOD) - PERIOD, abs=1e-6)
+    lag = (rate * RAMP_PERIODS * PERIOD - pose.theta) / rate  # behind the ramp one period after the last call
+    assert lag == pytest.approx(follower_lag(PERIOD) - PERIOD, abs=1e-6)
 
 
 @pytest.mark.parametrize("rate", [0.05, 0.35])  # rad/s: a partial pour's final stage; CFS's tilt rate limit
