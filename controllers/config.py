@@ -231,6 +231,13 @@ class PourConfig:
     start_time: float = setting(0.0, POUR, "The controller idles (vessel at home, catcher pre-positioned) until this "
                                 "time.", "s", 0.0, 60.0)
     gravity: float = setting(GRAVITY, POUR, "Gravity's magnitude.", "m/s^2", 0.0, 100.0, lo_open=True)
+    follower_lag: float | None = setting(
+        None, POUR, "How late the vessel's tilt follows a ramp of its command: the lag that the partial pour's stop "
+        "counts in the after-flow it predicts (controllers.cfs.after_flow_volume), known from the arm's chain (the "
+        "coupled pour sets its task-space filter's, trajectory's and servos'). A delay fitted to the measured tilt "
+        "reads a deflection of the vessel under the liquid's load, a static offset, as delay (offset / tilt rate); the "
+        "fit is reported beside it.", "s", 0.0, 1.0,
+        none_means="the delay fitted to the last 0.5 s of commanded and measured tilt (a plant without deflection)")
     slosh: SloshModel | None = None
     sim: SimConfig = field(default_factory=SimConfig)
     approach: ApproachConfig = field(default_factory=ApproachConfig)

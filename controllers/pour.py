@@ -7,9 +7,9 @@
 A partial pour ends with CFS_FINAL: CFS holding ``cfs.final_head_fraction`` of h_q_ref, entered once the volume
 still to pour before the predicted after-flow would leave within ``cfs.final_stage_time`` at the current rate. The
 stop has to predict the after-flow (what still leaves while the vessel turns back,
-:func:`controllers.cfs.after_flow_volume`, with the vessel's lag behind its command fitted over the last
-LAG_WINDOW s). That prediction is uncertain by about a fifth of the after-flow (docs/tuning.md); the smaller
-outflow at the stop makes that error a smaller share of the target.
+:func:`controllers.cfs.after_flow_volume`, with the vessel's lag behind its command: ``follower_lag`` where the
+configuration knows it, else fitted over the last LAG_WINDOW s). That prediction is uncertain by about a fifth of
+the after-flow (docs/tuning.md); the smaller outflow at the stop makes that error a smaller share of the target.
 
 Call :meth:`PourController.step` once per control period (``config.dt``, 10 ms by default) with a
 :class:`controllers.measurement.LiquidMeasurement`; it returns a :class:`controllers.measurement.PourCommand`.
@@ -58,10 +58,11 @@ STALL_FRACTION = 0.005
 STALL_TILT = 0.01  # rad
 # Tilt (rad) within which a rate-limited tilt counts as arrived (approach target, upright): 0.006 deg.
 ARRIVAL_TOLERANCE = 1e-4
-# The vessel's lag behind its commanded tilt, for the after-flow prediction: fitted as a pure delay
-# (controllers.motion.fitted_delay) over the last LAG_WINDOW s of commanded and measured tilt, between 0 and
-# MAX_FOLLOWER_LAG s in steps of half a control period; the bound leaves room above the coupled pour's task-space
-# filter and arm (docs/tuning.md).
+# The vessel's lag behind its commanded tilt, as measured: fitted as a pure delay (controllers.motion.fitted_delay)
+# over the last LAG_WINDOW s of commanded and measured tilt, between 0 and MAX_FOLLOWER_LAG s in steps of half a
+# control period; the bound leaves room above the coupled pour's task-space filter and arm (docs/tuning.md). The
+# after-flow prediction uses it where the configuration does not know the lag (PourConfig.follower_lag): the fit
+# reads a static offset of the vessel from its command (a deflection under the liquid's load) as delay.
 LAG_WINDOW = 0.5  # s, about one slosh period of the vessel of Camporredondo et al. (2019)
 MAX_FOLLOWER_LAG = 0.3  # s
 
@@ -283,7 +284,8 @@ class PourController:
         return (theta1 - theta0) / (t1 - t0)
 
     def _lag(self) -> float:
-        """Time (s) the vessel runs behind its commanded tilt, fitted over the last LAG_WINDOW s of steps."""
+        """Time (s) the vessel runs behind its commanded tilt, fitted as a pure delay over the last LAG_WINDOW s of
+        steps (a static offset of the vessel from its command counts in it as offset / tilt rate)."""
         if len(self._tilt_history) < 2:
             return 0.0
         t, commanded, measured = (np.array(c) for c in zip(*self._tilt_history))
@@ -316,7 +318,8 @@ class PourController:
         if target is not None:
             lever = crest_lever(self.config.vessel, self.pose.theta, self._area(m))
             ret = self.config.returning
-            lag = self._lag()
+            known = self.config.follower_lag
+            lag = self._lag() if known is None else known
             # Nothing over the crest now: the return only lowers the head, nothing more leaves. (The filtered rate and
             # head both decay after an earlier spill, and their ratio rate / head^(3/2), which the prediction scales
             # by, grows without bound as they do.)
@@ -330,9 +333,12 @@ class PourController:
             after = min(after, m.volume_in_pourer)  # what is there is the most that can still leave
             to_go = target - m.poured_volume - after
             if to_go <= 0.0:
+                fitted = lag if known is None else self._lag()
+                measured = f"vessel {1e3 * fitted:.0f} ms behind its command"
+                lags = measured if known is None else f"follower lag {1e3 * known:.0f} ms, {measured} by the fit"
                 return Phase.RETURN, (
                     f"poured {1e6 * m.poured_volume:.1f} mL + {1e6 * after:.1f} mL predicted after-flow "
-                    f"(vessel {1e3 * lag:.0f} ms behind its command) >= target {1e6 * target:.1f} mL"
+                    f"({lags}) >= target {1e6 * target:.1f} mL"
                 )
             cfs = self.config.cfs
             if (

@@ -33,6 +33,7 @@ from controllers.geometry import VesselGeometry
 from controllers.slosh import SloshModel
 from cosim.atomic_files import check_output_folder
 from cosim.coupling.exchange import ROLES
+from cosim.coupling.follower_lag import follower_lag
 from cosim.coupling.loop import CoupledPour, build_pour
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig
@@ -70,7 +71,8 @@ PlantIdentifier = Callable[[VesselSpec, float, FluidConfig], SloshModel]
 
 def _controller_config(scene: PourScene, spacing: float, slosh: SloshModel | None = None):
     """``pour_config`` callback of :func:`build_pour`: the scene's controller settings on the simulated geometry
-    (``slosh``: the pourer's identified plant, None for potential flow)."""
+    (``slosh``: the pourer's identified plant, None for potential flow), with the lag of the coupling's arm behind its
+    tilt command (:func:`cosim.coupling.follower_lag.follower_lag`) for the partial pour's stop."""
     c = scene.controller
     h_q_ref = cfs_head_reference(scene, spacing)
 
@@ -84,7 +86,7 @@ def _controller_config(scene: PourScene, spacing: float, slosh: SloshModel | Non
         return PourConfig(
             catcher=catcher, vessel=geometry, fill_depth=fill, target_volume=target, control_rate=c.control_rate,
             start_time=scene.coupling.start_delay, sim=c.sim, approach=c.approach, cfs=replace(c.cfs, h_q_ref=h_q_ref),
-            returning=c.returning, slosh=slosh,
+            returning=c.returning, slosh=slosh, follower_lag=follower_lag(1.0 / c.control_rate),
         )
 
     return make

@@ -198,6 +198,47 @@ def test_partial_pour_with_a_slow_arm_counts_the_lag_in_the_after_flow() -> None
     assert lag_ms == pytest.approx(90.0, abs=15.0)  # 8 periods late + the plant's own one-period move
 
 
+class _DeflectedPlant(ModelPlant):
+    """The model plant with its vessel measured ``offset`` rad short of its tilt: the static deflection of an arm that
+    carries part of the liquid's load (the liquid itself follows the undeflected tilt; for the stop only the tilt's
+    lag behind the command matters)."""
+
+    def __init__(self, config: ModelPlantConfig, dt: float, offset: float) -> None:
+        super().__init__(config, dt)
+        self.offset = offset
+
+    def measure(self) -> LiquidMeasurement:
+        m = super().measure()
+        return dataclasses.replace(m, tilt=m.tilt - self.offset)
+
+
+def test_partial_pour_with_a_known_follower_lag_is_not_misled_by_a_static_deflection() -> None:
+    """An arm 8 periods late (90 ms with the plant's own one-period move) whose vessel stands 4.5 mrad short of its
+    command: a pure delay fitted to the tilt reads the offset as lag (offset / tilt rate: 90 ms more at 0.05 rad/s) and
+    the stop, predicting after-flow that never comes, falls short. Given the follower's lag the stop predicts with it,
+    reports the fit beside it, and ends where the undeflected pour does."""
+    base = _config(target_volume=0.5 * _config().initial_volume)
+    base = dataclasses.replace(base, cfs=dataclasses.replace(base.cfs, final_head_fraction=1.0),
+                               sim=SimConfig(pid=PidDesignSpec(actuation_delay=0.09)))
+    poured, reasons = {}, {}
+    for case, lag, offset in (("undeflected", None, 0.0), ("fitted", None, 0.0045), ("known", 0.09, 0.0045)):
+        config = dataclasses.replace(base, follower_lag=lag)
+        controller = PourController(config)
+        plant_config = ModelPlantConfig(vessel=config.vessel, fill_depth=config.fill_depth, arm_delay_steps=8)
+        plant = _DeflectedPlant(plant_config, config.dt, offset)
+        assert run_closed_loop(controller, plant, 120.0).commands[-1].phase is Phase.DONE
+        poured[case] = plant.poured
+        reasons[case] = next(tr.reason for tr in controller.transitions if tr.target is Phase.RETURN)
+    fitted_ms = float(reasons["fitted"].split("(vessel ")[1].split(" ms")[0])
+    assert fitted_ms > 150.0  # 90 ms of lag + the offset read as delay
+    assert "(follower lag 90 ms, vessel " in reasons["known"]
+    assert float(reasons["known"].split(", vessel ")[1].split(" ms")[0]) > 150.0  # the fit, as measured
+    target = base.target_volume
+    shortfall = poured["undeflected"] - poured["fitted"]
+    assert shortfall > 0.005 * target  # the fit's extra lag: after-flow predicted that never comes
+    assert abs(poured["known"] - poured["undeflected"]) < 0.1 * shortfall
+
+
 def test_low_fill_goes_straight_to_cfs_through_the_approach() -> None:
     controller, _, trace = _run(_config(fill_depth=0.10, target_volume=2e-4))
     assert [tr.target for tr in controller.transitions][:2] == [Phase.APPROACH, Phase.CFS]
