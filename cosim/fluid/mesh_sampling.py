@@ -116,14 +116,15 @@ def _lattice(lo: np.ndarray, hi: np.ndarray, anchor: np.ndarray, dx: float, dim:
     return np.stack([g.ravel() for g in grid], axis=1)
 
 
-def sample_mesh_walls(spec: VesselSpec, spacing: float, thickness: float, dim: int) -> tuple[np.ndarray, np.ndarray]:
+def sample_mesh_walls(spec: VesselSpec, spacing: float, thickness: float, dim: int, confined: bool) -> tuple[np.ndarray, np.ndarray]:
     """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim) of a mesh vessel whose walls
-    the liquid sees ``thickness`` (m) thick (module doc)."""
+    the liquid sees ``thickness`` (m) thick (module doc); ``confined``: only those inside the wall solid (the vessel's
+    own walls, :class:`cosim.fluid.config.WallModel`)."""
     lo, hi = cavity_bounds(spec)
     anchor = np.array([-0.5 * spec.inner_width, lo[1], 0.0])
     points = _lattice(lo - thickness, hi + np.array([thickness, thickness, 0.0]), anchor, spacing, dim)
-    inside, distance, behind, _ = classify(spec, points, 2.0 * thickness)
-    keep = ~inside & behind & (distance < thickness)
+    inside, distance, behind, solid = classify(spec, points, 2.0 * thickness)
+    keep = ~inside & behind & (distance < thickness) & (solid | (not confined))
     walls = points[keep]
     return walls, np.full(len(walls), spacing**dim)
 

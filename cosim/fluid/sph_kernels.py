@@ -45,6 +45,12 @@ def _kernel_slope(kernel: KernelType, q: np.ndarray, h: float) -> np.ndarray:
     return -5.0 * q * (1.0 - 0.5 * q) ** 3 / h
 
 
+def kernel_slope(kernel: KernelType, r: np.ndarray, h: float, dim: int) -> np.ndarray:
+    """dW/dr (1/m^(dim+1)) at distances ``r`` (m) for smoothing length ``h`` (m); 0 beyond the support 2h."""
+    q = np.asarray(r, dtype=float) / h
+    return np.where(q < 2.0, kernel_sigma(kernel, h, dim) * _kernel_slope(kernel, q, h), 0.0)
+
+
 def lattice_kernel_sum(kernel: KernelType, smoothing_ratio: float, dim: int) -> float:
     """sum_j W(x_i - x_j) dx^dim over a full square (cubic) lattice of spacing dx around x_i (itself included):
     the summation density of a resting lattice in units of rho0 (1.005 for Wendland C2 at h = 1.5 dx in 2-D)."""

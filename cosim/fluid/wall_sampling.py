@@ -1,15 +1,21 @@
 """Dummy wall particles of a vessel, in the vessel frame (numpy, done once per run).
 
-The walls are filled with layers of particles that cover the whole kernel support behind every wetted face
-(Adami, Hu & Adams 2012): ``n_layers = ceil(2h / dx)`` layers of spacing dx. Where the vessel's wall is thinner
-than that, the layers extend beyond its outer face: the liquid sees a wall ``numerical_wall_thickness`` thick
-(the inner faces, which hold the liquid, are exact; the outer faces and the pour lip move outwards by the
-difference, which :func:`numerical_wall_thickness` reports so that lip positions can be corrected). Layers sit
-below the rim, so liquid flowing over the rim sees the wall beneath it.
+The walls hold layers of dummy particles (Adami, Hu & Adams 2012), filled one of two ways
+(:class:`cosim.fluid.config.WallModel`):
 
-In 2-D only the section in the pour plane (local y = 0) is filled: the floor and the +x / -x walls; a cylinder's
-section is that of a box of width 2R. Each particle carries its own volume (m^dim): the slab volume divided by
-the number of particles in it, close to dx^dim.
+- ``kernel_layers``: ``n_layers = ceil(2h / dx)`` layers of spacing dx cover the whole kernel support behind every
+  wetted face. Where the vessel's wall is thinner than that, the layers extend beyond its outer face: the liquid
+  sees a wall ``numerical_wall_thickness`` thick (the inner faces, which hold the liquid, are exact; the outer faces
+  and the pour lip move outwards by the difference).
+- ``real_thickness``: the layers fill the vessel's own wall and nothing beyond it, round(t / dx) of them (at least
+  one) across a wall t thick, so the outer faces and the pour lip are the vessel's. A wall thinner than the kernel
+  support then lacks the particles behind it that a liquid particle near its face would sum over; their volumes
+  make that up (:func:`support_compensation`).
+
+Layers sit below the rim, so liquid flowing over the rim sees the wall beneath it. In 2-D only the section in the
+pour plane (local y = 0) is filled: the floor and the +x / -x walls; a cylinder's section is that of a box of width
+2R. Each particle carries its own volume (m^dim): the slab volume divided by the number of particles in it, close
+to dx^dim, times the compensation.
 """
 
 from __future__ import annotations
@@ -18,7 +24,10 @@ import math
 
 import numpy as np
 
+from cosim.errors import InputError
+from cosim.fluid.config import FluidConfig, WallModel
 from cosim.fluid.mesh_sampling import mesh_wetted_layer, sample_mesh_walls
+from cosim.fluid.sph_kernels import kernel_slope
 from cosim.vessel import VesselSpec
 
 
@@ -27,9 +36,77 @@ def wall_layers(spacing: float, support: float) -> int:
     return max(1, math.ceil(support / spacing - 1e-9))
 
 
-def numerical_wall_thickness(spec: VesselSpec, spacing: float, support: float) -> float:
-    """Wall thickness (m) the liquid sees: the vessel's own, or the dummy layers' if those are thicker."""
-    return max(spec.wall_thickness, wall_layers(spacing, support) * spacing)
+def numerical_wall_thickness(spec: VesselSpec, cfg: FluidConfig) -> float:
+    """Wall thickness (m) the liquid sees: the vessel's own, or under ``kernel_layers`` the dummy layers' if those
+    are thicker."""
+    if cfg.wall_model is WallModel.REAL_THICKNESS:
+        return spec.wall_thickness
+    return max(spec.wall_thickness, wall_layers(cfg.spacing, cfg.support_radius) * cfg.spacing)
+
+
+def layer_depths(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Depths (m) behind the wetted face of the walls' dummy layers, and the thickness (m) of wall each stands for.
+
+    A box's or cylinder's wall t thick (:func:`numerical_wall_thickness`) holds round(t / dx) layers (at least one)
+    of equal thickness; a mesh's holds the lattice layers (k + 1/2) dx that lie within it (module
+    :mod:`cosim.fluid.mesh_sampling`). Raises InputError for a mesh wall too thin to hold one.
+    """
+    t, dx = numerical_wall_thickness(spec, cfg), cfg.spacing
+    if spec.is_mesh:
+        depths = dx * (0.5 + np.arange(math.ceil(t / dx + 1e-9)))
+        depths = depths[depths < t]
+        if len(depths) == 0:
+            raise InputError(f"fluid.wall_model: the mesh vessel's wall ({t:.4g} m) holds no dummy layer at spacing "
+                             f"{dx:.4g} m under 'real_thickness' (needs a wall thicker than dx / 2, or 'kernel_layers')")
+        return depths, np.full(len(depths), dx)
+    n = max(1, round(t / dx))
+    return (0.5 + np.arange(n)) * (t / n), np.full(n, t / n)
+
+
+def _face_gradient_sum(depths: np.ndarray, widths: np.ndarray, distance: float, cfg: FluidConfig) -> float:
+    """sum_b V_b dW/dn (1/m) at a point ``distance`` (m) in front of a flat wall whose layers lie at ``depths`` behind
+    its face, each standing for ``widths`` of wall, sampled at spacing dx along the face: the wall's share of a
+    particle's kernel-gradient sum, along the face normal."""
+    dx, support = cfg.spacing, cfg.support_radius
+    reach = math.ceil(support / dx)
+    axis = dx * np.arange(-reach, reach + 1)
+    along = np.stack(np.meshgrid(*([axis] * (cfg.dim - 1)), indexing="ij"), axis=-1).reshape(-1, cfg.dim - 1)
+    lateral2 = (along**2).sum(axis=1)
+    total = 0.0
+    for depth, width in zip(depths, widths):
+        normal = distance + depth
+        r = np.sqrt(lateral2 + normal**2)
+        total += width * dx ** (cfg.dim - 1) * float((kernel_slope(cfg.kernel, r, cfg.smoothing_length, cfg.dim) * normal / r).sum())
+    return total
+
+
+def support_compensation(spec: VesselSpec, cfg: FluidConfig) -> float:
+    """Factor (dimensionless, >= 1 for a thin wall) on the volumes of a vessel's dummy particles that makes up the
+    kernel support missing behind a wall thinner than it.
+
+    In a resting lattice the kernel gradients of a particle's neighbours sum to zero, sum_j V_j grad W_ij = 0; near a
+    wall the dummy particles supply the share of that sum behind the face, and it is that share which balances the
+    liquid's pressure at the wall (Adami, Hu & Adams 2012) and enters the continuity equation's wall term. Layers
+    covering the support, at depths (k + 1/2) dx with volume dx^dim, supply it as the liquid's own lattice would:
+    G_full(d) (:func:`_face_gradient_sum`) at a liquid particle d from the face. The layers of a thinner wall supply
+    G(d) < G_full(d). As Akinci et al. (2012, "Versatile rigid-fluid coupling for incompressible SPH") give a single
+    layer of boundary particles larger volumes to stand for the support behind it, the factor s scales the thin
+    wall's volumes, chosen by least squares over the liquid layers in reach of the wall, d_j = (j + 1/2) dx < 2h:
+    s = sum_j G(d_j) G_full(d_j) / sum_j G(d_j)^2. The kernel sum sum_b V_b W is matched less well (a single layer
+    dx/2 behind the face at h = 1.5 dx makes up the first liquid layer's sum to within about 15 %), which the
+    summation density of liquid against a thin wall inherits. 1 for walls that cover the support, and always under
+    ``kernel_layers``.
+    """
+    dx, support = cfg.spacing, cfg.support_radius
+    full = wall_layers(dx, support)
+    if cfg.wall_model is WallModel.KERNEL_LAYERS or numerical_wall_thickness(spec, cfg) >= full * dx:
+        return 1.0
+    depths, widths = layer_depths(spec, cfg)
+    full_depths = dx * (0.5 + np.arange(full))
+    probes = dx * (0.5 + np.arange(full))
+    thin = np.array([_face_gradient_sum(depths, widths, d, cfg) for d in probes])
+    reference = np.array([_face_gradient_sum(full_depths, np.full(full, dx), d, cfg) for d in probes])
+    return float(thin @ reference / (thin @ thin))
 
 
 def _axis(lo: float, hi: float, step: float) -> tuple[np.ndarray, float]:
@@ -80,12 +157,16 @@ def _fill_disc(radius: float, z0: float, z1: float, step: float) -> tuple[np.nda
     return np.concatenate(pts + [inner]), np.concatenate(vols + [outer])
 
 
-def sample_vessel_walls(spec: VesselSpec, spacing: float, support: float, dim: int) -> tuple[np.ndarray, np.ndarray]:
-    """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim)."""
+def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim), for ``cfg``'s spacing,
+    kernel support, dimension and wall model."""
     h = spec.inner_height
-    t = numerical_wall_thickness(spec, spacing, support)
+    t = numerical_wall_thickness(spec, cfg)
+    spacing, dim = cfg.spacing, cfg.dim
+    scale = support_compensation(spec, cfg)
     if spec.is_mesh:
-        return sample_mesh_walls(spec, spacing, t, dim)
+        points, volumes = sample_mesh_walls(spec, spacing, t, dim, confined=cfg.wall_model is WallModel.REAL_THICKNESS)
+        return points, scale * volumes
     if dim == 2 or spec.is_box:
         b = 0.5 * spec.inner_width
         d = 0.5 * spec.section_depth
@@ -100,7 +181,7 @@ def sample_vessel_walls(spec: VesselSpec, spacing: float, support: float, dim: i
     else:
         r = 0.5 * spec.inner_width
         parts = [_fill_disc(r + t, -t, 0.0, spacing), _fill_cylinder_shells(r, r + t, 0.0, h, spacing)]
-    return np.concatenate([p for p, _ in parts]), np.concatenate([v for _, v in parts])
+    return np.concatenate([p for p, _ in parts]), scale * np.concatenate([v for _, v in parts])
 
 
 def wetted_layer(spec: VesselSpec, points: np.ndarray, spacing: float, dim: int) -> np.ndarray:
