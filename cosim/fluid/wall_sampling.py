@@ -27,7 +27,7 @@ import numpy as np
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig, WallModel
 from cosim.fluid.mesh_sampling import mesh_wetted_layer, sample_mesh_walls
-from cosim.fluid.sph_kernels import kernel_slope
+from cosim.fluid.sph_kernels import kernel_values
 from cosim.vessel import VesselSpec
 
 
@@ -63,10 +63,10 @@ def layer_depths(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.nda
     return (0.5 + np.arange(n)) * (t / n), np.full(n, t / n)
 
 
-def _face_gradient_sum(depths: np.ndarray, widths: np.ndarray, distance: float, cfg: FluidConfig) -> float:
-    """sum_b V_b dW/dn (1/m) at a point ``distance`` (m) in front of a flat wall whose layers lie at ``depths`` behind
-    its face, each standing for ``widths`` of wall, sampled at spacing dx along the face: the wall's share of a
-    particle's kernel-gradient sum, along the face normal."""
+def _face_kernel_sum(depths: np.ndarray, widths: np.ndarray, distance: float, cfg: FluidConfig) -> float:
+    """sum_b V_b W (1/m^0, dimensionless) at a point ``distance`` (m) in front of a flat wall whose layers lie at
+    ``depths`` behind its face, each standing for ``widths`` of wall, sampled at spacing dx along the face: the wall's
+    share of a particle's summation density, in units of rho0."""
     dx, support = cfg.spacing, cfg.support_radius
     reach = math.ceil(support / dx)
     axis = dx * np.arange(-reach, reach + 1)
@@ -74,9 +74,8 @@ def _face_gradient_sum(depths: np.ndarray, widths: np.ndarray, distance: float, 
     lateral2 = (along**2).sum(axis=1)
     total = 0.0
     for depth, width in zip(depths, widths):
-        normal = distance + depth
-        r = np.sqrt(lateral2 + normal**2)
-        total += width * dx ** (cfg.dim - 1) * float((kernel_slope(cfg.kernel, r, cfg.smoothing_length, cfg.dim) * normal / r).sum())
+        r = np.sqrt(lateral2 + (distance + depth) ** 2)
+        total += width * dx ** (cfg.dim - 1) * float(kernel_values(cfg.kernel, r, cfg.smoothing_length, cfg.dim).sum())
     return total
 
 
@@ -84,18 +83,17 @@ def support_compensation(spec: VesselSpec, cfg: FluidConfig) -> float:
     """Factor (dimensionless, >= 1 for a thin wall) on the volumes of a vessel's dummy particles that makes up the
     kernel support missing behind a wall thinner than it.
 
-    In a resting lattice the kernel gradients of a particle's neighbours sum to zero, sum_j V_j grad W_ij = 0; near a
-    wall the dummy particles supply the share of that sum behind the face, and it is that share which balances the
-    liquid's pressure at the wall (Adami, Hu & Adams 2012) and enters the continuity equation's wall term. Layers
-    covering the support, at depths (k + 1/2) dx with volume dx^dim, supply it as the liquid's own lattice would:
-    G_full(d) (:func:`_face_gradient_sum`) at a liquid particle d from the face. The layers of a thinner wall supply
-    G(d) < G_full(d). As Akinci et al. (2012, "Versatile rigid-fluid coupling for incompressible SPH") give a single
-    layer of boundary particles larger volumes to stand for the support behind it, the factor s scales the thin
-    wall's volumes, chosen by least squares over the liquid layers in reach of the wall, d_j = (j + 1/2) dx < 2h:
-    s = sum_j G(d_j) G_full(d_j) / sum_j G(d_j)^2. The kernel sum sum_b V_b W is matched less well (a single layer
-    dx/2 behind the face at h = 1.5 dx makes up the first liquid layer's sum to within about 15 %), which the
-    summation density of liquid against a thin wall inherits. 1 for walls that cover the support, and always under
-    ``kernel_layers``.
+    Near a wall the dummy particles supply the share of a liquid particle's summation density that lies behind the
+    face, sum_b rho0 V_b W_ib; DFSPH holds that density to rho0. Layers covering the support, at depths (k + 1/2) dx
+    with volume dx^dim, supply it as the liquid's own lattice would: S_full(d) (:func:`_face_kernel_sum`) at a liquid
+    particle d from the face. The layers of a thinner wall supply S(d) < S_full(d). As Akinci et al. (2012,
+    "Versatile rigid-fluid coupling for incompressible SPH") give a single layer of boundary particles larger volumes
+    so that a particle at a wall sums to its rest density, the factor s scales the thin wall's volumes, chosen by
+    least squares over the liquid layers in reach of the wall, d_j = (j + 1/2) dx < 2h:
+    s = sum_j S(d_j) S_full(d_j) / sum_j S(d_j)^2. One factor cannot match the kernel-gradient sum as well (it is
+    short by about a fifth at the first liquid layer against a wall 0.84 dx thick at h = 1.5 dx), nor the sums
+    of the wall particles themselves, which lack the layers behind them (docs/walls.md). 1 for walls that cover the
+    support, and always under ``kernel_layers``.
     """
     dx, support = cfg.spacing, cfg.support_radius
     full = wall_layers(dx, support)
@@ -104,8 +102,8 @@ def support_compensation(spec: VesselSpec, cfg: FluidConfig) -> float:
     depths, widths = layer_depths(spec, cfg)
     full_depths = dx * (0.5 + np.arange(full))
     probes = dx * (0.5 + np.arange(full))
-    thin = np.array([_face_gradient_sum(depths, widths, d, cfg) for d in probes])
-    reference = np.array([_face_gradient_sum(full_depths, np.full(full, dx), d, cfg) for d in probes])
+    thin = np.array([_face_kernel_sum(depths, widths, d, cfg) for d in probes])
+    reference = np.array([_face_kernel_sum(full_depths, np.full(full, dx), d, cfg) for d in probes])
     return float(thin @ reference / (thin @ thin))
 
 
