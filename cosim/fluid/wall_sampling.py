@@ -10,17 +10,18 @@ The walls hold layers of dummy particles (Adami, Hu & Adams 2012), filled one of
 - ``real_thickness``: the layers fill the vessel's own wall and nothing beyond it, round(t / dx) of them (at least
   one) across a wall t thick, so the outer faces and the pour lip are the vessel's. A wall thinner than the kernel
   support then lacks the particles behind it that a liquid particle near its face would sum over; their volumes
-  make that up (:func:`support_compensation`).
+  are fitted to make that up (:func:`fit_wall_volumes`).
 
 Layers sit below the rim, so liquid flowing over the rim sees the wall beneath it. In 2-D only the section in the
 pour plane (local y = 0) is filled: the floor and the +x / -x walls; a cylinder's section is that of a box of width
 2R. Each particle carries its own volume (m^dim): the slab volume divided by the number of particles in it, close
-to dx^dim, times the compensation.
+to dx^dim (fitted where the wall is thinner than the support).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -44,67 +45,71 @@ def numerical_wall_thickness(spec: VesselSpec, cfg: FluidConfig) -> float:
     return max(spec.wall_thickness, wall_layers(cfg.spacing, cfg.support_radius) * cfg.spacing)
 
 
-def layer_depths(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
-    """Depths (m) behind the wetted face of the walls' dummy layers, and the thickness (m) of wall each stands for.
-
-    A box's or cylinder's wall t thick (:func:`numerical_wall_thickness`) holds round(t / dx) layers (at least one)
-    of equal thickness; a mesh's holds the lattice layers (k + 1/2) dx that lie within it (module
-    :mod:`cosim.fluid.mesh_sampling`). Raises InputError for a mesh wall too thin to hold one.
-    """
-    t, dx = numerical_wall_thickness(spec, cfg), cfg.spacing
-    if spec.is_mesh:
-        depths = dx * (0.5 + np.arange(math.ceil(t / dx + 1e-9)))
-        depths = depths[depths < t]
-        if len(depths) == 0:
-            raise InputError(f"fluid.wall_model: the mesh vessel's wall ({t:.4g} m) holds no dummy layer at spacing "
-                             f"{dx:.4g} m under 'real_thickness' (needs a wall thicker than dx / 2, or 'kernel_layers')")
-        return depths, np.full(len(depths), dx)
-    n = max(1, round(t / dx))
-    return (0.5 + np.arange(n)) * (t / n), np.full(n, t / n)
+# Sweeps of the multiplicative fit of the thin walls' volumes (fit_wall_volumes); the kernel sums it matches settle to
+# within 0.1 % well before
+FIT_SWEEPS = 40
+# Probe points per block of the pairwise distances (memory: block x wall particles floats)
+PROBE_BLOCK = 512
 
 
-def _face_kernel_sum(depths: np.ndarray, widths: np.ndarray, distance: float, cfg: FluidConfig) -> float:
-    """sum_b V_b W (1/m^0, dimensionless) at a point ``distance`` (m) in front of a flat wall whose layers lie at
-    ``depths`` behind its face, each standing for ``widths`` of wall, sampled at spacing dx along the face: the wall's
-    share of a particle's summation density, in units of rho0."""
-    dx, support = cfg.spacing, cfg.support_radius
-    reach = math.ceil(support / dx)
-    axis = dx * np.arange(-reach, reach + 1)
-    along = np.stack(np.meshgrid(*([axis] * (cfg.dim - 1)), indexing="ij"), axis=-1).reshape(-1, cfg.dim - 1)
-    lateral2 = (along**2).sum(axis=1)
-    total = 0.0
-    for depth, width in zip(depths, widths):
-        r = np.sqrt(lateral2 + (distance + depth) ** 2)
-        total += width * dx ** (cfg.dim - 1) * float(kernel_values(cfg.kernel, r, cfg.smoothing_length, cfg.dim).sum())
-    return total
+def _kernel_pairs(probes: np.ndarray, points: np.ndarray, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pairs (probe index, point index, W (1/m^dim)) closer than the kernel support: the probes in blocks along
+    x, each against the points within its x range widened by the support."""
+    support = cfg.support_radius
+    order = np.argsort(probes[:, 0], kind="stable")
+    point_order = np.argsort(points[:, 0], kind="stable")
+    point_x = points[point_order, 0]
+    rows, cols, weights = [], [], []
+    for start in range(0, len(probes), PROBE_BLOCK):
+        index = order[start:start + PROBE_BLOCK]
+        block = probes[index]
+        lo, hi = np.searchsorted(point_x, [block[:, 0].min() - support, block[:, 0].max() + support])
+        near = point_order[lo:hi]
+        r = np.linalg.norm(block[:, None, :] - points[near][None, :, :], axis=2)
+        i, j = np.nonzero(r < support)
+        rows.append(index[i])
+        cols.append(near[j])
+        weights.append(kernel_values(cfg.kernel, r[i, j], cfg.smoothing_length, cfg.dim))
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(weights)
 
 
-def support_compensation(spec: VesselSpec, cfg: FluidConfig) -> float:
-    """Factor (dimensionless, >= 1 for a thin wall) on the volumes of a vessel's dummy particles that makes up the
-    kernel support missing behind a wall thinner than it.
+def _kernel_sums(pairs, volumes: np.ndarray, n_probes: int) -> np.ndarray:
+    """(n_probes,) sum_b V_b W(p - x_b): the walls' share of each probe's summation density, in units of rho0."""
+    rows, cols, weights = pairs
+    return np.bincount(rows, weights * volumes[cols], n_probes)
+
+
+def fit_wall_volumes(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, volumes: np.ndarray) -> np.ndarray:
+    """Volumes (m^dim) of a thin wall's dummy particles ``points`` (their own slab volumes ``volumes`` to start from)
+    that make up the kernel support missing behind the wall.
 
     Near a wall the dummy particles supply the share of a liquid particle's summation density that lies behind the
-    face, sum_b rho0 V_b W_ib; DFSPH holds that density to rho0. Layers covering the support, at depths (k + 1/2) dx
-    with volume dx^dim, supply it as the liquid's own lattice would: S_full(d) (:func:`_face_kernel_sum`) at a liquid
-    particle d from the face. The layers of a thinner wall supply S(d) < S_full(d). As Akinci et al. (2012,
-    "Versatile rigid-fluid coupling for incompressible SPH") give a single layer of boundary particles larger volumes
-    so that a particle at a wall sums to its rest density, the factor s scales the thin wall's volumes, chosen by
-    least squares over the liquid layers in reach of the wall, d_j = (j + 1/2) dx < 2h:
-    s = sum_j S(d_j) S_full(d_j) / sum_j S(d_j)^2. One factor cannot match the kernel-gradient sum as well (it is
-    short by about a fifth at the first liquid layer against a wall 0.84 dx thick at h = 1.5 dx), nor the sums
-    of the wall particles themselves, which lack the layers behind them (docs/walls.md). 1 for walls that cover the
-    support, and always under ``kernel_layers``.
+    face, S(p) = sum_b V_b W(p - x_b) (times rho0); DFSPH holds that density to rho0. Walls covering the support
+    (``kernel_layers``: the liquid's own lattice continued behind every face) supply it as the liquid's lattice
+    would: S_ref(p). A thinner wall's own layers supply less. As Akinci et al. (2012, "Versatile rigid-fluid
+    coupling for incompressible SPH") give boundary particles volumes of their own so that a particle at a wall
+    sums to its rest density, the volumes are fitted here so that S(p) = S_ref(p) at the probes p, the points of
+    the liquid's initial lattice filling the vessel to its rim (:func:`cosim.fluid.seeding.fill_vessel`) within
+    reach of the walls: FIT_SWEEPS multiplicative sweeps V_b <- V_b sum_p W_pb S_ref(p) / S(p) / sum_p W_pb (each
+    particle scaled by the mean shortfall of the probes it reaches, weighted by its kernel there; volumes stay
+    positive). Inner edges and corners, where the missing support is largest, get the largest volumes. Particles no
+    probe reaches keep their slab volumes. One volume per particle cannot also match the kernel-gradient sums, nor
+    the sums of the wall particles themselves, which lack the layers behind them (docs/walls.md).
     """
-    dx, support = cfg.spacing, cfg.support_radius
-    full = wall_layers(dx, support)
-    if cfg.wall_model is WallModel.KERNEL_LAYERS or numerical_wall_thickness(spec, cfg) >= full * dx:
-        return 1.0
-    depths, widths = layer_depths(spec, cfg)
-    full_depths = dx * (0.5 + np.arange(full))
-    probes = dx * (0.5 + np.arange(full))
-    thin = np.array([_face_kernel_sum(depths, widths, d, cfg) for d in probes])
-    reference = np.array([_face_kernel_sum(full_depths, np.full(full, dx), d, cfg) for d in probes])
-    return float(thin @ reference / (thin @ thin))
+    from cosim.fluid.seeding import fill_vessel
+
+    probes = fill_vessel(spec, spec.inner_height, cfg).positions
+    reference_points, reference_volumes = slab_particles(spec, replace(cfg, wall_model=WallModel.KERNEL_LAYERS))
+    reference = _kernel_sums(_kernel_pairs(probes, reference_points, cfg), reference_volumes, len(probes))
+    pairs = _kernel_pairs(probes, points, cfg)
+    rows, cols, weights = pairs
+    reach = np.bincount(cols, weights, len(points))
+    fitted = volumes.copy()
+    for _ in range(FIT_SWEEPS):
+        sums = _kernel_sums(pairs, fitted, len(probes))
+        ratio = np.divide(reference, sums, out=np.ones_like(sums), where=sums > 0.0)
+        fitted = np.where(reach > 0.0, fitted * np.bincount(cols, weights * ratio[rows], len(points)) / np.where(reach > 0.0, reach, 1.0), fitted)
+    return fitted
 
 
 def _axis(lo: float, hi: float, step: float) -> tuple[np.ndarray, float]:
@@ -155,16 +160,14 @@ def _fill_disc(radius: float, z0: float, z1: float, step: float) -> tuple[np.nda
     return np.concatenate(pts + [inner]), np.concatenate(vols + [outer])
 
 
-def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
-    """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim), for ``cfg``'s spacing,
-    kernel support, dimension and wall model."""
+def slab_particles(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
+    """The walls' dummy particles (n, 3) in the vessel frame and their slab volumes (n,) (m^dim), before any fit
+    (:func:`sample_vessel_walls`)."""
     h = spec.inner_height
     t = numerical_wall_thickness(spec, cfg)
     spacing, dim = cfg.spacing, cfg.dim
-    scale = support_compensation(spec, cfg)
     if spec.is_mesh:
-        points, volumes = sample_mesh_walls(spec, spacing, t, dim, confined=cfg.wall_model is WallModel.REAL_THICKNESS)
-        return points, scale * volumes
+        return sample_mesh_walls(spec, spacing, t, dim, confined=cfg.wall_model is WallModel.REAL_THICKNESS)
     if dim == 2 or spec.is_box:
         b = 0.5 * spec.inner_width
         d = 0.5 * spec.section_depth
@@ -179,7 +182,27 @@ def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray,
     else:
         r = 0.5 * spec.inner_width
         parts = [_fill_disc(r + t, -t, 0.0, spacing), _fill_cylinder_shells(r, r + t, 0.0, h, spacing)]
-    return np.concatenate([p for p, _ in parts]), scale * np.concatenate([v for _, v in parts])
+    return np.concatenate([p for p, _ in parts]), np.concatenate([v for _, v in parts])
+
+
+def covers_support(spec: VesselSpec, cfg: FluidConfig) -> bool:
+    """Whether the walls the liquid sees are at least the kernel support's layers thick (always under
+    ``kernel_layers``)."""
+    return numerical_wall_thickness(spec, cfg) >= wall_layers(cfg.spacing, cfg.support_radius) * cfg.spacing - 1e-12
+
+
+def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim), for ``cfg``'s spacing,
+    kernel support, dimension and wall model; a thin wall's volumes fitted (:func:`fit_wall_volumes`). Raises
+    InputError for a mesh wall too thin to hold a layer."""
+    points, volumes = slab_particles(spec, cfg)
+    if len(points) == 0:
+        raise InputError(f"fluid.wall_model: the {spec.name} vessel's wall ({spec.wall_thickness:.4g} m) holds no dummy "
+                         f"particle at spacing {cfg.spacing:.4g} m under 'real_thickness' (a mesh wall needs to be "
+                         "thicker than dx / 2; or 'kernel_layers')")
+    if covers_support(spec, cfg):
+        return points, volumes
+    return points, fit_wall_volumes(spec, cfg, points, volumes)
 
 
 def wetted_layer(spec: VesselSpec, points: np.ndarray, spacing: float, dim: int) -> np.ndarray:
