@@ -7,7 +7,8 @@ by the numerical wall thickness t (:func:`cosim.fluid.wall_sampling.numerical_wa
 a wall particle when it is outside the cavity, no higher than the rim's highest point, less than t from the
 liquid-facing faces, and behind them (on the side their outward normal points away from, or inside the walls): the
 layers that cover the kernel support behind every wetted face (Adami, Hu & Adams 2012); where the wall is thinner
-than t they reach beyond its outer face, as the box's do. Each particle's volume is dx^dim; in 2-D only y = 0.
+than t they reach beyond its outer face, as the box's do; ``confined`` (the ``real_thickness`` wall model) keeps only
+those inside the wall solid. Each particle's volume is dx^dim; in 2-D only y = 0.
 
 Liquid (:func:`fill_mesh_vessel`): the lattice of :func:`cosim.fluid.seeding.liquid_block` over the cavity's
 bounding box, kept where it is in the cavity and at least dx/2 from the liquid-facing faces, as the box's lattice
