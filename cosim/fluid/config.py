@@ -88,7 +88,7 @@ class FluidConfig:
     wall_model: WallModel = setting(WallModel.KERNEL_LAYERS, DISCRETISATION, "How the walls are filled with dummy "
                                     "particles: 'kernel_layers' (ceil(2h / dx) layers behind every wetted face, so a "
                                     "wall thinner than that reaches past its outer face and the pour lip with it) or "
-                                    "'real_thickness' (layers confined to the vessel's own wall, their volumes scaled "
+                                    "'real_thickness' (layers confined to the vessel's own wall, their volumes fitted "
                                     "to make up the kernel support missing behind a thin wall; the lip is the real "
                                     "one, docs/walls.md).")
     depth_2d: float = setting(0.1, DISCRETISATION, "2-D: the liquid's thickness across the pour plane as seeded (the "
