@@ -258,7 +258,7 @@ def check_pour(scene: PourScene, long_run_ok: bool = False) -> PourPlan:
     check_resolution(pourer, fill, cfg)
     seeded_depth = fill_layers(pourer, fill, cfg.spacing) * cfg.spacing
     particles = round(_liquid_volume(pourer, seeded_depth, cfg.dim) / cfg.particle_volume)
-    walls = sum(len(sample_vessel_walls(robots.arms[r].vessel, cfg.spacing, cfg.support_radius, cfg.dim)[0]) for r in ArmRole)
+    walls = sum(len(sample_vessel_walls(robots.arms[r].vessel, cfg)[0]) for r in ArmRole)
     check_memory(cfg, particles, walls, device)
     substeps = round(scene.coupling.max_duration / cfg.fixed_time_step)
     plan = PourPlan(robots, limits, base, cfg, particles, walls, liquid_bytes(cfg, particles, walls), substeps,

@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver
+from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver, WallModel
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -69,6 +69,7 @@ class FluidSettings:
                                     "spacing dx = B / particles_across.", "", 8, 400)
     smoothing_ratio: float = like(FluidConfig, "smoothing_ratio")
     kernel: KernelType = like(FluidConfig, "kernel")
+    wall_model: WallModel = like(FluidConfig, "wall_model")
     # ---- material
     rest_density: float = like(FluidConfig, "rest_density")
     kinematic_viscosity: float = like(FluidConfig, "kinematic_viscosity")

@@ -53,6 +53,6 @@ def test_cylinder_liquid_fills_the_disc_to_the_wall(across) -> None:
     layer = x[np.abs(x[:, 2] - 0.5 * dx) < 1e-9]
     gaps = np.linalg.norm(layer[:, None, :] - layer[None, :, :], axis=2) + np.eye(len(layer))
     assert gaps.min() > 0.8 * dx  # no two particles closer than a lattice would put them (within 20 %)
-    walls, _ = sample_vessel_walls(cup, dx, cfg.support_radius, 3)
+    walls, _ = sample_vessel_walls(cup, cfg)
     side = walls[walls[:, 2] > 0.0]
     assert np.hypot(side[:, 0], side[:, 1]).min() == pytest.approx(radius + 0.5 * dx, abs=1e-9)

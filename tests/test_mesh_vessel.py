@@ -169,8 +169,9 @@ def test_the_box_mesh_gives_the_box_liquid_and_walls():
     mesh_liquid, box_liquid = fill_vessel(beaker(), 0.07, cfg), fill_vessel(BEAKER_BOX, 0.07, cfg)
     np.testing.assert_array_equal(mesh_liquid.positions, box_liquid.positions)
     for dim in (2, 3):
-        walls, volumes = sample_vessel_walls(beaker(), cfg.spacing, cfg.support_radius, dim)
-        box_walls, _ = sample_vessel_walls(BEAKER_BOX, cfg.spacing, cfg.support_radius, dim)
+        cfg_dim = FluidConfig(dim=dim, spacing=cfg.spacing)
+        walls, volumes = sample_vessel_walls(beaker(), cfg_dim)
+        box_walls, _ = sample_vessel_walls(BEAKER_BOX, cfg_dim)
         assert np.all(volumes == cfg.spacing**dim)
         assert wetted_layer(beaker(), walls, cfg.spacing, dim).sum() == wetted_layer(BEAKER_BOX, box_walls, cfg.spacing, dim).sum()
         # the same layers but for the outer corners more than the layers' thickness from the cavity
@@ -186,9 +187,9 @@ def test_the_2d_mug_holds_the_liquid_and_floor_of_the_box_of_its_section(across)
     box = VesselSpec("pourer", VesselShape.BOX, 0.08, mug.section_depth, 0.10, 0.004, 1000.0)
     cfg = FluidConfig(dim=2, spacing=0.08 / across)
     np.testing.assert_array_equal(fill_vessel(mug, 0.07, cfg).positions, fill_vessel(box, 0.07, cfg).positions)
-    walls, volumes = sample_vessel_walls(mug, cfg.spacing, cfg.support_radius, 2)
+    walls, volumes = sample_vessel_walls(mug, cfg)
     floor = (walls[:, 2] < 0.0) & (np.abs(walls[:, 0]) < 0.04)
-    thickness = numerical_wall_thickness(mug, cfg.spacing, cfg.support_radius)
+    thickness = numerical_wall_thickness(mug, cfg)
     assert volumes[floor].sum() == pytest.approx(0.08 * thickness, rel=1e-12)
 
 

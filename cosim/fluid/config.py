@@ -27,6 +27,13 @@ class KernelType(Enum):
     WENDLAND_C2 = "wendland_c2"  # Wendland (1995) C2; no pairing instability at large neighbour counts
 
 
+class WallModel(Enum):
+    """How a vessel's walls are filled with dummy particles (``cosim.fluid.wall_sampling``)."""
+
+    KERNEL_LAYERS = "kernel_layers"  # ceil(2h / dx) layers behind every wetted face, past a thinner wall's outer face
+    REAL_THICKNESS = "real_thickness"  # layers inside the vessel's own wall, volumes compensating the missing support
+
+
 class GridReset(Enum):
     """How the neighbour grid's cell ranges are reset before each build (``cosim.fluid.neighbors``)."""
 
@@ -78,6 +85,12 @@ class FluidConfig:
     kernel: KernelType = setting(KernelType.WENDLAND_C2, DISCRETISATION, "SPH smoothing kernel, compact support 2h: "
                                  "Wendland (1995) C2 (no pairing instability at large neighbour counts) or Monaghan "
                                  "(1992)'s cubic spline.")
+    wall_model: WallModel = setting(WallModel.KERNEL_LAYERS, DISCRETISATION, "How the walls are filled with dummy "
+                                    "particles: 'kernel_layers' (ceil(2h / dx) layers behind every wetted face, so a "
+                                    "wall thinner than that reaches past its outer face and the pour lip with it) or "
+                                    "'real_thickness' (layers confined to the vessel's own wall, their volumes fitted "
+                                    "to make up the kernel support missing behind a thin wall; the lip is the real "
+                                    "one, docs/walls.md).")
     depth_2d: float = setting(0.1, DISCRETISATION, "2-D: the liquid's thickness across the pour plane as seeded (the "
                               "pourer's depth); a particle stands for the 3-D volume dx^2 depth_2d, spread over the depth "
                               "of any other vessel it enters (cosim.fluid.model). Volumes and wrenches reported outside "

@@ -7,7 +7,8 @@ by the numerical wall thickness t (:func:`cosim.fluid.wall_sampling.numerical_wa
 a wall particle when it is outside the cavity, no higher than the rim's highest point, less than t from the
 liquid-facing faces, and behind them (on the side their outward normal points away from, or inside the walls): the
 layers that cover the kernel support behind every wetted face (Adami, Hu & Adams 2012); where the wall is thinner
-than t they reach beyond its outer face, as the box's do. Each particle's volume is dx^dim; in 2-D only y = 0.
+than t they reach beyond its outer face, as the box's do; ``confined`` (the ``real_thickness`` wall model) keeps only
+those inside the wall solid. Each particle's volume is dx^dim; in 2-D only y = 0.
 
 Liquid (:func:`fill_mesh_vessel`): the lattice of :func:`cosim.fluid.seeding.liquid_block` over the cavity's
 bounding box, kept where it is in the cavity and at least dx/2 from the liquid-facing faces, as the box's lattice
@@ -116,14 +117,15 @@ def _lattice(lo: np.ndarray, hi: np.ndarray, anchor: np.ndarray, dx: float, dim:
     return np.stack([g.ravel() for g in grid], axis=1)
 
 
-def sample_mesh_walls(spec: VesselSpec, spacing: float, thickness: float, dim: int) -> tuple[np.ndarray, np.ndarray]:
+def sample_mesh_walls(spec: VesselSpec, spacing: float, thickness: float, dim: int, confined: bool) -> tuple[np.ndarray, np.ndarray]:
     """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim) of a mesh vessel whose walls
-    the liquid sees ``thickness`` (m) thick (module doc)."""
+    the liquid sees ``thickness`` (m) thick (module doc); ``confined``: only those inside the wall solid (the vessel's
+    own walls, :class:`cosim.fluid.config.WallModel`)."""
     lo, hi = cavity_bounds(spec)
     anchor = np.array([-0.5 * spec.inner_width, lo[1], 0.0])
     points = _lattice(lo - thickness, hi + np.array([thickness, thickness, 0.0]), anchor, spacing, dim)
-    inside, distance, behind, _ = classify(spec, points, 2.0 * thickness)
-    keep = ~inside & behind & (distance < thickness)
+    inside, distance, behind, solid = classify(spec, points, 2.0 * thickness)
+    keep = ~inside & behind & (distance < thickness) & (solid | (not confined))
     walls = points[keep]
     return walls, np.full(len(walls), spacing**dim)
 

@@ -122,7 +122,7 @@ def _geometry(spec: VesselSpec, wall_thickness: float, liquid_mass: float, mesh:
 def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: int, device, atomic_replicas: int = 1) -> FluidModel:
     """Fill the walls with dummy particles and allocate the static arrays (after checking that the liquid fits in
     the device's memory, :func:`cosim.fluid.memory.check_memory`)."""
-    walls = [sample_vessel_walls(s, cfg.spacing, cfg.support_radius, cfg.dim) for s in specs]
+    walls = [sample_vessel_walls(s, cfg) for s in specs]
     samples = [w[0] for w in walls]
     b_local = np.concatenate(samples) if samples else np.zeros((0, 3))
     check_memory(cfg, n_particles, len(b_local), wp.get_device(device))
@@ -130,7 +130,7 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
     b_wetted = np.concatenate([wetted_layer(s, w[0], cfg.spacing, cfg.dim) for s, w in zip(specs, walls)]) if walls else np.zeros(0, bool)
     b_vessel = np.concatenate([np.full(len(s), k, dtype=np.int32) for k, s in enumerate(samples)]) if samples else np.zeros(0, np.int32)
     reach = np.array([np.linalg.norm(s, axis=1).max() for s in samples]) if samples else np.zeros(0)
-    thickness = np.array([numerical_wall_thickness(s, cfg.spacing, cfg.support_radius) for s in specs])
+    thickness = np.array([numerical_wall_thickness(s, cfg) for s in specs])
     densest = densest_smoothing_ratio(cfg, specs)
     meshes = [warp_mesh(s.mesh.vertices, s.mesh.faces, device) if s.is_mesh else None for s in specs]
     make_grid = lambda capacity: CellGrid(cfg.domain_min, cfg.domain_max, cfg.support_radius, cfg.dim, capacity, device, cfg.grid_reset)  # noqa: E731

@@ -45,16 +45,25 @@ def _kernel_slope(kernel: KernelType, q: np.ndarray, h: float) -> np.ndarray:
     return -5.0 * q * (1.0 - 0.5 * q) ** 3 / h
 
 
-def lattice_kernel_sum(kernel: KernelType, smoothing_ratio: float, dim: int) -> float:
-    """sum_j W(x_i - x_j) dx^dim over a full square (cubic) lattice of spacing dx around x_i (itself included):
-    the summation density of a resting lattice in units of rho0 (1.005 for Wendland C2 at h = 1.5 dx in 2-D)."""
-    h = smoothing_ratio  # in units of dx
-    q = _lattice_q(h, dim)
+def kernel_values(kernel: KernelType, r: np.ndarray, h: float, dim: int) -> np.ndarray:
+    """W (1/m^dim) at distances ``r`` (m) for smoothing length ``h`` (m); 0 beyond the support 2h."""
+    return kernel_sigma(kernel, h, dim) * _kernel_shape(kernel, np.asarray(r, dtype=float) / h)
+
+
+def _kernel_shape(kernel: KernelType, q: np.ndarray) -> np.ndarray:
+    """W / sigma at q = r / h; 0 beyond q = 2."""
     if kernel is KernelType.CUBIC_SPLINE:
         w = np.where(q < 1.0, 1.0 - 1.5 * q**2 + 0.75 * q**3, 0.25 * (2.0 - q) ** 3)
     else:
         w = (1.0 - 0.5 * q) ** 4 * (2.0 * q + 1.0)
-    return float(kernel_sigma(kernel, h, dim) * w.sum())
+    return np.where(q < 2.0, w, 0.0)
+
+
+def lattice_kernel_sum(kernel: KernelType, smoothing_ratio: float, dim: int) -> float:
+    """sum_j W(x_i - x_j) dx^dim over a full square (cubic) lattice of spacing dx around x_i (itself included):
+    the summation density of a resting lattice in units of rho0 (1.005 for Wendland C2 at h = 1.5 dx in 2-D)."""
+    h = smoothing_ratio  # in units of dx
+    return float(kernel_sigma(kernel, h, dim) * _kernel_shape(kernel, _lattice_q(h, dim)).sum())
 
 
 def lattice_gradient_square_sum(kernel: KernelType, smoothing_ratio: float, dim: int) -> float:

@@ -1,24 +1,34 @@
 """Dummy wall particles of a vessel, in the vessel frame (numpy, done once per run).
 
-The walls are filled with layers of particles that cover the whole kernel support behind every wetted face
-(Adami, Hu & Adams 2012): ``n_layers = ceil(2h / dx)`` layers of spacing dx. Where the vessel's wall is thinner
-than that, the layers extend beyond its outer face: the liquid sees a wall ``numerical_wall_thickness`` thick
-(the inner faces, which hold the liquid, are exact; the outer faces and the pour lip move outwards by the
-difference, which :func:`numerical_wall_thickness` reports so that lip positions can be corrected). Layers sit
-below the rim, so liquid flowing over the rim sees the wall beneath it.
+The walls hold layers of dummy particles (Adami, Hu & Adams 2012), filled one of two ways
+(:class:`cosim.fluid.config.WallModel`):
 
-In 2-D only the section in the pour plane (local y = 0) is filled: the floor and the +x / -x walls; a cylinder's
-section is that of a box of width 2R. Each particle carries its own volume (m^dim): the slab volume divided by
-the number of particles in it, close to dx^dim.
+- ``kernel_layers``: ``n_layers = ceil(2h / dx)`` layers of spacing dx cover the whole kernel support behind every
+  wetted face. Where the vessel's wall is thinner than that, the layers extend beyond its outer face: the liquid
+  sees a wall ``numerical_wall_thickness`` thick (the inner faces, which hold the liquid, are exact; the outer faces
+  and the pour lip move outwards by the difference).
+- ``real_thickness``: the layers fill the vessel's own wall and nothing beyond it, round(t / dx) of them (at least
+  one) across a wall t thick, so the outer faces and the pour lip are the vessel's. A wall thinner than the kernel
+  support then lacks the particles behind it that a liquid particle near its face would sum over; their volumes
+  are fitted to make that up (:func:`fit_wall_volumes`).
+
+Layers sit below the rim, so liquid flowing over the rim sees the wall beneath it. In 2-D only the section in the
+pour plane (local y = 0) is filled: the floor and the +x / -x walls; a cylinder's section is that of a box of width
+2R. Each particle carries its own volume (m^dim): the slab volume divided by the number of particles in it, close
+to dx^dim (fitted where the wall is thinner than the support).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
+from cosim.errors import InputError
+from cosim.fluid.config import FluidConfig, WallModel
 from cosim.fluid.mesh_sampling import mesh_wetted_layer, sample_mesh_walls
+from cosim.fluid.sph_kernels import kernel_values
 from cosim.vessel import VesselSpec
 
 
@@ -27,9 +37,79 @@ def wall_layers(spacing: float, support: float) -> int:
     return max(1, math.ceil(support / spacing - 1e-9))
 
 
-def numerical_wall_thickness(spec: VesselSpec, spacing: float, support: float) -> float:
-    """Wall thickness (m) the liquid sees: the vessel's own, or the dummy layers' if those are thicker."""
-    return max(spec.wall_thickness, wall_layers(spacing, support) * spacing)
+def numerical_wall_thickness(spec: VesselSpec, cfg: FluidConfig) -> float:
+    """Wall thickness (m) the liquid sees: the vessel's own, or under ``kernel_layers`` the dummy layers' if those
+    are thicker."""
+    if cfg.wall_model is WallModel.REAL_THICKNESS:
+        return spec.wall_thickness
+    return max(spec.wall_thickness, wall_layers(cfg.spacing, cfg.support_radius) * cfg.spacing)
+
+
+# Sweeps of the multiplicative fit of the thin walls' volumes (fit_wall_volumes); the kernel sums it matches settle to
+# within 0.1 % well before
+FIT_SWEEPS = 40
+# Probe points per block of the pairwise distances (memory: block x wall particles floats)
+PROBE_BLOCK = 512
+
+
+def _kernel_pairs(probes: np.ndarray, points: np.ndarray, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pairs (probe index, point index, W (1/m^dim)) closer than the kernel support: the probes in blocks along
+    x, each against the points within its x range widened by the support."""
+    support = cfg.support_radius
+    order = np.argsort(probes[:, 0], kind="stable")
+    point_order = np.argsort(points[:, 0], kind="stable")
+    point_x = points[point_order, 0]
+    rows, cols, weights = [], [], []
+    for start in range(0, len(probes), PROBE_BLOCK):
+        index = order[start:start + PROBE_BLOCK]
+        block = probes[index]
+        lo, hi = np.searchsorted(point_x, [block[:, 0].min() - support, block[:, 0].max() + support])
+        near = point_order[lo:hi]
+        r = np.linalg.norm(block[:, None, :] - points[near][None, :, :], axis=2)
+        i, j = np.nonzero(r < support)
+        rows.append(index[i])
+        cols.append(near[j])
+        weights.append(kernel_values(cfg.kernel, r[i, j], cfg.smoothing_length, cfg.dim))
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(weights)
+
+
+def _kernel_sums(pairs, volumes: np.ndarray, n_probes: int) -> np.ndarray:
+    """(n_probes,) sum_b V_b W(p - x_b): the walls' share of each probe's summation density, in units of rho0."""
+    rows, cols, weights = pairs
+    return np.bincount(rows, weights * volumes[cols], n_probes)
+
+
+def fit_wall_volumes(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, volumes: np.ndarray) -> np.ndarray:
+    """Volumes (m^dim) of a thin wall's dummy particles ``points`` (their own slab volumes ``volumes`` to start from)
+    that make up the kernel support missing behind the wall.
+
+    Near a wall the dummy particles supply the share of a liquid particle's summation density that lies behind the
+    face, S(p) = sum_b V_b W(p - x_b) (times rho0); DFSPH holds that density to rho0. Walls covering the support
+    (``kernel_layers``: the liquid's own lattice continued behind every face) supply it as the liquid's lattice
+    would: S_ref(p). A thinner wall's own layers supply less. As Akinci et al. (2012, "Versatile rigid-fluid
+    coupling for incompressible SPH") give boundary particles volumes of their own so that a particle at a wall
+    sums to its rest density, the volumes are fitted here so that S(p) = S_ref(p) at the probes p, the points of
+    the liquid's initial lattice filling the vessel to its rim (:func:`cosim.fluid.seeding.fill_vessel`) within
+    reach of the walls: FIT_SWEEPS multiplicative sweeps V_b <- V_b sum_p W_pb S_ref(p) / S(p) / sum_p W_pb (each
+    particle scaled by the mean shortfall of the probes it reaches, weighted by its kernel there; volumes stay
+    positive). Inner edges and corners, where the missing support is largest, get the largest volumes. Particles no
+    probe reaches keep their slab volumes. One volume per particle cannot also match the kernel-gradient sums, nor
+    the sums of the wall particles themselves, which lack the layers behind them (docs/walls.md).
+    """
+    from cosim.fluid.seeding import fill_vessel
+
+    probes = fill_vessel(spec, spec.inner_height, cfg).positions
+    reference_points, reference_volumes = slab_particles(spec, replace(cfg, wall_model=WallModel.KERNEL_LAYERS))
+    reference = _kernel_sums(_kernel_pairs(probes, reference_points, cfg), reference_volumes, len(probes))
+    pairs = _kernel_pairs(probes, points, cfg)
+    rows, cols, weights = pairs
+    reach = np.bincount(cols, weights, len(points))
+    fitted = volumes.copy()
+    for _ in range(FIT_SWEEPS):
+        sums = _kernel_sums(pairs, fitted, len(probes))
+        ratio = np.divide(reference, sums, out=np.ones_like(sums), where=sums > 0.0)
+        fitted = np.where(reach > 0.0, fitted * np.bincount(cols, weights * ratio[rows], len(points)) / np.where(reach > 0.0, reach, 1.0), fitted)
+    return fitted
 
 
 def _axis(lo: float, hi: float, step: float) -> tuple[np.ndarray, float]:
@@ -80,12 +160,14 @@ def _fill_disc(radius: float, z0: float, z1: float, step: float) -> tuple[np.nda
     return np.concatenate(pts + [inner]), np.concatenate(vols + [outer])
 
 
-def sample_vessel_walls(spec: VesselSpec, spacing: float, support: float, dim: int) -> tuple[np.ndarray, np.ndarray]:
-    """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim)."""
+def slab_particles(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
+    """The walls' dummy particles (n, 3) in the vessel frame and their slab volumes (n,) (m^dim), before any fit
+    (:func:`sample_vessel_walls`)."""
     h = spec.inner_height
-    t = numerical_wall_thickness(spec, spacing, support)
+    t = numerical_wall_thickness(spec, cfg)
+    spacing, dim = cfg.spacing, cfg.dim
     if spec.is_mesh:
-        return sample_mesh_walls(spec, spacing, t, dim)
+        return sample_mesh_walls(spec, spacing, t, dim, confined=cfg.wall_model is WallModel.REAL_THICKNESS)
     if dim == 2 or spec.is_box:
         b = 0.5 * spec.inner_width
         d = 0.5 * spec.section_depth
@@ -101,6 +183,26 @@ def sample_vessel_walls(spec: VesselSpec, spacing: float, support: float, dim: i
         r = 0.5 * spec.inner_width
         parts = [_fill_disc(r + t, -t, 0.0, spacing), _fill_cylinder_shells(r, r + t, 0.0, h, spacing)]
     return np.concatenate([p for p, _ in parts]), np.concatenate([v for _, v in parts])
+
+
+def covers_support(spec: VesselSpec, cfg: FluidConfig) -> bool:
+    """Whether the walls the liquid sees are at least the kernel support's layers thick (always under
+    ``kernel_layers``)."""
+    return numerical_wall_thickness(spec, cfg) >= wall_layers(cfg.spacing, cfg.support_radius) * cfg.spacing - 1e-12
+
+
+def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim), for ``cfg``'s spacing,
+    kernel support, dimension and wall model; a thin wall's volumes fitted (:func:`fit_wall_volumes`). Raises
+    InputError for a mesh wall too thin to hold a layer."""
+    points, volumes = slab_particles(spec, cfg)
+    if len(points) == 0:
+        raise InputError(f"fluid.wall_model: the {spec.name} vessel's wall ({spec.wall_thickness:.4g} m) holds no dummy "
+                         f"particle at spacing {cfg.spacing:.4g} m under 'real_thickness' (a mesh wall needs to be "
+                         "thicker than dx / 2; or 'kernel_layers')")
+    if covers_support(spec, cfg):
+        return points, volumes
+    return points, fit_wall_volumes(spec, cfg, points, volumes)
 
 
 def wetted_layer(spec: VesselSpec, points: np.ndarray, spacing: float, dim: int) -> np.ndarray:

@@ -116,7 +116,7 @@ def run(p: Params) -> CaseResult:
     )
     vessels, poses, gate = [tank], [Pose()], None
     if p.gate_speed is not None:
-        gate = lifted_gate(wall, a, height, depth, p.dim, numerical_wall_thickness(tank, dx, cfg.support_radius), p.gate_speed)
+        gate = lifted_gate(wall, a, height, depth, p.dim, numerical_wall_thickness(tank, cfg), p.gate_speed)
         vessels.append(gate.spec)
         poses.append(gate.pose(0.0))
         top = max(tank.inner_height, gate.top) + margin  # the gate's ceiling stays in the domain at full travel

@@ -137,9 +137,10 @@ class Channel:
 
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
-    # the kernel's support (the domain does not matter to it) sets the dummy layers, and so the channel's layout
-    support = case_fluid_config(2, dx, p.crest_height + p.head, DEPTH, (-1, -1, -1), (1, 1, 1), p.solver, numerics=p.numerics).support_radius
-    thickness = numerical_wall_thickness(VesselSpec(), dx, support)  # the walls the liquid sees, both vessels'
+    # the kernel's support and the wall model (the domain does not matter to them) set the dummy layers, and so the
+    # channel's layout
+    layout = case_fluid_config(2, dx, p.crest_height + p.head, DEPTH, (-1, -1, -1), (1, 1, 1), p.solver, numerics=p.numerics)
+    thickness = numerical_wall_thickness(VesselSpec(), layout)  # the walls the liquid sees, both vessels'
     ch = Channel(p, dx, thickness)
     margin = 0.05  # m
     cfg = case_fluid_config(
