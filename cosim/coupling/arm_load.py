@@ -97,6 +97,7 @@ class ArmLoadMonitor:
             q, qd = targets[role]
             twin.ctrl[scene.arms[role].ctrl_adr] = scene.servo_controls(role, q, qd)
         mujoco.mj_step(scene.model, twin)
+        mujoco.mj_kinematics(scene.model, twin)  # the frames at the new qpos, as the coupled step brings the live ones
         k, bodies = self._recorded, self._bodies
         np.take(live.xpos, bodies, axis=0, out=self._live_pos[k])
         np.take(twin.xpos, bodies, axis=0, out=self._twin_pos[k])

@@ -90,6 +90,10 @@ def coupled_step(
             scene.apply_vessel_wrench(role, force, torque)
     dt = float(scene.model.opt.timestep)
     mujoco.mj_step(scene.model, scene.data)
+    # mj_step leaves the body frames at the step's start (its forward pass runs before the integration): bring them,
+    # and the Jacobians' frame (mj_comPos), to the new qpos so the liquid's target is the pose at t + dt.
+    mujoco.mj_kinematics(scene.model, scene.data)
+    mujoco.mj_comPos(scene.model, scene.data)
     fluid.set_vessel_poses(vessel_poses(scene))
     fluid.advance(dt)
     return fluid.vessel_wrenches()

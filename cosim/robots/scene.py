@@ -357,7 +357,7 @@ class RobotScene:
 
     def vessel_pose(self, role: ArmRole) -> tuple[np.ndarray, np.ndarray]:
         """The held vessel frame's world position (3,) m and orientation quaternion (4,) [w, x, y, z] (copies; valid
-        after mj_forward/mj_step): :meth:`vessel_state` without the velocity, for the every-step exchange."""
+        after mj_forward or mj_kinematics, not mj_step alone, whose forward pass precedes its integration): :meth:`vessel_state` without the velocity, for the every-step exchange."""
         body, d = self.arms[role].vessel_body, self.data
         return d.xpos[body].copy(), d.xquat[body].copy()
 
