@@ -15,8 +15,8 @@ from enum import Enum
 from controllers.errors import ControllerInputError
 from controllers.geometry import VesselGeometry
 from controllers.pid_spec import PidDesignSpec
-from controllers.slosh import GRAVITY, SloshModel, potential_flow_model
-from declared_settings.setting import REQUIRED, check_settings, documented, setting
+from controllers.slosh import SloshModel, potential_flow_model
+from declared_settings.setting import REQUIRED, check_settings, documented, like, setting
 
 
 class Handover(Enum):
@@ -60,7 +60,7 @@ POUR = "pour"
 class SimConfig:
     """Slosh induction (Camporredondo et al. 2019, Fig. 7).
 
-    pid: :class:`controllers.pid.PidDesignSpec`.
+    pid: the PID design of the damping phase t2, :class:`controllers.pid_spec.PidDesignSpec`.
     """
 
     mode: SimMode = setting(SimMode.AUTO, SIM, "When the slosh induction method runs: 'auto' when the fill condition "
@@ -224,13 +224,13 @@ class PourConfig:
     target_volume: float | None = setting(None, POUR, "Volume to pour (a partial pour).", "m^3", 0.0,
                                           "initial_volume", lo_open=True, none_means="pour until empty")
     control_rate: float = setting(
-        100.0, POUR, "Rate of PourController.step. 100 Hz: five 2 ms MuJoCo steps, 50 samples per slosh period (0.50 s "
-        "for the paper's vessel), the derivative filter Tf = 27 ms spans 2.7 samples, and the sampled SIM loop (theta1 "
-        "measured one period before it acts) keeps a 52 deg phase margin, 13.8 dB gain margin and Ms = 1.47 (50 Hz: "
-        "43 deg, 11.6 dB, Ms = 1.70).", "Hz", 20.0, 500.0)
+        100.0, POUR, "Rate of PourController.step. 100 Hz is five 2 ms MuJoCo steps and 50 samples per slosh period "
+        "of the paper's vessel (0.50 s). The PID is designed for the loop sampled at this rate, theta1 measured one "
+        "period before it acts, so a slower rate delays the feedback and leaves the design less margin (the designs' "
+        "margins: docs/controller.md).", "Hz", 20.0, 500.0)
     start_time: float = setting(0.0, POUR, "The controller idles (vessel at home, catcher pre-positioned) until this "
                                 "time.", "s", 0.0, 60.0)
-    gravity: float = setting(GRAVITY, POUR, "Gravity's magnitude.", "m/s^2", 0.0, 100.0, lo_open=True)
+    gravity: float = like(SloshModel, "gravity")
     follower_lag: float | None = setting(
         None, POUR, "How late the vessel's tilt follows a ramp of its command: the lag that the partial pour's stop "
         "counts in the after-flow it predicts (controllers.cfs.after_flow_volume), known from the arm's chain (the "

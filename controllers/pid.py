@@ -17,7 +17,8 @@ Loop: unity negative feedback, theta = C(s) (r - theta1), theta1 = Gp(s) theta, 
   ignores that lag; the paper's design placed on its printed plant, with the physical plant, has a closed-loop pole
   at +33 rad/s. :func:`design_filtered_pid` therefore places the poles for a family of bandwidths and keeps the
   design whose sampled loop with the delay (:func:`delayed_loop`) decays fastest while keeping the gain and phase
-  margins the spec asks for (6 dB and 45 deg by default, the usual robustness floor), verified with python-control.
+  margins the spec asks for (:class:`controllers.pid_spec.PidDesignSpec`; by default the usual robustness floor),
+  verified with python-control.
 * The PID reads theta1 through a low-pass (:func:`measurement_filter`) that passes the first slosh mode and stops
   the liquid's own faster motion (a weakly compressible liquid's acoustic modes, the particles' passage), which
   the derivative term would otherwise pass to the tilt. Its phase lag at omega1 is part of the loop the design

@@ -64,6 +64,7 @@ from functools import cached_property
 from typing import TYPE_CHECKING
 
 from controllers.checks import check_choice, check_range
+from declared_settings.setting import REQUIRED, check_settings, documented, setting
 
 if TYPE_CHECKING:  # python-control (and scipy) take seconds to load, NumPy a fraction of one: imported by the
     import control as ct  # functions that use them, so that reading a configuration stays fast
@@ -96,27 +97,30 @@ def first_mode_frequency(width: float, fill_depth: float, gravity: float = GRAVI
     return math.sqrt(gravity * k * math.tanh(k * fill_depth)) / (2.0 * math.pi)
 
 
+SLOSH = "first slosh mode"
+
+
+@documented
 @dataclass(frozen=True)
 class SloshModel:
-    """The first-mode pendulum (M): length ``l1`` (m), hinge ``hinge_height`` (m above the inner floor, on the
-    vessel's axis), ``damping_ratio`` zeta, ``gravity`` (m/s^2). ``source`` says where the numbers come from.
+    """The first-mode pendulum (M). ``source`` says where the numbers come from.
 
     Build it with :func:`potential_flow_model` (the default everywhere), from an SPH identification
     (``cosim validate slosh-plant``), or with :func:`printed_paper_model` to reproduce the paper's figures.
     Lengths in m, frequencies in rad/s unless the name says Hz.
     """
 
-    l1: float
-    hinge_height: float
-    damping_ratio: float = 0.0
-    gravity: float = GRAVITY
+    l1: float = setting(REQUIRED, SLOSH, "Length of the equivalent pendulum, g / omega1^2.", "m", 0.0, 10.0,
+                        lo_open=True)
+    hinge_height: float = setting(REQUIRED, SLOSH, "Height of the pendulum's hinge H above the inner floor, on the "
+                                  "vessel's axis.", "m", -2.0, 2.0)
+    damping_ratio: float = setting(0.0, SLOSH, "The mode's damping ratio zeta (0 for potential flow).", "", 0.0, 1.0,
+                                   hi_open=True)
+    gravity: float = setting(GRAVITY, SLOSH, "Gravity's magnitude.", "m/s^2", 0.0, 100.0, lo_open=True)
     source: str = "potential flow"
 
     def __post_init__(self) -> None:
-        check_range("slosh.l1", self.l1, 0.0, 10.0, "m", lo_open=True)
-        check_range("slosh.hinge_height", self.hinge_height, -2.0, 2.0, "m")
-        check_range("slosh.damping_ratio", self.damping_ratio, 0.0, 1.0, hi_open=True)
-        check_range("slosh.gravity", self.gravity, 0.0, 100.0, "m/s^2", lo_open=True)
+        check_settings(self, "slosh")
 
     @property
     def b2(self) -> float:

@@ -29,15 +29,14 @@ from cosim.robots.scene_config import (
     CATCHER_HOME_X, POUR_HEIGHT, POURER_FLOOR_ABOVE_TABLE, TABLE_TOP, SceneConfig, pour_cell_config,
 )
 from cosim.trajectory.limits import JointLimitOverride
-from cosim.trajectory.sampling import DEFAULT_SAMPLE_RATE_HZ, MAX_SAMPLE_RATE_HZ
+from cosim.trajectory.sampling import DEFAULT_SAMPLE_RATE_HZ, SAMPLE_RATE
 from cosim.vessel import VesselShape, VesselSpec, default_catching_vessel, mesh_vessel_spec, seed_pouring_vessel
 from declared_settings.setting import (
-    Derived, check_settings, declared, declared_fields, derived, documented, like, setting,
+    Derived, argument_field, check_settings, declared, declared_fields, derived, documented, like, setting,
 )
 
 
 LIQUID = "liquid"
-TRAJECTORY = "trajectory"
 VESSEL = "vessel"
 PLACEMENT = "placement"
 
@@ -186,8 +185,7 @@ class TrajectorySettings:
       driver uses, e.g. 'shoulder_pan_joint'), as the driver's tf_prefix.
     """
 
-    sample_rate_hz: float = setting(DEFAULT_SAMPLE_RATE_HZ, TRAJECTORY, "Rate of the exported joint trajectories.",
-                                    "Hz", 0.0, MAX_SAMPLE_RATE_HZ, lo_open=True)
+    sample_rate_hz: float = argument_field(SAMPLE_RATE, DEFAULT_SAMPLE_RATE_HZ)
     limits: dict[str, JointLimitOverride] = field(default_factory=dict)
     joint_prefix: JointPrefix = field(default_factory=JointPrefix)
 

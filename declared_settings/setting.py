@@ -136,14 +136,15 @@ def setting(
 ) -> Any:
     """A dataclass field with ``default`` declared as a :class:`Setting` (``kind`` from the default where not given:
     a bool, an Enum member, a tuple (vector, of the tuple's length), an int or a float; a None default, or an empty tuple for a list kind,
-    makes it optional, ``none_means`` saying what not setting it stands for; :data:`REQUIRED`: no default, a float
+    makes it optional, ``none_means`` saying what not setting it stands for; ``none_means`` with another default
+    makes it optional too, with that default, for code that passes None; :data:`REQUIRED`: no default, a float
     unless ``kind`` says otherwise). A bound given as a name is that attribute of the object the setting belongs to
     (:meth:`Bounds.of`)."""
     if kind is None:
         kind = ("bool" if isinstance(default, bool) else "choice" if isinstance(default, Enum)
                 else "vector" if isinstance(default, tuple) else "int" if isinstance(default, int) else "float")
     bounds = None if lo is None and hi is None else Bounds(lo, hi, lo_open, hi_open)
-    optional = default is None or (kind in LISTS and default == ())
+    optional = default is None or (kind in LISTS and default == ()) or bool(none_means)
     length = len(default) if isinstance(default, tuple) and default else 3
     spec = Setting(group, meaning, unit, kind, bounds, type(default) if kind == "choice" else None, optional, none_means,
                    length)
@@ -157,6 +158,13 @@ def argument(group: str, meaning: str, unit: str = "", lo: Bound = None, hi: Bou
     code that takes it and checked by :meth:`Setting.check` (a named bound reads the ``owner`` passed there)."""
     bounds = None if lo is None and hi is None else Bounds(lo, hi, lo_open, hi_open)
     return Setting(group, meaning, unit, kind, bounds)
+
+
+def argument_field(spec: Setting, default: Any) -> Any:
+    """A dataclass field declared by the :func:`argument` ``spec``, with ``default``: a configuration's setting that
+    a building block below it takes as an argument, declared once beside that building block (its default too), so
+    that both check it from the same declaration."""
+    return dataclasses.field(default=default, metadata={SETTING: spec})
 
 
 def declared(cls: type, name: str) -> Setting:

@@ -16,6 +16,8 @@ import pytest
 from controllers.config import ApproachConfig, CatcherConfig, CfsConfig, PourConfig, ReturnConfig, SimConfig
 from controllers.geometry import VesselGeometry
 from controllers.model_plant import ModelPlantConfig
+from controllers.pid_spec import PidDesignSpec
+from controllers.slosh import SloshModel
 from controllers.motion import (
     BANDWIDTH, MAX_ACCEL, MAX_JERK, MAX_RATE, STAGES, STOP_ACCEL, TIME_STEP, CriticallyDampedSmoother, JerkLimitedMove,
     RateLimitedTracker,
@@ -40,6 +42,8 @@ from cosim.sweep.spec import POURS, SEED, parse_sweep
 from cosim.trajectory.generator import GeneratorSettings
 from cosim.trajectory.limits import JointLimits
 from cosim.trajectory.pour_motion import PourMotionSpec
+from cosim.trajectory.recorder import TrajectoryRecorder
+from cosim.trajectory.sampling import SAMPLE_RATE
 from cosim.vessel import VesselSpec
 from cosim.validation import coupling_static, dam_break, free_fall, hydrostatic, moving_vessel, slosh, slosh_plant, weir
 from declared_settings.setting import REQUIRED, declared, declared_fields
@@ -77,6 +81,8 @@ def _joint(**values) -> JointLimits:
 # class, how to build it with some of its settings given, the prefix its messages name the fields with
 CLASSES = [
     (SimConfig, SimConfig, "sim."),
+    (PidDesignSpec, PidDesignSpec, "pid."),
+    (SloshModel, lambda **v: SloshModel(**{"l1": 0.1, "hinge_height": 0.1, **v}), "slosh."),
     (ApproachConfig, ApproachConfig, "approach."),
     (CfsConfig, CfsConfig, "cfs."),
     (ReturnConfig, ReturnConfig, "returning."),
@@ -193,6 +199,11 @@ def test_a_setting_with_no_default_is_required():
         CatcherConfig()
 
 
+def test_a_setting_with_a_default_and_a_meaning_of_none_takes_none_in_code():
+    assert declared(PidDesignSpec, "noise_frequency").optional
+    assert PidDesignSpec().noise_frequency > 0.0 and PidDesignSpec(noise_frequency=None).noise_frequency is None
+
+
 def test_the_scene_takes_the_controllers_declarations_and_defaults():
     for name in ("max_speed", "max_accel", "discharge_coefficient", "filter_time"):
         assert declared(CatcherSettings, name) == declared(CatcherConfig, name), name
@@ -200,6 +211,10 @@ def test_the_scene_takes_the_controllers_declarations_and_defaults():
     assert declared(ControllerSettings, "control_rate") == declared(PourConfig, "control_rate")
     assert ControllerSettings().control_rate == _pour().control_rate
     assert LiquidSettings().fill_depth == _pour().fill_depth == coupling_static.Params().fill
+
+
+def test_the_scene_and_the_recorder_take_the_sample_rate_from_one_declaration():
+    assert declared(TrajectorySettings, "sample_rate_hz") is SAMPLE_RATE
 
 
 def test_the_scene_keeps_each_sections_own_defaults():
@@ -216,7 +231,8 @@ def test_the_scenes_arm_sections_take_the_placements_declarations():
 
 # the scene's tables of declared settings, as a scene file names them
 SCENE_TABLES = [("liquid", LiquidSettings, "liquid."), ("controller", ControllerSettings, "controller."),
-                ("controller.sim", SimConfig, "sim."), ("controller.approach", ApproachConfig, "approach."),
+                ("controller.sim", SimConfig, "sim."), ("controller.sim.pid", PidDesignSpec, "pid."),
+                ("controller.approach", ApproachConfig, "approach."),
                 ("controller.cfs", CfsConfig, "cfs."), ("controller.returning", ReturnConfig, "returning."),
                 ("controller.catcher", CatcherSettings, "controller.catcher."),
                 ("controller.pose_filter", PoseFilterLimits, "pose_filter."), ("coupling", CouplingSettings, "coupling."),
@@ -280,6 +296,7 @@ ARGUMENTS = [
     (CLEARANCE, lambda v, _: MotionChecker(_robot_scene(), clearance=v), "collision.clearance", None),
     (MAX_JOINT_STEP, lambda v, _: MotionChecker(_robot_scene(), max_joint_step=v), "collision.max_joint_step", None),
     (PARTICLE_RADIUS, _recorder, "recording.particle_radius", None),
+    (SAMPLE_RATE, lambda v, _: TrajectoryRecorder((), v), "trajectory.sample_rate_hz", None),
     (SEED, lambda v, folder: parse_sweep({"seed": v, "axes": {"liquid.fill_depth": [0.1]}}, folder, "s"), "seed", None),
     (POURS, lambda v, folder: parse_sweep({"axes": {"fluid.particles_across": {"start": 16, "stop": 32, "num": v}}},
                                           folder, "s"), "axes.fluid.particles_across.num", None),

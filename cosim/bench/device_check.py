@@ -50,7 +50,7 @@ from cosim.atomic_files import write_text_atomic
 AGREEMENT_INTERVALS = 10  # of 4 ms: long enough for the graph replay (from the second interval on) to matter
 AGREEMENT_INTERVAL = 0.004  # s
 # s simulated and timed per pour, by dimension (after the warm-up): the 3-D pour at 112k particles plans 30,000
-# WCSPH substeps per simulated second (3,000 DFSPH), 15 s at 1 ms a substep
+# WCSPH substeps per simulated second (3,000 DFSPH), so 0.5 s is 15,000 substeps (their cost: docs/performance.md)
 POUR_SECONDS = {2: 2.0, 3: 0.5}
 # slosh periods run (the frequency is measured from a quarter period after the pulse: 2 periods leave the window
 # too few zero crossings to give one)

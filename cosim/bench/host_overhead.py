@@ -28,6 +28,7 @@ from cosim.coupling.loop import CoupledPour
 from cosim.coupling.settings import CouplingSettings
 from cosim.errors import InputError
 from cosim.bench.fluid_throughput import machine_description
+from cosim.bench.options import DURATION, REPEATS
 from cosim.fluid.config import PressureSolver
 from cosim.pour_run import prepare
 from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene, load_scene
@@ -123,10 +124,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--device", default="cpu", help="cpu or cuda[:N] (default cpu)")
     args = ap.parse_args(argv)
     try:
-        if not 0.0 < args.duration <= 60.0:
-            raise InputError(f"--duration: must be in (0, 60] s, got {args.duration:g}")
-        if not 1 <= args.repeats <= 50:
-            raise InputError(f"--repeats: must be in [1, 50], got {args.repeats}")
+        DURATION.check("--duration", args.duration)
+        REPEATS.check("--repeats", args.repeats)
         base = load_scene(args.scene) if args.scene else PourScene()
         variants = [scene_variant(base, PressureSolver(s), n, args.device) for s in args.solver for n in args.across]
     except InputError as exc:

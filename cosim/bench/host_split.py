@@ -26,6 +26,7 @@ import mujoco
 
 from cosim.bench.fluid_throughput import machine_description
 from cosim.bench.host_overhead import POUR_WARM_UP, time_steps
+from cosim.bench.options import DURATION
 from cosim.coupling import loop
 from cosim.coupling.loop import CoupledPour
 from cosim.errors import InputError
@@ -103,8 +104,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--threads", type=int, default=1, help="the liquid solver's CPU threads, 0: one per core (default 1)")
     args = ap.parse_args(argv)
     try:
-        if not 0.0 < args.duration <= 60.0:
-            raise InputError(f"--duration: must be in (0, 60] s, got {args.duration:g}")
+        DURATION.check("--duration", args.duration)
         declared(FluidConfig, "cpu_threads").check("--threads", args.threads)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)

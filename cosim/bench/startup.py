@@ -24,6 +24,7 @@ from collections.abc import Hashable
 from pathlib import Path
 
 from cosim.bench.fluid_throughput import machine_description
+from cosim.bench.options import REPEATS
 from cosim.errors import InputError
 
 THIS_TREE = Path(__file__).resolve().parents[2]  # the checkout this module is in
@@ -88,8 +89,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--before", type=Path, metavar="DIR", help="another checkout of cosim, timed in turn with this one")
     args = ap.parse_args(argv)
     try:
-        if not 1 <= args.repeats <= 50:
-            raise InputError(f"--repeats: must be in [1, 50], got {args.repeats}")
+        REPEATS.check("--repeats", args.repeats)
         if args.before is not None and not (args.before / "cosim" / "__main__.py").is_file():
             raise InputError(f"--before: must be a checkout of cosim (with cosim/__main__.py), got {args.before}")
     except InputError as exc:

@@ -28,6 +28,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from cosim.bench.fluid_throughput import machine_description
+from cosim.bench.options import DURATION
 from cosim.bench.report import update_document
 from cosim.errors import InputError
 
@@ -121,8 +122,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--docs", type=Path, help="Markdown file to put the table into (between this tool's markers)")
     args = ap.parse_args(argv)
     try:
-        if not 0.0 < args.duration <= 60.0:
-            raise InputError(f"--duration: must be in (0, 60] s, got {args.duration:g}")
+        DURATION.check("--duration", args.duration)
         if not 1 <= args.repeats <= 20:
             raise InputError(f"--repeats: must be in [1, 20], got {args.repeats}")
     except InputError as exc:

@@ -52,6 +52,7 @@ from cosim.robots.vessel_mjcf import frame_site
 from cosim.trajectory.generator import GeneratorSettings, TrajectoryGenerator
 from cosim.trajectory.limits import ArmLimits
 from cosim.trajectory.recorder import TrajectoryRecorder
+from cosim.trajectory.sampling import DEFAULT_SAMPLE_RATE_HZ
 
 CATCHER_TRAVEL = 0.15  # m each way along x: the catcher workspace the robot scene's IK is verified over
 # IK of the smoothed vessel targets: converged far below the trajectory checks' tolerances (looser solves add
@@ -125,7 +126,7 @@ class CoupledPour:
         geometry: MeasurementGeometry,
         settings: CouplingSettings,
         pose_limits: PoseFilterLimits = PoseFilterLimits(),
-        sample_rate_hz: float = 500.0,
+        sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
     ):
         self.scene, self.fluid, self.controller = scene, fluid, controller
         dt = float(scene.model.opt.timestep)
@@ -343,7 +344,7 @@ def build_pour(
     settings: CouplingSettings = CouplingSettings(),
     device: str = "cpu",
     pose_limits: PoseFilterLimits = PoseFilterLimits(),
-    sample_rate_hz: float = 500.0,
+    sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ,
 ) -> CoupledPour:
     """Assemble a pour: the liquid filling the pourer at home to ``fill_depth``, the controller (built by
     ``pour_config(vessel_geometry, catcher_config, actual_fill_depth, initial_volume)``), the arms' trajectory

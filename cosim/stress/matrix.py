@@ -22,7 +22,7 @@ from cosim.validation.scripted import FALL_HEIGHT, PoseScript, domain_around, sh
 from cosim.validation.slosh import eq17_frequency
 from cosim.vessel import VesselSpec, seed_pouring_vessel
 
-DURATION = 0.6  # s simulated per configuration (the budget: the whole matrix, two solvers, in 25 min on 2 CPU cores)
+DURATION = 0.6  # s simulated per configuration: the whole matrix's time budget (docs/tuning.md)
 TILT_ANGLE = math.pi / 2  # rad, a tilt stops (and is held) at 90 deg
 CARRY_TIME = 0.4  # s, a carry accelerates and stops within this time, then the vessel is held
 # Bound on the linear slosh response of a carry, in units of the quasi-static surface rise (B/2) a_max / g. By

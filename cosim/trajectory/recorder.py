@@ -12,23 +12,22 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from cosim.checks import check_positive
 from cosim.trajectory.generator import TIME_EPSILON, TrajectoryGenerator
 from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.limits import ArmLimits
-from cosim.trajectory.sampling import DEFAULT_SAMPLE_RATE_HZ, MAX_SAMPLE_RATE_HZ
-
+from cosim.trajectory.sampling import DEFAULT_SAMPLE_RATE_HZ, SAMPLE_RATE
 
 
 class TrajectoryRecorder:
-    """Records ``generators`` (all with the same cycle time and clock) at ``sample_rate_hz`` (0, 10000] Hz.
+    """Records ``generators`` (all with the same cycle time and clock) at ``sample_rate_hz`` (Hz, in
+    :data:`cosim.trajectory.sampling.SAMPLE_RATE`'s range).
 
     Call :meth:`record` after every :meth:`TrajectoryGenerator.step` of all generators; :meth:`trajectory` returns
     what was recorded so far.
     """
 
     def __init__(self, generators: Sequence[TrajectoryGenerator], sample_rate_hz: float = DEFAULT_SAMPLE_RATE_HZ) -> None:
-        self.sample_rate_hz = check_positive("trajectory.sample_rate_hz", sample_rate_hz, "Hz", MAX_SAMPLE_RATE_HZ)
+        self.sample_rate_hz = SAMPLE_RATE.check("trajectory.sample_rate_hz", sample_rate_hz)
         self.generators = tuple(generators)
         if not self.generators:
             raise ValueError("TrajectoryRecorder needs at least one generator")

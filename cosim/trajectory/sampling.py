@@ -1,5 +1,7 @@
-"""The rate the joint trajectories are sampled at: its default and its range, for the recorder and the scene (its own
-module, so that a scene names them without loading the recorder's NumPy and ruckig)."""
+"""The rate the joint trajectories are sampled at, declared once for the recorder that takes it and the scene that
+sets it (its own module, so that a scene reads the declaration without loading the recorder's NumPy and ruckig)."""
 
-DEFAULT_SAMPLE_RATE_HZ = 500.0  # Hz
-MAX_SAMPLE_RATE_HZ = 10_000.0  # Hz; the rate is in (0, MAX_SAMPLE_RATE_HZ]
+from declared_settings.setting import argument
+
+DEFAULT_SAMPLE_RATE_HZ = 500.0  # Hz, the scene's trajectory.sample_rate_hz and the recorder's default
+SAMPLE_RATE = argument("trajectory", "Rate of the exported joint trajectories.", "Hz", 0.0, 10_000.0, lo_open=True)

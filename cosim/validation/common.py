@@ -11,7 +11,7 @@ import numpy as np
 from cosim.checks import check_device
 from cosim.errors import InputError
 from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
-from declared_settings.setting import check_settings, declared
+from declared_settings.setting import check_settings, declared, like
 
 # FluidConfig fields a case's numerics may override (the rest is the case's geometry, physics and solver).
 NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "density_iteration", "density_tolerance", "wall_model")
@@ -59,7 +59,7 @@ class CaseResult:
 class FluidCaseParams:
     """Parameters every fluid case shares (overridable from the command line).
 
-    spacing: m, particle spacing (None: the case's default resolution). dim: 2 or 3. device: 'cpu' or 'cuda[:N]'.
+    device: 'cpu' or 'cuda[:N]'.
     depth: m, tank depth perpendicular to the pour plane (3-D extent, rounded to whole spacings by
         :meth:`tank_depth`; 2-D out-of-plane scale).
     solver: pressure solver, :class:`PressureSolver` or its name ('wcsph', 'dfsph').
@@ -67,18 +67,15 @@ class FluidCaseParams:
         (("kernel", "cubic_spline"), ("cfl", 0.4)); one of NUMERICS_FIELDS each (the benchmark's axes).
     """
 
-    spacing: float | None = None
-    dim: int = FluidConfig.dim
+    spacing: float | None = like(FluidConfig, "spacing", None, "the case's default resolution")
+    dim: int = like(FluidConfig, "dim")
     device: str = "cpu"
     depth: float = FluidConfig.depth_2d
     solver: PressureSolver = FluidConfig.pressure_solver
     numerics: tuple[tuple[str, Any], ...] = ()
 
     def __post_init__(self) -> None:
-        """The shared parameters checked, then a case's own declared ones (:func:`check_settings`)."""
-        if self.spacing is not None:
-            declared(FluidConfig, "spacing").check("spacing", self.spacing)
-        declared(FluidConfig, "dim").check("dim", self.dim)
+        """The shared parameters checked, then the declared ones, the shared and the case's own (:func:`check_settings`)."""
         check_device("device", self.device)
         declared(FluidConfig, "depth_2d").check("depth", self.depth)
         object.__setattr__(self, "solver", declared(FluidConfig, "pressure_solver").check("solver", self.solver))
