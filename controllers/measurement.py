@@ -10,6 +10,7 @@ about world +y, positive lowers the lip.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from enum import Enum
 
@@ -112,6 +113,10 @@ class PhaseTransition:
     reason: str
 
 
+# A command's path ahead where the controller knows it (an analytic command): ``tau`` s ahead (s) -> the target pose.
+PoseAhead = Callable[[float], PlanarPose]
+
+
 @dataclass(frozen=True)
 class PourCommand:
     """The controller's answer for one step.
@@ -127,6 +132,9 @@ class PourCommand:
     feedback: the pourer's target is a feedback command whose timing matters (the slosh damping, SIM_DAMP), already
       smoothed by the controller (:class:`controllers.motion.CriticallyDampedSmoother`): it goes to the arm without
       further smoothing lag.
+    pourer_ahead: the pourer's target ``tau`` s ahead, where the command is analytic (the slosh induction's
+      excitation and the hold it ends in), so that a stage that delays the path can be fed it that much early;
+      None elsewhere.
     """
 
     t: float
@@ -137,6 +145,7 @@ class PourCommand:
     landing_x: float
     slosh_angle: float
     feedback: bool = False
+    pourer_ahead: PoseAhead | None = None
 
     @property
     def done(self) -> bool:

@@ -33,7 +33,7 @@ from controllers.cfs import after_flow_volume, cfs_increment, cfs_pivot, crest_l
 from controllers.config import Damping, Handover, PourConfig, SimMode
 from controllers.errors import ControllerInputError, MeasurementError
 from controllers.geometry import PlanarPose, static_tilt_for_h_q
-from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PourCommand
+from controllers.measurement import LiquidMeasurement, Phase, PhaseTransition, PoseAhead, PourCommand
 from controllers.motion import CriticallyDampedSmoother, JerkLimitedMove, RateLimitedTracker, fitted_delay
 from controllers.pid import DiscretePid, PidDesign, design_filtered_pid
 from controllers.sampled_filter import SampledFilter
@@ -221,6 +221,7 @@ class PourController:
             landing_x=self._catcher.target_dx + self.config.catcher.home_x if landing is None else landing,
             slosh_angle=m.slosh_angle,
             feedback=self.phase is Phase.SIM_DAMP,
+            pourer_ahead=self._excitation_ahead(m) if self.phase in (Phase.SIM_EXCITE, Phase.SIM_HOLD) else None,
         )
 
     # ---- bookkeeping ------------------------------------------------------------------------------------------
@@ -448,6 +449,15 @@ class PourController:
     def _act_excite(self, m: LiquidMeasurement) -> PlanarPose:
         theta = excitation_tilt(self._elapsed(m), self.sim_amplitude, self.sim_frequency)
         return self.pose.rotated_about((0.0, 0.0), theta)
+
+    def _excitation_ahead(self, m: LiquidMeasurement) -> PoseAhead:
+        """The excitation's command ``tau`` s after this step (its hold at phi after the quarter period); in the
+        hold, the held pose."""
+        pose = self.pose
+        if self.phase is Phase.SIM_HOLD:
+            return lambda tau: pose
+        elapsed, phi, alpha = self._elapsed(m), self.sim_amplitude, self.sim_frequency
+        return lambda tau: pose.rotated_about((0.0, 0.0), excitation_tilt(elapsed + tau, phi, alpha))
 
     def _act_damp(self, m: LiquidMeasurement) -> PlanarPose:
         assert self._pid is not None and self._smoother is not None

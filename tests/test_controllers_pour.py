@@ -475,3 +475,23 @@ def test_cfs_that_no_longer_pours_returns_as_stalled() -> None:
     # not before a whole hold of CFS has been seen
     cfs_entry = next(tr.t for tr in controller.transitions if tr.target is Phase.CFS)
     assert transition.t - cfs_entry >= config.cfs.max_tilt_hold
+
+
+def test_the_excitations_path_ahead_is_the_commands_that_follow() -> None:
+    """In the excitation and its hold the command carries its path ahead: one period on, the next command (the hold
+    holds the excitation's last sample, short of phi by at most phi (alpha dt)^2 / 2), and in the hold the held pose;
+    elsewhere there is none."""
+    controller, _, trace = _run(_config(), duration=2.0)
+    commands = trace.commands
+    dt = commands[1].t - commands[0].t
+    induced = [k for k, c in enumerate(commands) if c.phase in (Phase.SIM_EXCITE, Phase.SIM_HOLD)]
+    assert induced and all(c.pourer_ahead is None for k, c in enumerate(commands) if k not in induced)
+    last_sample = controller.sim_amplitude * (controller.sim_frequency * dt) ** 2 / 2.0
+    for k in induced[:-1]:
+        ahead = commands[k].pourer_ahead(dt)
+        following = commands[k + 1].pourer
+        tolerance = 1e-12 if commands[k + 1].phase is commands[k].phase else last_sample
+        assert ahead.theta == pytest.approx(following.theta, abs=tolerance)
+        assert (ahead.dx, ahead.dz) == pytest.approx((following.dx, following.dz), abs=1e-12)
+    hold = [k for k in induced if commands[k].phase is Phase.SIM_HOLD]
+    assert hold and all(commands[k].pourer_ahead(0.5) == commands[k].pourer for k in hold)

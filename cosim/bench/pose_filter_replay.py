@@ -5,11 +5,12 @@
 Reads ``RUN/series.csv`` (the controller's pourer targets ``target_dx``, ``target_dz``, ``target_theta`` and the
 phase, every control period) and passes them through :class:`cosim.coupling.pose_filter.PoseFilter` and
 :class:`cosim.coupling.pose_filter.PoseSmoother` as the coupling loop does (the slosh damping's command passed
-through, the slosh induction undelayed, CFS tracked). The filters are pure functions of the targets, so with the
-code that ran the pour the replay gives the recorded ``smoothed_theta`` exactly (printed as a check); with other
-filter code it shows what that code would have made of the same targets. The controller does not see the change
-(the targets are the recorded ones), so this measures the filter alone. ``--rest-to-rest``: the jerk-limited
-filter in CFS too (each target approached as one to stop at), the filter before tracking.
+through, the slosh damping undelayed, CFS tracked). The filters are pure functions of the targets, so with the
+code that ran the pour the replay gives the recorded ``smoothed_theta`` exactly (printed as a check) in a pour without
+slosh induction (the coupling feeds the filter the excitation ahead of the recorded command: the replay differs from
+there on); with other filter code it shows what that code would have made of the same targets. The controller does
+not see the change (the targets are the recorded ones), so this measures the filter alone. ``--rest-to-rest``: the
+jerk-limited filter in CFS too (each target approached as one to stop at), the filter before tracking.
 
 Prints, over CFS from :data:`SETTLE` after its start to its end: the tilt's delay behind the command
 (least-squares fit, :func:`controllers.motion.fitted_delay`) after the filter and after the smoothing, and per
@@ -27,7 +28,7 @@ import numpy as np
 
 from controllers.measurement import Phase
 from controllers.motion import fitted_delay
-from cosim.coupling.loop import SLOSH_INDUCTION, TRACKED
+from cosim.coupling.loop import TRACKED, UNDELAYED
 from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits, PoseSmoother
 from cosim.robots.planar import PlanarPose
 from cosim.trajectory.smoothness import acceleration_rms_above, jerk_sign_changes
@@ -50,7 +51,7 @@ def replay(series: Path, rest_to_rest: bool = False) -> dict[str, object]:
         target = PlanarPose(float(row["target_dx"]), float(row["target_dz"]), float(row["target_theta"]))
         limited = pose_filter(target, pass_through=phase is Phase.SIM_DAMP, track=phase in TRACKED and not rest_to_rest)
         passed = pose_filter.passing
-        smoothed = smoother(limited, passing=passed or phase in SLOSH_INDUCTION, source="command" if passed else "limited")
+        smoothed = smoother(limited, passing=passed or phase in UNDELAYED, source="command" if passed else "limited")
         limited_path.append([getattr(limited, c) for c in COORDINATES])
         smoothed_path.append([getattr(smoothed, c) for c in COORDINATES])
     return {

@@ -39,7 +39,7 @@ from cosim.coupling.exchange import ROLES, vessel_poses, wrench_at_body_com
 from cosim.coupling.landing import landing_accuracy
 from cosim.coupling.outflow import outflow_timing
 from cosim.coupling.measure import LiquidProbe, MeasurementGeometry
-from cosim.coupling.pose_filter import PoseFilter, PoseFilterLimits, PoseSmoother
+from cosim.coupling.pose_filter import SMOOTHING_DELAY, PoseFilter, PoseFilterLimits, PoseSmoother
 from cosim.coupling.settings import Compensation, Coupling, CouplingSettings
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.seeding import fill_vessel
@@ -58,10 +58,14 @@ CATCHER_TRAVEL = 0.15  # m each way along x: the catcher workspace the robot sce
 # IK of the smoothed vessel targets: converged far below the trajectory checks' tolerances (looser solves add
 # solver noise that shows up as joint acceleration, trajectory tests).
 TARGET_IK = IKSettings(position_tolerance=1e-10, rotation_tolerance=1e-10, max_iterations=200)
-# The slosh induction's phases: the excitation, the hold that waits for the slosh's zero crossing and the damping's
-# feedback are timed against the liquid's own oscillation and the arm's known delay, so the pourer's path in them is
-# not delayed by the pose smoothing (cosim.coupling.pose_filter.PoseSmoother).
-SLOSH_INDUCTION = (Phase.SIM_EXCITE, Phase.SIM_HOLD, Phase.SIM_DAMP)
+# The phases whose pourer path the pose smoothing does not delay (cosim.coupling.pose_filter.PoseSmoother): the slosh
+# damping, a feedback loop designed with the arm's known delay. The excitation and the hold before it go through the
+# smoothing like every other path: the jerk-limited filter re-plans a stop at every excitation target and, where it
+# catches up with a small excitation, follows it bang-bang in jerk at the control rate, the ripple the smoothing
+# stages roll off. Their delay is taken out where the command's path ahead is known (the excitation's): the filter
+# is fed the command SMOOTHING_DELAY early, so that the arm tilts when it did without the stages (the hold's end
+# is timed by the slosh against the vessel's measured tilt).
+UNDELAYED = (Phase.SIM_DAMP,)
 # The phases whose targets move on every period (the CFS law's tilt and the catcher's landing point): the pose filter
 # tracks them instead of approaching each as a target to stop at (cosim.coupling.pose_filter.PoseFilter).
 TRACKED = (Phase.CFS, Phase.CFS_FINAL)
@@ -195,11 +199,13 @@ class CoupledPour:
         smoothed = {}
         for role in ROLES:
             t = targets[role]
+            if role is ArmRole.POUR and cmd.pourer_ahead is not None:
+                t = cmd.pourer_ahead(SMOOTHING_DELAY)
             limited = self.filters[role](
                 PlanarPose(t.dx, t.dz, t.theta), pass_through=role is ArmRole.POUR and cmd.feedback, track=cmd.phase in TRACKED,
             )
             passed = self.filters[role].passing
-            undelayed = passed or (role is ArmRole.POUR and cmd.phase in SLOSH_INDUCTION)
+            undelayed = passed or (role is ArmRole.POUR and cmd.phase in UNDELAYED)
             pose = self.smoothers[role](limited, passing=undelayed, source="command" if passed else "limited")
             smoothed[role] = pose
             pos, quat = scene.vessel_target(role, pose)

@@ -149,9 +149,9 @@ class PoseSmoother:
     :class:`PoseFilter`'s, starting at rest at the home pose (all zero).
 
     A path that must not be delayed (a command the pose filter passes through, the slosh damping's feedback, whose
-    delay the controller's design includes with its own smoothing; the coupling also passes the slosh induction's
-    path) is not delayed. The output is always a path plus a residual: the smoothed limited pose, or the undelayed
-    path itself, plus what is left of the difference at the last hand-over, blended
+    delay the controller's design includes with its own smoothing; the coupling also passes the damping's path
+    before the filter joins it) is not delayed. The output is always a path plus a residual: the smoothed limited
+    pose, or the undelayed path itself, plus what is left of the difference at the last hand-over, blended
     out over :data:`HANDOVER_TIME` with zero rate and acceleration at both ends (:func:`_blend_out`). At a hand-over to
     pass-through the residual is where the output would be at its last rate less the command (the pose filter joins
     a command up to a millimetre or milliradian away from its own path, :data:`PASS_THROUGH_JOIN`); back to filtering, the smoothing stages restart
