@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from cosim.fluid.config import GRAVITY
+from cosim.fluid.config import GRAVITY, FluidConfig
 from cosim.fluid.wall_sampling import sample_vessel_walls
 from cosim.validation import dam_break
 from cosim.validation.dam_gate import lauber_hager_speed, lifted_gate
@@ -38,7 +38,7 @@ def test_gate_rises_at_its_speed_then_stops_clear_of_the_column() -> None:
 def test_only_the_gate_wall_faces_the_column(dim: int) -> None:
     wall_x, a, height, depth = -0.2, 0.05, 0.06, 0.1
     gate = lifted_gate(wall_x, a, height, depth, dim, LAYERS, speed=1.0)
-    local, _ = sample_vessel_walls(gate.spec, DX, SUPPORT, dim)
+    local, _ = sample_vessel_walls(gate.spec, FluidConfig(dim=dim, spacing=DX))  # support 2h = 3 dx = SUPPORT
     for t in (0.0, 0.02):
         world = gate.pose(t).transform(local)
         lift = gate.lift(t)
