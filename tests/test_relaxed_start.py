@@ -12,7 +12,7 @@ import pytest
 
 from cosim.fluid.config import GRAVITY, FluidConfig, InitialState
 from cosim.fluid.dfsph import MAX_PARTICLE_RESIDUAL
-from cosim.fluid.relaxation import RELAX_INTERVAL, RELAX_TIME_CAP, stop_speed
+from cosim.fluid.relaxation import AT_REST, RELAX_INTERVAL, RELAX_TIME_CAP, STALLED, TIME_CAP, stop_speed
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
@@ -53,7 +53,7 @@ def test_seeded_is_the_default_and_keeps_the_seeded_offsets():
 def test_relaxation_stops_by_its_speed_criterion_and_starts_the_run_at_rest():
     solver = _tank(InitialState.RELAXED)
     report = solver.relaxation
-    assert report.converged and report.last_speed < stop_speed(GRAVITY)
+    assert report.outcome == AT_REST and report.converged and report.last_speed < stop_speed(GRAVITY)
     assert 1 < report.intervals < RELAX_TIME_CAP / RELAX_INTERVAL and report.substeps >= report.intervals
     assert report.settle_time == pytest.approx(report.intervals * RELAX_INTERVAL)
     assert solver.time == 0.0 and solver.step_count == 0 and solver.history() == {}
@@ -62,11 +62,13 @@ def test_relaxation_stops_by_its_speed_criterion_and_starts_the_run_at_rest():
     assert not _offsets(solver).any()  # no per-particle offset on the relaxed path
 
 
-def test_relaxation_reports_a_time_cap_reached_before_its_criterion():
+def test_relaxation_reports_a_time_cap_or_a_stall_reached_before_its_criterion():
     solver = _tank(InitialState.RELAXED, relax_start=False)
     assert solver.relaxation is None
-    report = solver.relax(2 * RELAX_INTERVAL, RELAX_INTERVAL, stop=1e-9)
-    assert not report.converged and report.intervals == 2 and report.last_speed >= 1e-9
+    capped = solver.relax(2 * RELAX_INTERVAL, RELAX_INTERVAL, stop=1e-9)
+    assert capped.outcome == TIME_CAP and not capped.converged and capped.intervals == 2 and capped.last_speed >= 1e-9
+    stalled = _tank(InitialState.RELAXED, relax_start=False).relax(RELAX_TIME_CAP, RELAX_INTERVAL, stop=1e-9, stall=2 * RELAX_INTERVAL)
+    assert stalled.outcome == STALLED and stalled.intervals < RELAX_TIME_CAP / RELAX_INTERVAL
 
 
 def _rms_speed_after(solver: FluidSolver, intervals: int) -> float:

@@ -33,7 +33,7 @@ from cosim.fluid.instability import FluidInstabilityError, check_interval
 from cosim.fluid.lanes import Lanes, lane_count
 from cosim.fluid.memory import allocation_failure_refused
 from cosim.fluid.model import FluidModel, FluidState, build_model
-from cosim.fluid.relaxation import RELAX_INTERVAL, RELAX_TIME_CAP, RelaxationReport, relax_liquid, stop_speed
+from cosim.fluid.relaxation import RELAX_INTERVAL, RELAX_TIME_CAP, STALL_TIME, RelaxationReport, relax_liquid, stop_speed
 from cosim.fluid.runner import SubstepRunner
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
@@ -124,7 +124,7 @@ class FluidSolver:
         self.energy_account = EnergyAccount(config, vessels, particles.positions, particles.velocities, self.step.internal_energy(state))
         self.relaxation: RelaxationReport | None = None
         if relax_start and config.initial_state is InitialState.RELAXED:
-            self.relaxation = self.relax(RELAX_TIME_CAP, RELAX_INTERVAL, stop_speed(config.gravity_magnitude))
+            self.relaxation = self.relax(RELAX_TIME_CAP, RELAX_INTERVAL, stop_speed(config.gravity_magnitude), STALL_TIME)
 
     # ---- set-up ----------------------------------------------------------------------------------------------
     def _planar(self, pose: Pose) -> Pose:
@@ -226,17 +226,17 @@ class FluidSolver:
         self._last_report = IntervalReport(n_sub, dt, lambda: rows.record(n_sub - 1, first + n_sub - 1, t0 + (n_sub - 1) * dt + dt, dt, n, volume))
         return self._last_report
 
-    def relax(self, duration: float, interval: float, stop: float = 0.0) -> RelaxationReport:
+    def relax(self, duration: float, interval: float, stop: float = 0.0, stall: float = math.inf) -> RelaxationReport:
         """Let the seeded liquid settle into the solver's own rest state, then start the run from it at t = 0
         (:func:`cosim.fluid.relaxation.relax_liquid`): the vessels held at their poses, intervals of ``interval``
-        s, every particle's velocity set to zero after each, for ``duration`` s or until no particle regained more
-        than ``stop`` m/s within an interval (0: the whole ``duration``). A seeding that is not the lattice the rest
-        density is normalised on (rings in a cylinder) starts with local density errors of a few per cent; DFSPH
-        corrects a density error within one substep by a velocity of error times spacing over dt, so released at
-        once the liquid would carry that velocity on (hundreds of mm/s, which the liquid's small viscosity does not
-        remove). Here the pressure solve's position corrections are kept and the velocity that made them is
-        dropped."""
-        return relax_liquid(self, duration, interval, stop)
+        s, every particle's velocity set to zero after each, for ``duration`` s, or until no particle regained more
+        than ``stop`` m/s within an interval (0: never), or until that largest speed has set no new low for
+        ``stall`` s (inf: never). A seeding that is not the lattice the rest density is normalised on (rings in a
+        cylinder) starts with local density errors of a few per cent; DFSPH corrects a density error within one
+        substep by a velocity of error times spacing over dt, so released at once the liquid would carry that
+        velocity on (hundreds of mm/s, which the liquid's small viscosity does not remove). Here the pressure
+        solve's position corrections are kept and the velocity that made them is dropped."""
+        return relax_liquid(self, duration, interval, stop, stall)
 
     def restart_at_rest(self) -> None:
         """The clock, the step count, the history and the energy account restart from the liquid as it is, at rest
