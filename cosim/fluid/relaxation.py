@@ -3,9 +3,9 @@
 A seeded lattice is not the solver's own rest state. Near a free surface (and near a curved wall seeded in rings)
 the kernel sums fall short of the rest density rho0; standard DFSPH corrects compression only (the density error
 e_i = max(rho_i - rho0, 0), Bender & Koschier 2017, "Divergence-free SPH for incompressible and weakly
-compressible fluids", IEEE TVCG), so the surface rows, carried by nothing, sink under gravity until their sums
-reach rho0. Released as seeded, the liquid does that during the run: the surface settles and the column rings
-for a while. Here it does it before the run, damped: the vessels are held at their poses, the liquid is advanced
+compressible fluids", IEEE TVCG), so the surface rows carry no pressure of their own and settle onto the rows
+below. Released as seeded, the liquid does that during the run: the surface settles and the column rings for a
+while. Here it does it before the run, damped: the vessels are held at their poses, the liquid is advanced
 by the solver itself in intervals of ``interval`` s and every particle's velocity is set to zero after each
 (the pressure solve's position corrections are kept, the velocity that made them is dropped: a damped dynamic
 relaxation, as the particle-packing algorithms of Colagrossi et al. 2012, "Particle packing algorithm for SPH
@@ -16,6 +16,9 @@ exceeds that (a coarse liquid, a particle jammed in a wall corner that the solve
 largest speed regained has set no new low for ``STALL_TIME`` ('stalled': the settling is over, what is left is the
 solve's own motion); or after ``duration`` s ('time cap'). The clock, the step count, the history and the energy
 account then restart from the relaxed liquid at rest (:meth:`cosim.fluid.solver.FluidSolver.restart_at_rest`).
+The settled top row still sums short of rho0, resting on the row below in a stacking the compression-only solve
+holds but that is not stable: released, it drops into that row's gaps within about half a second (measured in
+docs/relaxed_start.md).
 """
 
 from __future__ import annotations
