@@ -1,6 +1,6 @@
 """fluid.initial_state: 'seeded' keeps the seeded kernel deficiency as DFSPH's per-particle rest offset and starts
 as seeded; 'relaxed' settles the liquid in its vessel, held still, until it stops moving (or a time cap), with no
-offset, and the run starts there at rest, the liquid at rest density within the solve's tolerance."""
+offset, and the run starts there at rest, no particle compressed beyond the solve's per-particle bound."""
 
 from __future__ import annotations
 
