@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver, WallModel
+from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, InitialState, KernelType, PressureSolver, WallModel
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -78,6 +78,7 @@ class FluidSettings:
     artificial_viscosity: float = like(FluidConfig, "artificial_viscosity")
     free_liquid: bool = like(FluidConfig, "free_liquid")
     free_artificial_viscosity: float = like(FluidConfig, "free_artificial_viscosity")
+    initial_state: InitialState = like(FluidConfig, "initial_state")
     # ---- WCSPH
     gamma: float = like(FluidConfig, "gamma")
     max_tension: float = like(FluidConfig, "max_tension")

@@ -48,6 +48,13 @@ class PressureSolver(Enum):
     DFSPH = "dfsph"  # divergence-free SPH (Bender & Koschier 2015/2017): iterative incompressibility, CFL on flow speed
 
 
+class InitialState(Enum):
+    """How the seeded liquid starts (``cosim.fluid.relaxation``)."""
+
+    SEEDED = "seeded"  # as seeded; DFSPH holds each bound particle to the kernel deficiency it was seeded with
+    RELAXED = "relaxed"  # settled in its vessels held still before t = 0; DFSPH corrects compression only, no offsets
+
+
 class DensityIteration(Enum):
     """How DFSPH's density solve iterates (its divergence solve, about one iteration a substep, is always Jacobi)."""
 
@@ -134,6 +141,13 @@ class FluidConfig:
                                                "(and of a free particle against walls): free liquid has no tension, so "
                                                "this makes its impacts inelastic; alpha acts only on approaching "
                                                "pairs, so a separating stream flies free.", "", 0.0, 1.0)
+    initial_state: InitialState = setting(InitialState.SEEDED, PRESSURE, "How the liquid starts: 'seeded' (from "
+                                          "its seeded lattice; DFSPH holds each bound particle to the kernel deficiency "
+                                          "it was seeded with, so the surface rows stay at their seeded spacing) or "
+                                          "'relaxed' (settled first with its vessels held still and its velocities "
+                                          "zeroed, until it stops moving, and started from there at rest; DFSPH then "
+                                          "corrects compression only, with no per-particle offset: Bender & Koschier "
+                                          "2017). docs/relaxed_start.md.")
     # ---- WCSPH
     gamma: float = setting(7.0, WCSPH, "Tait exponent of the equation of state p = rho0 c0^2 / gamma ((rho / rho0)^gamma "
                            "- 1) (Camporredondo et al. 2019).", "", 1.0, 10.0)

@@ -131,7 +131,8 @@ MIN_FACTOR_DENOMINATOR = wp.constant(0.25)
 # same approach, and both correcting it in full overshoots: tilted and shaken tanks create energy and the pour
 # spills; halved, neither does and the validation errors stay as they are (docs/tuning.md).
 WALL_RELAXATION = wp.constant(0.5)
-# rest_offset of a particle whose first substep has not run yet (kg/m^3; any real offset is >= 0)
+# rest_offset of a particle whose first substep has not run yet under initial_state 'seeded' (kg/m^3; any real offset
+# is >= 0)
 UNSEEDED_OFFSET = wp.constant(-1.0)
 
 SOLVE_DIVERGENCE = 0
@@ -171,10 +172,12 @@ def bound_or_free_density(
     rest_offset: wp.array(dtype=float),
 ) -> float:
     """The density the solves hold particle i to (kg/m^3), from its summation density ``summation`` (over a resting
-    lattice's). A particle's first substep stores the kernel deficiency it was seeded with, max(rho0 - summation, 0),
-    as its ``rest_offset``: the seeded liquid is at rest, so its surface rows, short of neighbours above, are held
-    at the spacing they were seeded with instead of sinking until their sums reach rho0 (without
-    it a resting column's top rows merge below their spacing). Bound liquid is held to summation + offset; free liquid
+    lattice's). With ``initial_state`` 'seeded', a particle's first substep stores the kernel deficiency it was
+    seeded with, max(rho0 - summation, 0), as its ``rest_offset``: the seeded liquid is at rest, so its surface rows,
+    short of neighbours above, are held at the spacing they were seeded with instead of sinking until their sums
+    reach rho0 (without it a resting column's top rows merge below their spacing). With 'relaxed' every offset is 0
+    from the start (``cosim.fluid.dfsph_step.DFSPHStep.initialise``): standard DFSPH, the surface rows settle before
+    t = 0 (``cosim.fluid.relaxation``). Bound liquid is held to summation + offset; free liquid
     (WCSPH's rules, ``cosim.fluid.wcsph.update_free_liquid``; ``free_liquid`` 0: all liquid stays bound) to its
     plain summation density: a bound particle outside every vessel becomes free once separated (summation below
     rho0), a free one bound again, with no offset, when packed (summation >= rho0) inside a vessel. (Only

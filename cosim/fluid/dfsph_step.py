@@ -21,7 +21,7 @@ import numpy as np
 import warp as wp
 
 from cosim.fluid import dfsph, wcsph
-from cosim.fluid.config import DensityIteration
+from cosim.fluid.config import DensityIteration, InitialState
 from cosim.fluid.device_layout import pair_table
 from cosim.fluid.lanes import LANE_CHUNK, Lanes, PerLane
 from cosim.fluid.launch import launch_now
@@ -231,11 +231,15 @@ class DFSPHStep:
 
     def initialise(self, st: FluidState) -> None:
         """The seeded pressure (hydrostatic for a filled vessel) as the stiffness the liquid was already under: the
-        first density solve warm-starts from it as from any previous substep's. The seeded kernel deficiency is
-        measured in the first substep (``cosim.fluid.dfsph.bound_or_free_density``)."""
+        first density solve warm-starts from it as from any previous substep's. With ``initial_state`` 'seeded', the
+        seeded kernel deficiency is measured in the first substep and kept as each particle's rest offset
+        (``cosim.fluid.dfsph.bound_or_free_density``); with 'relaxed', no particle has one: the liquid is held to its
+        summation density, compression only (Bender & Koschier 2017), and settles before t = 0
+        (``cosim.fluid.relaxation``)."""
         launch_now(wcsph.equation_of_state, self.model.n_particles, self.model.device, dict(prm=self.model.params, rho=st.rho, p=st.p))
         st.kappa_density.assign((st.p.numpy() / st.rho.numpy()).astype(np.float32))
-        st.rest_offset.fill_(float(dfsph.UNSEEDED_OFFSET))
+        seeded = self.model.config.initial_state is InitialState.SEEDED
+        st.rest_offset.fill_(float(dfsph.UNSEEDED_OFFSET) if seeded else 0.0)
 
     def internal_energy(self, st: FluidState) -> float:
         """The incompressible liquid stores no elastic energy (J)."""

@@ -24,7 +24,7 @@ import numpy as np
 import warp as wp
 
 from cosim.errors import InputError
-from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver
+from cosim.fluid.config import DensityIteration, FluidConfig, InitialState, PressureSolver
 from cosim.fluid.device_layout import DeviceLayout, layout_for
 from cosim.fluid.dfsph_step import DFSPHStep
 from cosim.fluid.diagnostics import StepDiagnostics, SubstepRows
@@ -33,6 +33,7 @@ from cosim.fluid.instability import FluidInstabilityError, check_interval
 from cosim.fluid.lanes import Lanes, lane_count
 from cosim.fluid.memory import allocation_failure_refused
 from cosim.fluid.model import FluidModel, FluidState, build_model
+from cosim.fluid.relaxation import RELAX_INTERVAL, RELAX_TIME_CAP, STALL_TIME, RelaxationReport, relax_liquid, stop_speed
 from cosim.fluid.runner import SubstepRunner
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
@@ -72,6 +73,9 @@ class FluidSolver:
         operations one by one where capture fails (:attr:`graph_capture_error` says why) or when False.
       layout: how the pair tables, the wrench reduction and the atomic accumulators are laid out
         (:mod:`cosim.fluid.device_layout`); None: the device kind's own. The particles are the same under any.
+      relax_start: with ``config.initial_state`` 'relaxed', settle the liquid before t = 0 (``cosim.fluid.relaxation``;
+        :attr:`relaxation` reports it); False for a liquid that starts moving or that its vessels do not hold at
+        rest (a released column), which starts as given, with no offsets.
     In 2-D, vessel poses are projected onto the pour plane (rotation about y, translation in x-z, y = 0).
     """
 
@@ -84,6 +88,7 @@ class FluidSolver:
         device: str = "cpu",
         graphs: bool = True,
         layout: DeviceLayout | None = None,
+        relax_start: bool = True,
     ):
         if len(vessels) != len(poses):
             raise InputError(f"fluid: {len(vessels)} vessels but {len(poses)} poses")
@@ -117,6 +122,9 @@ class FluidSolver:
             self.runner = SubstepRunner(self.lanes, self.step.substep, state, FluidState.allocate(self.n_particles, self.device), graphs)
         self.scratch.set_motions(self._poses, self._lin_vel, self._ang_vel, self._lin_vel, self._ang_vel)
         self.energy_account = EnergyAccount(config, vessels, particles.positions, particles.velocities, self.step.internal_energy(state))
+        self.relaxation: RelaxationReport | None = None
+        if relax_start and config.initial_state is InitialState.RELAXED:
+            self.relaxation = self.relax(RELAX_TIME_CAP, RELAX_INTERVAL, stop_speed(config.gravity_magnitude), STALL_TIME)
 
     # ---- set-up ----------------------------------------------------------------------------------------------
     def _planar(self, pose: Pose) -> Pose:
@@ -167,6 +175,10 @@ class FluidSolver:
                 raise InputError(f"fluid: vessel {self.model.vessel_specs[k].name} pose is not finite")
         self._targets = [self._planar(p) for p in poses]
 
+    def hold_vessels(self) -> None:
+        """The vessels stay at their current poses through the next :meth:`advance` interval."""
+        self._targets = list(self._poses)
+
     def plan_time_step(self, duration: float, wall_speed: float) -> tuple[int, float]:
         """(substeps, dt) for an interval of ``duration`` s with walls moving at up to ``wall_speed`` m/s
         (``cosim.fluid.time_step``); raises :class:`FluidInstabilityError` below ``min_time_step``."""
@@ -214,28 +226,32 @@ class FluidSolver:
         self._last_report = IntervalReport(n_sub, dt, lambda: rows.record(n_sub - 1, first + n_sub - 1, t0 + (n_sub - 1) * dt + dt, dt, n, volume))
         return self._last_report
 
-    def relax(self, duration: float, interval: float) -> None:
-        """Let the seeded liquid settle into the solver's own rest state, then start the run from it at t = 0.
+    def relax(self, duration: float, interval: float, stop: float = 0.0, stall: float = math.inf) -> RelaxationReport:
+        """Let the seeded liquid settle into the solver's own rest state, then start the run from it at t = 0
+        (:func:`cosim.fluid.relaxation.relax_liquid`): the vessels held at their poses, intervals of ``interval``
+        s, every particle's velocity set to zero after each, for ``duration`` s, or until no particle regained more
+        than ``stop`` m/s within an interval (0: never), or until that largest speed has set no new low for
+        ``stall`` s (inf: never). A seeding that is not the lattice the rest density is normalised on (rings in a
+        cylinder) starts with local density errors of a few per cent; DFSPH corrects a density error within one
+        substep by a velocity of error times spacing over dt, so released at once the liquid would carry that
+        velocity on (hundreds of mm/s, which the liquid's small viscosity does not remove). Here the pressure
+        solve's position corrections are kept and the velocity that made them is dropped."""
+        return relax_liquid(self, duration, interval, stop, stall)
 
-        The vessels are held at their poses for ``duration`` (s), advanced in steps of ``interval`` (s), and every
-        particle's velocity is set to zero after each step: a damped relaxation. A seeding that is not the lattice
-        the rest density is normalised on (rings in a cylinder) starts with local density errors of a few per
-        cent; DFSPH corrects a density error within one substep by a velocity of error times spacing over dt, so
-        released at once the liquid would carry that velocity on (hundreds of mm/s, which the liquid's small
-        viscosity does not remove). Here the pressure solve's position corrections are kept and the velocity that
-        made them is dropped. The clock, the step count, the history and the energy account restart from the
-        relaxed state."""
-        steps = max(1, round(duration / interval))
-        for _ in range(steps):
-            self.set_vessel_poses(self._poses)
-            self.advance(interval)
-            self.state.v.zero_()
+    def restart_at_rest(self) -> None:
+        """The clock, the step count, the history and the energy account restart from the liquid as it is, at rest
+        (its velocities already zero): the end of a relaxation."""
         self.time = 0.0
         self.step_count = 0
         self._history = []
         self._last_max_speed = 0.0
         self.energy_account = EnergyAccount(self.config, self.model.vessel_specs, self.positions(), self.velocities(),
                                             self.step.internal_energy(self.state))
+
+    @property
+    def last_max_speed(self) -> float:
+        """m/s: the largest particle speed of the last interval's substeps."""
+        return self._last_max_speed
 
     # ---- readers (numpy, original particle order) ---------------------------------------------------------------
     def _in_id_order(self, arr: wp.array) -> np.ndarray:
