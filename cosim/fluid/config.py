@@ -69,7 +69,7 @@ class DensityIteration(Enum):
 DEFAULT_DENSITY_TOLERANCE = {DensityIteration.GAUSS_SEIDEL: 0.00015, DensityIteration.JACOBI: 0.00005}
 
 # beta of the signal velocity v_sig = c + beta max(0, -v_ij . r_ij / |r_ij|) (FluidConfig.viscosity_speed): Monaghan
-# (1997)'s c_i + c_j + 4 max(0, -w_ij) per unit of one particle's c (docs/artificial_viscosity.md).
+# (1997)'s form c_i + c_j + 4 max(0, -w_ij) per unit of one particle's c (docs/artificial_viscosity.md).
 APPROACH_WEIGHT = 2.0
 
 # Monaghan's alpha when none is given (FluidConfig.artificial_viscosity), per velocity scale in effect: the same
