@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, InitialState, KernelType, PressureSolver, WallModel
+from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, FluidConfig, GridReset, InitialState, KernelType, PressureSolver, WallModel
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -76,8 +76,9 @@ class FluidSettings:
     pressure_solver: PressureSolver = like(FluidConfig, "pressure_solver")
     sound_speed_factor: float = like(FluidConfig, "sound_speed_factor")
     artificial_viscosity: float = like(FluidConfig, "artificial_viscosity")
+    artificial_viscosity_scale: ArtificialViscosityScale = like(FluidConfig, "artificial_viscosity_scale")
     free_liquid: bool = like(FluidConfig, "free_liquid")
-    free_artificial_viscosity: float = like(FluidConfig, "free_artificial_viscosity")
+    free_artificial_viscosity: float | None = like(FluidConfig, "free_artificial_viscosity")
     initial_state: InitialState = like(FluidConfig, "initial_state")
     # ---- WCSPH
     gamma: float = like(FluidConfig, "gamma")

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
-from cosim.fluid.config import DensityIteration, FluidConfig, InitialState, PressureSolver, WallModel
+from cosim.fluid.config import ArtificialViscosityScale, DensityIteration, FluidConfig, InitialState, PressureSolver, WallModel
 from cosim.validation import CASES, DEFAULT_CASES
 from declared_settings.setting import declared
 
@@ -64,6 +64,14 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--initial-state", choices=[s.value for s in InitialState],
                    help="how the liquid starts: seeded or relaxed (docs/relaxed_start.md) (default: the default scene's "
                    "fluid.initial_state)")
+    p.add_argument("--artificial-viscosity", type=float, metavar="ALPHA",
+                   help="Monaghan's alpha (default: the default scene's fluid.artificial_viscosity)")
+    p.add_argument("--artificial-viscosity-scale", choices=[s.value for s in ArtificialViscosityScale],
+                   help="the artificial viscosity's velocity scale: sound_speed or signal_velocity (docs/artificial_viscosity.md) "
+                   "(default: the default scene's fluid.artificial_viscosity_scale)")
+    p.add_argument("--free-artificial-viscosity", metavar="ALPHA|none",
+                   help="Monaghan's alpha of pairs with free liquid, or none for the one alpha of all liquid (default: the "
+                   "default scene's fluid.free_artificial_viscosity)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
@@ -81,6 +89,9 @@ def _case_params(name: str, args) -> list:
                 ("initial_state", args.initial_state or scene.initial_state.value))
     if args.density_tolerance is not None:
         numerics += (("density_tolerance", args.density_tolerance),)
+    numerics += (("artificial_viscosity", scene.artificial_viscosity if args.artificial_viscosity is None else args.artificial_viscosity),
+                 ("artificial_viscosity_scale", args.artificial_viscosity_scale or scene.artificial_viscosity_scale.value),
+                 ("free_artificial_viscosity", _free_alpha(args.free_artificial_viscosity, scene.free_artificial_viscosity)))
     common = {"dim": declared(FluidConfig, "dim").check("--dim", args.dim), "device": args.device, "spacing": args.spacing, "solver": solver, "numerics": numerics}
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
@@ -98,6 +109,18 @@ def _case_params(name: str, args) -> list:
     if name == "slosh" and args.fill is None:
         return [params(**common, **geometry, fill=fill) for fill in slosh.SEED_FILLS]
     return [params(**common, **geometry)]
+
+
+def _free_alpha(text: str | None, default: float | None) -> float | None:
+    """--free-artificial-viscosity: a number, 'none' (the one alpha) or not given (``default``)."""
+    if text is None:
+        return default
+    if text.strip().lower() == "none":
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        raise InputError(f"--free-artificial-viscosity: must be a number in [0, 1] or 'none', got {text!r}") from None
 
 
 def _json_value(value):

@@ -55,6 +55,14 @@ class InitialState(Enum):
     RELAXED = "relaxed"  # settled in its vessels held still before t = 0; DFSPH corrects compression only, no offsets
 
 
+class ArtificialViscosityScale(Enum):
+    """The velocity scale v_sig of Monaghan's artificial viscosity Pi_ij = -alpha v_sig h (v_ij . r_ij) /
+    ((r_ij^2 + eta^2) rho_ij) (``cosim.fluid.sph_common.viscous_pair``)."""
+
+    SOUND_SPEED = "sound_speed"  # c0 (WCSPH: its equation of state's; DFSPH: sound_speed_factor x max_expected_speed)
+    SIGNAL_VELOCITY = "signal_velocity"  # DFSPH: sqrt(|g| h) + 2 x each pair's approach speed (Monaghan 1997); WCSPH: c0
+
+
 class DensityIteration(Enum):
     """How DFSPH's density solve iterates (its divergence solve, about one iteration a substep, is always Jacobi)."""
 
@@ -66,6 +74,15 @@ class DensityIteration(Enum):
 # two measure differently (a Gauss-Seidel sweep measures each particle before relaxing it, after the particles
 # before it), so each has its own, chosen by the validations (docs/benchmarks.md, docs/performance.md).
 DEFAULT_DENSITY_TOLERANCE = {DensityIteration.GAUSS_SEIDEL: 0.00015, DensityIteration.JACOBI: 0.00005}
+
+# beta of the signal velocity v_sig = c + beta max(0, -v_ij . r_ij / |r_ij|) (FluidConfig.viscosity_speed): Monaghan
+# (1997)'s form c_i + c_j + 4 max(0, -w_ij) per unit of one particle's c (docs/artificial_viscosity.md).
+APPROACH_WEIGHT = 2.0
+
+# Monaghan's alpha when none is given (FluidConfig.artificial_viscosity), per velocity scale in effect: the same
+# alpha is a viscosity about c0 / sqrt(g h) (~100) times as large on c0, so each scale has its own, chosen by the
+# validations (docs/artificial_viscosity.md).
+DEFAULT_ARTIFICIAL_VISCOSITY = {ArtificialViscosityScale.SOUND_SPEED: 0.01, ArtificialViscosityScale.SIGNAL_VELOCITY: 1.0}
 
 # The concerns the settings are grouped by, in the order references list them.
 DISCRETISATION = "discretisation"
@@ -127,9 +144,21 @@ class FluidConfig:
     sound_speed_factor: float = setting(10.0, PRESSURE, "c0 / max_expected_speed: the artificial speed of sound c0 of "
                                         "Monaghan (1994) instead of water's; >= 10 keeps the density error near "
                                         "(v_max / c0)^2 = 1 %. DFSPH has no equation of state and uses c0 only as "
-                                        "the artificial viscosity's velocity scale.", "", 10.0, 100.0)
-    artificial_viscosity: float = setting(0.01, PRESSURE, "Monaghan's alpha (dimensionless), also against walls.", "",
-                                          0.0, 1.0)
+                                        "the artificial viscosity's velocity scale (artificial_viscosity_scale "
+                                        "'sound_speed').", "", 10.0, 100.0)
+    artificial_viscosity: float | None = setting(None, PRESSURE, "Monaghan's alpha (dimensionless), also against "
+                                                 "walls.", "", 0.0, 1.0, kind="float", none_means="the velocity scale's "
+                                                 "own, " + ", ".join(f"{a:g} for {s.value!r}" for s, a in
+                                                                     DEFAULT_ARTIFICIAL_VISCOSITY.items())
+                                                 + " (WCSPH, whose scale is c0 either way: the first)")
+    artificial_viscosity_scale: ArtificialViscosityScale = setting(
+        ArtificialViscosityScale.SOUND_SPEED, PRESSURE, "The artificial viscosity's velocity scale v_sig (its "
+        "kinematic viscosity is about alpha h v_sig / (2 (dim + 2)), Monaghan 2005): 'sound_speed', c0 (WCSPH: the "
+        "equation of state's signal speed; DFSPH, which has no equation of state: the same c0 from "
+        "max_expected_speed, a scene estimate) or 'signal_velocity': WCSPH keeps its c0, DFSPH takes Monaghan "
+        "(1997)'s signal velocity of each pair, v_sig = sqrt(|g| h) + 2 max(0, -v_ij . r_ij / |r_ij|), with the "
+        "speed of gravity waves at the kernel scale, sqrt(|g| h), for the sound speed the incompressible liquid does "
+        "not have: the same for every scene, larger where particles collide (docs/artificial_viscosity.md).")
     free_liquid: bool = setting(True, PRESSURE, "Treat liquid outside every vessel (the stream, spray) as free once it "
                                 "has separated (summation density below rho0): WCSPH gives it a memoryless summation "
                                 "density clamped at rho0, so no tension pulls the stream back to the vessel it left "
@@ -137,10 +166,12 @@ class FluidConfig:
                                 "tension lands the stream short of its free-fall parabola, `cosim validate free-fall`); "
                                 "DFSPH holds it to its plain summation density (cosim.fluid.dfsph.bound_or_free_density). "
                                 "Either way its pairs use free_artificial_viscosity.")
-    free_artificial_viscosity: float = setting(0.25, PRESSURE, "Monaghan's alpha of every pair with a free particle "
-                                               "(and of a free particle against walls): free liquid has no tension, so "
-                                               "this makes its impacts inelastic; alpha acts only on approaching "
-                                               "pairs, so a separating stream flies free.", "", 0.0, 1.0)
+    free_artificial_viscosity: float | None = setting(0.25, PRESSURE, "Monaghan's alpha of every pair with a free "
+                                                      "particle (and of a free particle against walls): free liquid "
+                                                      "has no tension, so this makes its impacts inelastic; alpha acts "
+                                                      "only on approaching pairs, so a separating stream flies free.",
+                                                      "", 0.0, 1.0, kind="float", none_means="artificial_viscosity, "
+                                                      "one alpha for all liquid")
     initial_state: InitialState = setting(InitialState.SEEDED, PRESSURE, "How the liquid starts: 'seeded' (from "
                                           "its seeded lattice; DFSPH holds each bound particle to the kernel deficiency "
                                           "it was seeded with, so the surface rows stay at their seeded spacing) or "
@@ -214,6 +245,9 @@ class FluidConfig:
         check_settings(self, "fluid")
         if self.density_tolerance is None:
             object.__setattr__(self, "density_tolerance", DEFAULT_DENSITY_TOLERANCE[self.density_iteration])
+        if self.artificial_viscosity is None:
+            scale = ArtificialViscosityScale.SIGNAL_VELOCITY if self.signal_velocity_viscosity else ArtificialViscosityScale.SOUND_SPEED
+            object.__setattr__(self, "artificial_viscosity", DEFAULT_ARTIFICIAL_VISCOSITY[scale])
         for axis in range(3):
             if self.domain_max[axis] - self.domain_min[axis] < 4.0 * self.support_radius:
                 raise InputError(
@@ -236,6 +270,29 @@ class FluidConfig:
     def sound_speed(self) -> float:
         """Artificial speed of sound c0 (m/s)."""
         return self.sound_speed_factor * self.max_expected_speed
+
+    @property
+    def free_liquid_alpha(self) -> float:
+        """Monaghan's alpha of pairs with free liquid: ``free_artificial_viscosity``, or the one alpha where unset."""
+        return self.artificial_viscosity if self.free_artificial_viscosity is None else self.free_artificial_viscosity
+
+    @property
+    def signal_velocity_viscosity(self) -> bool:
+        """Whether the artificial viscosity's velocity scale is Monaghan (1997)'s signal velocity of an
+        incompressible liquid under gravity (DFSPH with ``artificial_viscosity_scale`` 'signal_velocity') rather
+        than c0 (WCSPH's equation of state has the physical signal speed c0, which it keeps)."""
+        return self.artificial_viscosity_scale is ArtificialViscosityScale.SIGNAL_VELOCITY and self.pressure_solver is PressureSolver.DFSPH
+
+    @property
+    def viscosity_speed(self) -> float:
+        """m/s, the part c of the artificial viscosity's velocity scale v_sig = c + beta max(0, -v_ij . r_ij / |r_ij|)
+        every pair has: c0, or for the signal velocity sqrt(|g| h), the speed of gravity waves of wavenumber 1/h."""
+        return math.sqrt(self.gravity_magnitude * self.smoothing_length) if self.signal_velocity_viscosity else self.sound_speed
+
+    @property
+    def viscosity_approach_weight(self) -> float:
+        """beta of the velocity scale (:attr:`viscosity_speed`): 0 with c0."""
+        return APPROACH_WEIGHT if self.signal_velocity_viscosity else 0.0
 
     @property
     def fixed_time_step(self) -> float:

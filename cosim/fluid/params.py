@@ -20,7 +20,9 @@ class SPHParams:
     """Static SPH parameters (SI). ``mass`` is the SPH mass a particle is seeded with (kg, or kg/m of depth in 2-D;
     each particle's own is ``FluidState.mass``); ``mass_out`` the 3-D mass one particle stands for (kg, the same for
     every particle); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``alpha_free`` the artificial
-    viscosity of pairs with free liquid (WCSPH); ``max_tension`` (Pa) the clamp of WCSPH's negative pressure,
+    viscosity of pairs with free liquid (:attr:`FluidConfig.free_liquid_alpha`); ``viscosity_speed`` (m/s) and
+    ``viscosity_approach_weight`` the c and beta of the artificial viscosity's velocity scale
+    (``FluidConfig.viscosity_speed``); ``max_tension`` (Pa) the clamp of WCSPH's negative pressure,
     reached at ``tension_density`` (kg/m^3); ``eta2`` = 0.01 h^2 (m^2); then DFSPH's stopping rule (relative
     tolerances and the iteration cap of each solve) and ``lattice_density``, the summation density of a resting
     lattice over rho0 (DFSPH and WCSPH's free liquid divide their summation density by it, so the liquid as seeded
@@ -44,6 +46,8 @@ class SPHParams:
     nu: float
     alpha: float
     alpha_free: float
+    viscosity_speed: float
+    viscosity_approach_weight: float
     max_tension: float
     tension_density: float
     delta: float
@@ -81,7 +85,9 @@ def make_params(cfg: FluidConfig, n_vessels: int, atomic_replicas: int = 1, dens
     p.gamma = cfg.gamma
     p.nu = cfg.kinematic_viscosity
     p.alpha = cfg.artificial_viscosity
-    p.alpha_free = cfg.free_artificial_viscosity
+    p.alpha_free = cfg.free_liquid_alpha
+    p.viscosity_speed = cfg.viscosity_speed
+    p.viscosity_approach_weight = cfg.viscosity_approach_weight
     p.max_tension = cfg.max_tension
     p.delta = cfg.density_diffusion
     p.eta2 = 0.01 * h * h

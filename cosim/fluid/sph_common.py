@@ -106,13 +106,18 @@ def viscous_pair(
     rho_j: float,
 ) -> wp.vec3:
     """Acceleration (m/s^2) of particle i from neighbour j of mass ``mass_j`` (kg, or kg/m in 2-D): Monaghan (1992)
-    artificial viscosity with coefficient ``alpha`` on the approaching relative velocity ``v_rel`` = v_i - v_j
-    (scaled by the configured c0) plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the
+    artificial viscosity with coefficient ``alpha`` on the approaching relative velocity ``v_rel`` = v_i - v_j,
+    -m_j Pi_ij grad W with Pi_ij = -alpha v_sig mu_ij / rho_ij, mu_ij = h min(v_rel . r, 0) / (r^2 + eta^2), its velocity
+    scale v_sig = c + beta max(0, -v_rel . r / |r|) (Monaghan 1997, "SPH and Riemann solvers"; c =
+    ``prm.viscosity_speed``, beta = ``prm.viscosity_approach_weight``: c0 and 0, or sqrt(|g| h) and 2,
+    ``FluidConfig.viscosity_speed``), plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the
     neighbour's, or a wall's no-slip, velocity)."""
     # min(vr, 0) instead of a branch on the approach: about half the pairs approach, so the branch is mispredicted
     # about half the time (docs/tuning.md); a receding pair adds exactly zero, as the branch would skip it
-    mu = prm.h * wp.min(wp.dot(v_rel, r), 0.0) / (r2 + prm.eta2)
-    a = (mass_j * alpha * prm.sound_speed * mu / (0.5 * (rho_i + rho_j))) * gw
+    approach = wp.min(wp.dot(v_rel, r), 0.0)
+    mu = prm.h * approach / (r2 + prm.eta2)
+    speed = prm.viscosity_speed + prm.viscosity_approach_weight * (-approach / wp.sqrt(r2))
+    a = (mass_j * alpha * speed * mu / (0.5 * (rho_i + rho_j))) * gw
     a += (mass_j * prm.nu * (1.0 / rho_i + 1.0 / rho_j) * wp.dot(r, gw) / (r2 + prm.eta2)) * v_rel_laminar
     return a
 

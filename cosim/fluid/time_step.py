@@ -7,7 +7,18 @@ import math
 from cosim.fluid.config import FluidConfig, PressureSolver
 
 FORCE_CFL = 0.25  # Monaghan's force criterion dt <= 0.25 sqrt(h / a_max)
-VISCOUS_CFL = 0.125  # viscous criterion dt <= 0.125 h^2 / nu
+VISCOUS_CFL = 0.125  # viscous criterion dt <= 0.125 h^2 / (nu + nu_art)
+
+
+def artificial_kinematic_viscosity(cfg: FluidConfig, flow_speed: float, wall_speed: float) -> float:
+    """m^2/s, the largest kinematic viscosity the artificial viscosity stands for, nu_art = alpha h v_sig / (2 (dim + 2))
+    (Monaghan 2005, "Smoothed particle hydrodynamics", Rep. Prog. Phys. 68: alpha h c / 8 in 2-D, / 10 in 3-D), with
+    the largest alpha any pair uses and the largest velocity scale v_sig = c + beta w (``FluidConfig.viscosity_speed``):
+    c0, or with the signal velocity the fastest approach w the planned flow allows, two particles head on at
+    ``flow_speed`` (m/s) or one at ``flow_speed`` against a wall moving at ``wall_speed`` (m/s)."""
+    alpha = max(cfg.artificial_viscosity, cfg.free_liquid_alpha) if cfg.free_liquid else cfg.artificial_viscosity
+    speed = cfg.viscosity_speed + cfg.viscosity_approach_weight * max(2.0 * flow_speed, flow_speed + wall_speed)
+    return alpha * cfg.smoothing_length * speed / (2.0 * (cfg.dim + 2))
 
 
 def stable_time_step(cfg: FluidConfig, wall_speed: float, max_speed: float, max_accel: float) -> float:
@@ -15,19 +26,24 @@ def stable_time_step(cfg: FluidConfig, wall_speed: float, max_speed: float, max_
     (m/s^2) in vessels whose walls move at up to ``wall_speed`` (m/s): the CFL condition dt <= cfl h / signal,
     with the signal speed acoustic for WCSPH (c0 + the flow's and the wall's speed) and the flow's alone for DFSPH
     (at least ``max_expected_speed``: a jet forms within an interval), and the force criterion; with
-    ``adaptive_time_step`` off, the fixed step; both bounded by the viscous criterion."""
+    ``adaptive_time_step`` off, the fixed step; both bounded by the viscous diffusion criterion
+    dt <= 0.125 h^2 / (nu + nu_art) (:func:`artificial_kinematic_viscosity`, at the flow speed DFSPH's CFL condition
+    plans with: the fixed step's at ``max_expected_speed`` and still walls)."""
     h = cfg.smoothing_length
     if not cfg.adaptive_time_step:
+        flow_speed, wall_speed = cfg.max_expected_speed, 0.0  # the fixed step measures nothing
         dt = cfg.fixed_time_step
     else:
+        flow_speed = max(cfg.max_expected_speed, max_speed)
         if cfg.pressure_solver is PressureSolver.WCSPH:
             signal = cfg.sound_speed + max_speed + wall_speed
         else:
-            signal = max(cfg.max_expected_speed, max_speed) + wall_speed
+            signal = flow_speed + wall_speed
         dt = cfg.cfl * h / max(signal, 1e-9)
         dt = min(dt, FORCE_CFL * math.sqrt(h / max(max_accel, 1e-9)))
-    if cfg.kinematic_viscosity > 0.0:
-        dt = min(dt, VISCOUS_CFL * h * h / cfg.kinematic_viscosity)
+    diffusivity = cfg.kinematic_viscosity + artificial_kinematic_viscosity(cfg, flow_speed, wall_speed)
+    if diffusivity > 0.0:
+        dt = min(dt, VISCOUS_CFL * h * h / diffusivity)
     return dt
 
 

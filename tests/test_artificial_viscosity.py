@@ -1,0 +1,155 @@
+"""The artificial viscosity's velocity scale (``fluid.artificial_viscosity_scale``), the one alpha
+(``fluid.free_artificial_viscosity`` unset) and the time step's artificial-viscosity criterion."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+import warp as wp
+
+from cosim.cli.main import main
+from cosim.fluid.config import DEFAULT_ARTIFICIAL_VISCOSITY, GRAVITY, ArtificialViscosityScale, FluidConfig
+from cosim.fluid.params import SPHParams, make_params
+from cosim.fluid.seeding import fill_vessel
+from cosim.fluid.solver import FluidSolver
+from cosim.fluid.sph_common import kernel_gradient, viscous_pair
+from cosim.fluid.time_step import FORCE_CFL, VISCOUS_CFL, artificial_kinematic_viscosity, stable_time_step
+from cosim.frames import Pose
+from cosim.vessel import VesselSpec
+
+SPACING = 0.005  # m
+DISTANCE = 0.006  # m, the pair's separation (inside the support 2h = 0.015 m)
+
+
+@wp.kernel
+def _pair_acceleration(prm: SPHParams, r: wp.vec3, v_rel: wp.vec3, out: wp.array(dtype=wp.vec3)):
+    gw = kernel_gradient(prm, r, wp.dot(r, r))
+    out[0] = viscous_pair(prm, prm.alpha, prm.mass, r, wp.dot(r, r), gw, v_rel, v_rel, prm.rest_density, prm.rest_density)
+    out[1] = gw
+
+
+def _pair(cfg: FluidConfig, closing_speed: float) -> tuple[np.ndarray, np.ndarray]:
+    """(acceleration of i, grad_i W) for particle i at +DISTANCE along x from j, closing on it at ``closing_speed``
+    (m/s; negative: receding), both at rest density."""
+    out = wp.zeros(2, dtype=wp.vec3, device="cpu")
+    wp.launch(_pair_acceleration, 1, inputs=[make_params(cfg, 0), wp.vec3(DISTANCE, 0.0, 0.0), wp.vec3(-closing_speed, 0.0, 0.0), out],
+              device="cpu")
+    a, gw = out.numpy()
+    return a, gw
+
+
+def _config(**kw) -> FluidConfig:
+    return FluidConfig(dim=2, spacing=SPACING, kinematic_viscosity=0.0, artificial_viscosity=0.5, **kw)
+
+
+def _monaghan(cfg: FluidConfig, closing_speed: float, scale: float, gw: np.ndarray) -> np.ndarray:
+    """m_j alpha c mu / rho0 grad W, mu = h v_rel . r / (r^2 + 0.01 h^2), with the velocity scale c = ``scale``."""
+    h = cfg.smoothing_length
+    mu = h * (-closing_speed * DISTANCE) / (DISTANCE**2 + 0.01 * h * h)
+    return cfg.particle_mass * cfg.artificial_viscosity * scale * mu / cfg.rest_density * gw
+
+
+@pytest.mark.parametrize("closing_speed", [0.1, 1.0])
+def test_dfsph_signal_velocity_is_the_gravity_wave_speed_plus_twice_the_approach_speed(closing_speed):
+    cfg = _config(artificial_viscosity_scale="signal_velocity")
+    a, gw = _pair(cfg, closing_speed)
+    signal = math.sqrt(GRAVITY * cfg.smoothing_length) + 2.0 * closing_speed
+    np.testing.assert_allclose(a, _monaghan(cfg, closing_speed, signal, gw), rtol=1e-5, atol=0.0)
+    assert a[0] > 0.0  # pushed away from j: the approach is decelerated
+
+
+def test_the_sound_speed_scale_is_c0_and_wcsph_keeps_it_with_either_setting():
+    closing_speed = 0.3
+    for cfg in (_config(), _config(pressure_solver="wcsph"), _config(pressure_solver="wcsph", artificial_viscosity_scale="signal_velocity")):
+        a, gw = _pair(cfg, closing_speed)
+        np.testing.assert_allclose(a, _monaghan(cfg, closing_speed, cfg.sound_speed, gw), rtol=1e-5, atol=0.0)
+
+
+def test_a_receding_pair_feels_no_artificial_viscosity():
+    for scale in ("sound_speed", "signal_velocity"):
+        a, _ = _pair(_config(artificial_viscosity_scale=scale), -1.0)
+        assert np.all(a == 0.0)
+
+
+def test_an_unset_free_alpha_is_the_one_alpha():
+    assert _config(free_artificial_viscosity=None).free_liquid_alpha == 0.5
+    assert make_params(_config(free_artificial_viscosity=None), 0).alpha_free == 0.5
+    assert make_params(_config(free_artificial_viscosity=0.25), 0).alpha_free == 0.25
+
+
+def test_an_unset_alpha_is_the_velocity_scales_own():
+    assert FluidConfig().artificial_viscosity == DEFAULT_ARTIFICIAL_VISCOSITY[ArtificialViscosityScale.SOUND_SPEED]
+    signal = DEFAULT_ARTIFICIAL_VISCOSITY[ArtificialViscosityScale.SIGNAL_VELOCITY]
+    assert FluidConfig(artificial_viscosity_scale="signal_velocity").artificial_viscosity == signal
+    assert FluidConfig(artificial_viscosity_scale="signal_velocity", pressure_solver="wcsph").artificial_viscosity == 0.01  # c0
+
+
+def _cfl_and_force_step(cfg: FluidConfig, flow_speed: float, max_accel: float) -> float:
+    h = cfg.smoothing_length
+    return min(cfg.cfl * h / flow_speed, FORCE_CFL * math.sqrt(h / max_accel))
+
+
+def test_the_viscous_criterion_leaves_the_default_step_alone():
+    # alpha 0.25 c0 (c0 = 10 v): dt_visc = 0.4 h / v against the CFL's 0.25 h / v
+    cfg = FluidConfig(dim=2, spacing=SPACING, max_expected_speed=1.0)
+    assert stable_time_step(cfg, 0.0, 1.5, 10.0) == _cfl_and_force_step(cfg, 1.5, 10.0)
+
+
+@pytest.mark.parametrize("scale, free_alpha", [("signal_velocity", None), ("sound_speed", 0.25)])
+def test_the_viscous_criterion_binds_past_the_diffusion_limit(scale, free_alpha):
+    # at the largest Courant number the artificial viscosity's diffusion limit 0.125 h^2 / nu_art is the shorter
+    # (v the expected speed, reached): the signal velocity with alpha 1, nu_art = alpha h (sqrt(g h) + 2 (2 v)) / 8,
+    # dt just under 0.25 h / v; c0 = 10 v with the free alpha 0.25, nu_art = 0.25 h (10 v) / 8, dt = 0.4 h / v; the
+    # CFL's is 0.6 h / v
+    cfg = FluidConfig(dim=2, spacing=SPACING, max_expected_speed=1.0, cfl=0.6, artificial_viscosity=1.0 if free_alpha is None else 0.01,
+                      artificial_viscosity_scale=scale, free_artificial_viscosity=free_alpha)
+    h, speed = cfg.smoothing_length, cfg.max_expected_speed
+    nu_art = artificial_kinematic_viscosity(cfg, speed, 0.0)
+    expected_scale = math.sqrt(GRAVITY * h) + 4.0 * speed if free_alpha is None else cfg.sound_speed
+    assert nu_art == pytest.approx((1.0 if free_alpha is None else 0.25) * h * expected_scale / 8.0, rel=1e-12)
+    dt = stable_time_step(cfg, 0.0, speed, 1e-3)
+    assert dt == pytest.approx(VISCOUS_CFL * h * h / (cfg.kinematic_viscosity + nu_art), rel=1e-12)
+    assert dt < 0.7 * _cfl_and_force_step(cfg, speed, 1e-3)
+
+
+def test_wall_speed_raises_the_approach_speed_the_criterion_plans_with():
+    cfg = FluidConfig(dim=3, spacing=SPACING, artificial_viscosity=1.0, artificial_viscosity_scale="signal_velocity")
+    h, c = cfg.smoothing_length, math.sqrt(GRAVITY * cfg.smoothing_length)
+    assert artificial_kinematic_viscosity(cfg, 1.0, 0.5) == pytest.approx(h * (c + 2.0 * 2.0) / 10.0)
+    assert artificial_kinematic_viscosity(cfg, 1.0, 3.0) == pytest.approx(h * (c + 2.0 * 4.0) / 10.0)
+
+
+def _wcsph_tank_after_a_pulse(scale: str) -> np.ndarray:
+    """Positions of a small WCSPH tank's liquid after a sideways jerk of the tank (approaching pairs at the walls)."""
+    cfg = FluidConfig(dim=2, spacing=0.01, pressure_solver="wcsph", max_expected_speed=1.0, artificial_viscosity_scale=scale,
+                      domain_min=(-0.2, -0.1, -0.05), domain_max=(0.2, 0.1, 0.25))
+    tank = VesselSpec(name="tank", inner_width=0.1, inner_depth=0.1, inner_height=0.12)
+    solver = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, 0.06, cfg))
+    for k in range(4):
+        solver.set_vessel_poses([Pose((0.002 * (k + 1), 0.0, 0.0))])
+        solver.advance(0.005)
+    return solver.positions()
+
+
+def test_wcsph_runs_bit_identical_with_either_scale():
+    assert np.array_equal(_wcsph_tank_after_a_pulse("sound_speed"), _wcsph_tank_after_a_pulse("signal_velocity"))
+
+
+def test_the_validation_cases_take_the_viscosity_settings(capsys):
+    argv = ["validate", "hydrostatic", "--spacing", "0.0125", "--width", "0.1", "--fill", "0.05", "--no-plot", "--json"]
+    assert main(argv) == 0
+    default = json.loads(capsys.readouterr().out)["cases"][0]
+    assert main([*argv, "--artificial-viscosity-scale", "signal_velocity", "--free-artificial-viscosity", "none"]) == 0
+    signal = json.loads(capsys.readouterr().out)["cases"][0]
+    assert signal["pressure"] != default["pressure"]
+
+
+@pytest.mark.parametrize("flag, value", [("--free-artificial-viscosity", "abc"), ("--free-artificial-viscosity", "2"),
+                                         ("--artificial-viscosity", "-1")])
+def test_bad_viscosity_input_exits_2_with_one_line(flag, value, capsys):
+    assert main(["validate", "hydrostatic", flag, value, "--no-plot"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("cosim validate: error:")
