@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
-from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver, WallModel
+from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver, WallModel, WallPressure
 from cosim.validation import CASES, DEFAULT_CASES
 from declared_settings.setting import declared
 
@@ -61,6 +61,9 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--wall-model", choices=[m.value for m in WallModel],
                    help="the walls' dummy particles: kernel_layers or real_thickness (docs/walls.md) (default: the default "
                    "scene's fluid.wall_model)")
+    p.add_argument("--wall-pressure", choices=[m.value for m in WallPressure],
+                   help="DFSPH: how the walls carry pressure: solved_layer, solved_rest_sum or mirrored (docs/walls.md) (default: the default "
+                   "scene's fluid.wall_pressure)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
@@ -74,7 +77,8 @@ def _case_params(name: str, args) -> list:
     scene = FluidSettings()
     solver = args.solver or scene.pressure_solver.value
     numerics = (("density_iteration", args.density_iteration or scene.density_iteration.value),
-                ("wall_model", args.wall_model or scene.wall_model.value))
+                ("wall_model", args.wall_model or scene.wall_model.value),
+                ("wall_pressure", args.wall_pressure or scene.wall_pressure.value))
     if args.density_tolerance is not None:
         numerics += (("density_tolerance", args.density_tolerance),)
     common = {"dim": declared(FluidConfig, "dim").check("--dim", args.dim), "device": args.device, "spacing": args.spacing, "solver": solver, "numerics": numerics}
