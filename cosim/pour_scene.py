@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, FluidConfig, GridReset, InitialState, KernelType, PressureSolver, WallModel
+from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, FluidConfig, GridReset, InitialState, KernelType, PressureSolver, WallModel, WallPressure
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -88,6 +88,7 @@ class FluidSettings:
     density_iteration: DensityIteration = like(FluidConfig, "density_iteration")
     density_tolerance: float | None = like(FluidConfig, "density_tolerance")
     divergence_tolerance: float = like(FluidConfig, "divergence_tolerance")
+    wall_pressure: WallPressure = like(FluidConfig, "wall_pressure")
     max_solver_iterations: int = like(FluidConfig, "max_solver_iterations")
     # ---- time stepping
     cfl: float = like(FluidConfig, "cfl")

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
-from cosim.fluid.config import ArtificialViscosityScale, DensityIteration, FluidConfig, InitialState, PressureSolver, WallModel
+from cosim.fluid.config import ArtificialViscosityScale, DensityIteration, FluidConfig, InitialState, PressureSolver, WallModel, WallPressure
 from cosim.validation import CASES, DEFAULT_CASES
 from declared_settings.setting import declared
 
@@ -72,6 +72,9 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--free-artificial-viscosity", metavar="ALPHA|none",
                    help="Monaghan's alpha of pairs with free liquid, or none for the velocity scale's own (the one alpha under the signal velocity) (default: the "
                    "default scene's fluid.free_artificial_viscosity)")
+    p.add_argument("--wall-pressure", choices=[m.value for m in WallPressure],
+                   help="DFSPH: how the walls carry pressure: solved_layer, solved_rest_sum or mirrored (docs/walls.md) (default: the default "
+                   "scene's fluid.wall_pressure)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
@@ -86,7 +89,8 @@ def _case_params(name: str, args) -> list:
     solver = args.solver or scene.pressure_solver.value
     numerics = (("density_iteration", args.density_iteration or scene.density_iteration.value),
                 ("wall_model", args.wall_model or scene.wall_model.value),
-                ("initial_state", args.initial_state or scene.initial_state.value))
+                ("initial_state", args.initial_state or scene.initial_state.value,
+                ("wall_pressure", args.wall_pressure or scene.wall_pressure.value))
     if args.density_tolerance is not None:
         numerics += (("density_tolerance", args.density_tolerance),)
     numerics += (("artificial_viscosity", scene.artificial_viscosity if args.artificial_viscosity is None else args.artificial_viscosity),

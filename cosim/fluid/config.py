@@ -34,6 +34,14 @@ class WallModel(Enum):
     REAL_THICKNESS = "real_thickness"  # layers inside the vessel's own wall, volumes compensating the missing support
 
 
+class WallPressure(Enum):
+    """How DFSPH's walls carry the liquid's pressure (``cosim.fluid.dfsph``; WCSPH extrapolates it, Adami et al. 2012)."""
+
+    SOLVED_LAYER = "solved_layer"  # the wall layer facing the liquid solved with it, each particle's own stiffness
+    SOLVED_REST_SUM = "solved_rest_sum"  # the same, each particle held to its summation density with liquid at rest
+    MIRRORED = "mirrored"  # no unknown on the wall: each wall pair carries the liquid particle's own stiffness
+
+
 class GridReset(Enum):
     """How the neighbour grid's cell ranges are reset before each build (``cosim.fluid.neighbors``)."""
 
@@ -214,6 +222,15 @@ class FluidConfig:
     divergence_tolerance: float = setting(0.001, DFSPH, "The divergence solve stops when the average density rate "
                                           "times dt, over rho0, is below this (Bender & Koschier's 0.1 % per step).",
                                           "", 0.0, 0.05, lo_open=True)
+    wall_pressure: WallPressure = setting(WallPressure.SOLVED_LAYER, DFSPH, "How the walls carry pressure: "
+                                         "'solved_layer' (the wall layer facing the liquid is held to rest density "
+                                         "with a stiffness of its own, solved with the liquid's; a wall thinner than "
+                                         "the kernel support, whose particles sum short of rho0 with liquid resting "
+                                         "against them, carries none), 'solved_rest_sum' (the same, each particle of "
+                                         "a thin wall held to the summation density it has with liquid resting "
+                                         "against it; walls covering the support as 'solved_layer') or 'mirrored' "
+                                         "(no unknown on the wall: each wall pair carries the liquid particle's own "
+                                         "stiffness, Akinci et al. 2012); docs/walls.md.")
     max_solver_iterations: int = setting(100, DFSPH, "Iteration cap of each of the two solves; a solve that hits it "
                                          "is not an error, its remaining error shows in the diagnostics.", "", 2, 1000)
     # ---- time stepping

@@ -44,17 +44,22 @@ Only compression is corrected (e_i >= 0): a free surface's kernel deficiency is 
 
 Pressure-carrying walls (Band et al. 2018 solve boundary pressures with the liquid's; this is that idea in DFSPH's
 constraint form): the layer of dummy wall particles that faces the liquid (``FluidModel.b_wetted``) is held to rest
-density like liquid that does not move, each wall particle b with its own stiffness k_b (its density rate
-sum_j m_j (v_b - v_j) . grad W_bj from the liquid moving against the wall, its factor from the density change its
-push on the liquid causes, warm-started as the liquid's). The force on the liquid stays the transpose of the
-constraints' gradient, so the solve is stable. A wall term carrying only the particle's own stiffness (as
-SPlisHSPlasH's Akinci boundary) lets the constant part of the pressure push the rows next to a wall onto it, and the
-column settles low; mirroring the particle's pressure onto the wall is not a constraint gradient and blows a resting
-column up (the measurements: docs/physics-and-validation.md, Design notes). The deeper layers lack the layers
-beyond the last in their kernel support, so they only contribute density. The stiffness each particle applied
-over both solves, kappa_i, is kept: it gives the reported pressure p_i = rho_i kappa_i (the pressure whose impulse
-acted over dt; reported as its average over the interval), the wall reaction, and the warm start of the next
-substep.
+density like liquid that does not move, each wall particle b with its own stiffness k_b (its density rate sum_j m_j
+(v_b - v_j) . grad W_bj from the liquid moving against the wall, its factor from the density change its push on the
+liquid causes, warm-started as the liquid's). The force on the liquid stays the transpose of the constraints'
+gradient, so the solve is stable. A wall term carrying only the particle's own stiffness (as SPlisHSPlasH's Akinci
+boundary; ``FluidConfig.wall_pressure`` 'mirrored', which leaves the layer's stages out and its stiffness at zero,
+``cosim.fluid.dfsph_step.solved_wall_layer``) lets the constant part of the pressure push the rows next to a wall
+onto it, and the column settles low (a thin wall cannot hold them off at all); mirroring the particle's pressure
+onto the wall is not a constraint gradient and blows a resting column up (the measurements:
+docs/physics-and-validation.md, Design notes). The deeper layers lack the layers beyond the last in their kernel
+support, so they only contribute density. A wall thinner than the support lacks those layers behind its facing one
+too: liquid resting against it sums it to 0.76 rho0 (32 across), so held to rho0 it is never compressed and carries
+nothing; ``FluidConfig.wall_pressure`` 'solved_rest_sum' holds each of its particles to that rest sum instead (its
+summation density plus ``FluidModel.b_rest_offset``, as the liquid's surface rows keep their seeded deficiency). The
+stiffness each particle applied over both solves, kappa_i, is kept: it gives the reported pressure p_i = rho_i
+kappa_i (the pressure whose impulse acted over dt; reported as its average over the interval), the wall reaction,
+and the warm start of the next substep.
 
 The stopping test reads one int32 flag that ``check_convergence`` writes on the device, driven by
 ``wp.capture_while``: captured, it becomes a conditional graph node on CUDA and a while operation of warp's
@@ -461,6 +466,7 @@ def compute_wall_density_factor(
     prm: SPHParams,
     b_volume: wp.array(dtype=float),
     b_wetted: wp.array(dtype=wp.int32),
+    b_rest_offset: wp.array(dtype=float),
     capacity: int,
     # State in
     nb: Neighborhood,
@@ -477,7 +483,8 @@ def compute_wall_density_factor(
 ):
     """The pressure-carrying wall layer (``b_wetted``): each of its particles b is held to rest density like a
     liquid particle that does not move. Its summation density rho_b = (rho0 V_b W(0) + sum_j m_j W_bj + sum_b'
-    rho0 V_b' W_bb') / s, its factor alpha_b = rho_b / sum_j m_j rho0 V_b |grad W_bj|^2 (the density change its
+    rho0 V_b' W_bb') / s + o_b (o_b, ``b_rest_offset``: the shortfall of a thin wall's sum with liquid at rest,
+    :func:`cosim.fluid.wall_sampling.wall_rest_offsets`, or zero), its factor alpha_b = rho_b / sum_j m_j rho0 V_b |grad W_bj|^2 (the density change its
     stiffness causes by pushing its liquid neighbours away; bounded below as the liquid's) and its list of liquid
     neighbours with m grad_b W. Other wall particles carry no stiffness (rho_b = rho0, no pairs)."""
     b = wp.tid()
@@ -507,7 +514,7 @@ def compute_wall_density_factor(
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], b), DIAG_PAIR_OVERFLOW, 1)
     b_pair_count[b] = wp.min(count, capacity)
-    density = density / prm.lattice_density
+    density = density / prm.lattice_density + b_rest_offset[b]
     b_rho[b] = density
     b_alpha[b] = density / wp.max(grad_sq, MIN_FACTOR_DENOMINATOR * prm.lattice_factor_denominator)
     wp.atomic_add(solve_stats, stat_slot(prm, b, STAT_COUNT), wp.int64(1))

@@ -2,7 +2,8 @@
 
     start_substep: move_vessels; place_wall_particles; find_neighbors; reorder_particles (``cosim.fluid.substep``)
     compute_density_factor       summation density, the DFSPH factor, the pair list; the divergence solve's warm start
-    compute_wall_density_factor  the same for the wall layer facing the liquid, with its warm start
+    compute_wall_density_factor  the same for the wall layer facing the liquid, with its warm start (a solved layer only,
+                                 :func:`solved_wall_layer`)
     divergence_solve             Jacobi iterations until the density rate is small
     compute_nonpressure          v* = v + dt (g + viscosity); the density solve's warm start (and, for Gauss-Seidel,
                                  each sweep thread's cells)
@@ -21,13 +22,21 @@ import numpy as np
 import warp as wp
 
 from cosim.fluid import dfsph, wcsph
-from cosim.fluid.config import DensityIteration, InitialState
+from cosim.fluid.config import DensityIteration, InitialState, WallPressure
 from cosim.fluid.device_layout import pair_table
 from cosim.fluid.lanes import LANE_CHUNK, Lanes, PerLane
 from cosim.fluid.launch import launch_now
 from cosim.fluid.model import FluidModel, FluidState
 from cosim.fluid.program import Recorder
 from cosim.fluid.substep import PairList, SubstepScratch, end_substep, start_substep
+
+
+def solved_wall_layer(m: FluidModel) -> bool:
+    """Whether the wall layer facing the liquid is solved with it (``FluidConfig.wall_pressure`` 'solved_layer' or
+    'solved_rest_sum'). Otherwise ('mirrored') its stages do not run: its stiffness stays zero and its density rho0, so each wall pair
+    of the liquid's pressure terms carries the liquid particle's own stiffness alone, sum_b rho0 V_b (k_i / rho_i)
+    grad W_ib (``cosim.fluid.dfsph``, pressure-carrying walls), in the solves and in the wall reaction alike."""
+    return m.config.wall_pressure is not WallPressure.MIRRORED
 
 
 class DFSPHScratch:
@@ -51,6 +60,8 @@ class DFSPHScratch:
         self.pairs = PairList(wp.zeros(n, dtype=wp.int32, device=d), pair_table(n, cap, wp.int32, d, by_column), pair_table(n, cap, wp.vec3, d, by_column))
         self.pair_mass_grad = pair_table(n, cap, wp.vec3, d, by_column)
         self.b_rho = wp.zeros(nb, dtype=float, device=d)
+        if not solved_wall_layer(m):
+            self.b_rho.fill_(m.config.rest_density)  # never computed: the mirrored walls' k_b / rho_b = 0 / rho0
         self.b_alpha = wp.zeros(nb, dtype=float, device=d)
         self.b_increment = wp.zeros(nb, dtype=float, device=d)
         self.b_increment_per_rho = wp.zeros(nb, dtype=float, device=d)
@@ -89,7 +100,7 @@ def compute_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
 def compute_wall_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: DFSPHScratch) -> None:
     """The wall layer's summation density, factor and list of liquid neighbours."""
     rec.launch(
-        dfsph.compute_wall_density_factor, m.n_boundary, prm=m.params, b_volume=m.b_volume, b_wetted=m.b_wetted,
+        dfsph.compute_wall_density_factor, m.n_boundary, prm=m.params, b_volume=m.b_volume, b_wetted=m.b_wetted, b_rest_offset=m.b_rest_offset,
         capacity=sh.pair_capacity, nb=sh.neighborhood(m, st), mass=st.mass, row=sh.row, b_rho=sc.b_rho, b_alpha=sc.b_alpha,
         b_pair_count=sc.b_pair_count, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
         solve_stats=sc.lane_stats, diag_i=sh.diagnostics.lane_i,
@@ -127,7 +138,7 @@ def jacobi_solve(
 ) -> None:
     """A solve by Jacobi iterations (``mode``: dfsph.SOLVE_DIVERGENCE or SOLVE_DENSITY) on the velocities ``v``: each
     applies the increments the last measured (the first, the warm start), then measures the liquid's and the wall
-    layer's errors and their next increments."""
+    layer's (a solved one's) errors and their next increments."""
     with rec.loop(sc.keep_going):
         apply_stiffness(rec, m, st, sh, sc, v, kappa)
         with rec.together():
@@ -136,11 +147,12 @@ def jacobi_solve(
                 bv=sh.bv, pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_mass_grad=sc.pair_mass_grad,
                 increment=sc.increment, increment_per_rho=sc.increment_per_rho, solve_stats=sc.lane_stats,
             )
-            rec.launch(
-                dfsph.compute_wall_solve_error, m.n_boundary, prm=m.params, mode=mode, v=v, dt=sh.dt, bv=sh.bv, b_rho=sc.b_rho, b_alpha=sc.b_alpha,
-                b_pair_count=sc.b_pair_count, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
-                b_kappa=b_kappa, b_increment=sc.b_increment, b_increment_per_rho=sc.b_increment_per_rho, solve_stats=sc.lane_stats,
-            )
+            if solved_wall_layer(m):
+                rec.launch(
+                    dfsph.compute_wall_solve_error, m.n_boundary, prm=m.params, mode=mode, v=v, dt=sh.dt, bv=sh.bv, b_rho=sc.b_rho,
+                    b_alpha=sc.b_alpha, b_pair_count=sc.b_pair_count, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
+                    b_kappa=b_kappa, b_increment=sc.b_increment, b_increment_per_rho=sc.b_increment_per_rho, solve_stats=sc.lane_stats,
+                )
         check_convergence(rec, m, sh, sc, mode)
 
 
@@ -256,14 +268,17 @@ class DFSPHStep:
         """One substep: the liquid ``src`` reordered into ``st`` and advanced there."""
         m, sh, sc = self.model, self.shared, self.scratch
         start_substep(rec, m, src, st, sh)
+        solved_walls = solved_wall_layer(m)
         compute_density_factor(rec, m, st, sh, sc)
-        with rec.together():
-            compute_wall_density_factor(rec, m, st, sh, sc)
-            start_wall_solve(rec, m, sc, sc.b_kappa_divergence, dfsph.WARM_START_DIVERGENCE, warm_start_applied=False)
+        if solved_walls:
+            with rec.together():
+                compute_wall_density_factor(rec, m, st, sh, sc)
+                start_wall_solve(rec, m, sc, sc.b_kappa_divergence, dfsph.WARM_START_DIVERGENCE, warm_start_applied=False)
         divergence_solve(rec, m, st, sh, sc)
         with rec.together():
             compute_nonpressure(rec, m, st, sh, sc)
-            start_wall_solve(rec, m, sc, sc.b_kappa_density, dfsph.WARM_START_DENSITY, warm_start_applied=self.gauss_seidel)
+            if solved_walls:
+                start_wall_solve(rec, m, sc, sc.b_kappa_density, dfsph.WARM_START_DENSITY, warm_start_applied=self.gauss_seidel)
             if self.gauss_seidel:
                 list_sweep_cells(rec, m, sc)
         density_solve(rec, m, st, sh, sc, self.gauss_seidel)

@@ -21,11 +21,11 @@ import warp as wp
 from cosim.fluid.boundary import SHAPE_BOX, SHAPE_CYLINDER, VesselGeometry
 from cosim.fluid.mesh_boundary import SHAPE_MESH
 from cosim.fluid.mesh_sampling import cavity_bounds, warp_mesh
-from cosim.fluid.config import FluidConfig
+from cosim.fluid.config import FluidConfig, WallPressure
 from cosim.fluid.memory import check_memory
 from cosim.fluid.neighbors import CellGrid
 from cosim.fluid.params import SPHParams, make_params
-from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls, wetted_layer
+from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls, wall_rest_offsets, wetted_layer
 from cosim.vessel import VesselSpec
 
 
@@ -41,6 +41,9 @@ class FluidModel:
     b_volume: (Nb,) float, volume of each wall particle (m^dim; its mass is rho0 times this).
     b_wetted: (Nb,) int32, 1 for the wall particles of the layer facing the liquid
     (:func:`cosim.fluid.wall_sampling.wetted_layer`; DFSPH holds them to rest density too).
+    b_rest_offset: (Nb,) float, kg/m^3, added to a wall particle's summation density where DFSPH holds the layer
+    to its rest sum (``FluidConfig.wall_pressure`` 'solved_rest_sum': :func:`cosim.fluid.wall_sampling.wall_rest_offsets`);
+    zeros otherwise.
     b_reach: (V,) numpy, largest distance of a vessel's wall particles from its frame origin (m): wall speed bound.
     wall_thickness: (V,) numpy, wall thickness the liquid sees (m), >= the vessel's own.
     grid, b_grid: neighbour grids for liquid and wall particles (identical cell layout).
@@ -58,6 +61,7 @@ class FluidModel:
     b_vessel: wp.array
     b_volume: wp.array
     b_wetted: wp.array
+    b_rest_offset: wp.array
     b_reach: np.ndarray
     wall_thickness: np.ndarray
     grid: CellGrid
@@ -128,6 +132,8 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
     check_memory(cfg, n_particles, len(b_local), wp.get_device(device))
     b_volume = np.concatenate([w[1] for w in walls]) if walls else np.zeros(0)
     b_wetted = np.concatenate([wetted_layer(s, w[0], cfg.spacing, cfg.dim) for s, w in zip(specs, walls)]) if walls else np.zeros(0, bool)
+    rest_sum = cfg.wall_pressure is WallPressure.SOLVED_REST_SUM
+    b_rest_offset = np.concatenate([wall_rest_offsets(s, cfg, *w) if rest_sum else np.zeros(len(w[0])) for s, w in zip(specs, walls)]) if walls else np.zeros(0)
     b_vessel = np.concatenate([np.full(len(s), k, dtype=np.int32) for k, s in enumerate(samples)]) if samples else np.zeros(0, np.int32)
     reach = np.array([np.linalg.norm(s, axis=1).max() for s in samples]) if samples else np.zeros(0)
     thickness = np.array([numerical_wall_thickness(s, cfg) for s in specs])
@@ -144,6 +150,7 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
         b_vessel=wp.array(b_vessel, dtype=wp.int32, device=device),
         b_volume=wp.array(b_volume.astype(np.float32), dtype=float, device=device),
         b_wetted=wp.array(b_wetted.astype(np.int32), dtype=wp.int32, device=device),
+        b_rest_offset=wp.array(b_rest_offset.astype(np.float32), dtype=float, device=device),
         b_reach=reach,
         wall_thickness=thickness,
         grid=make_grid(n_particles),

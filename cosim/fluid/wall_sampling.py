@@ -28,7 +28,7 @@ import numpy as np
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig, WallModel
 from cosim.fluid.mesh_sampling import mesh_wetted_layer, sample_mesh_walls
-from cosim.fluid.sph_kernels import kernel_values
+from cosim.fluid.sph_kernels import kernel_values, lattice_kernel_sum
 from cosim.vessel import VesselSpec
 
 
@@ -203,6 +203,25 @@ def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray,
     if covers_support(spec, cfg):
         return points, volumes
     return points, fit_wall_volumes(spec, cfg, points, volumes)
+
+
+def wall_rest_offsets(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, volumes: np.ndarray) -> np.ndarray:
+    """(n,) kg/m^3: how far each dummy particle's summation density falls short of rho0 with liquid resting against
+    it, max(rho0 - rho_b^rest, 0): rho_b^rest = rho0 (V_b W(0) + sum_b' V_b' W_bb' + sum_p dx^dim W(x_b - p)) / s
+    over the vessel's own particles ``points`` (volumes ``volumes``) and the liquid's initial lattice filling the
+    vessel to its rim (the points :func:`fit_wall_volumes` fits at; s: a resting lattice's kernel sum, as the
+    solver divides by). A wall thinner than the kernel support lacks the layers behind its particles, so liquid at
+    rest against it leaves them short (0.76 rho0 at 32 across, less at inner corners); held to rho0 they would never
+    be compressed. Walls covering the support need no offset (zeros)."""
+    from cosim.fluid.seeding import fill_vessel
+
+    if covers_support(spec, cfg):
+        return np.zeros(len(points))
+    probes = fill_vessel(spec, spec.inner_height, cfg).positions
+    liquid = _kernel_sums(_kernel_pairs(points, probes, cfg), np.full(len(probes), cfg.spacing**cfg.dim), len(points))
+    walls = _kernel_sums(_kernel_pairs(points, points, cfg), volumes, len(points))
+    rest = cfg.rest_density * (liquid + walls) / lattice_kernel_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim)
+    return np.maximum(cfg.rest_density - rest, 0.0)
 
 
 def wetted_layer(spec: VesselSpec, points: np.ndarray, spacing: float, dim: int) -> np.ndarray:
