@@ -89,7 +89,7 @@ def _case_params(name: str, args) -> list:
     solver = args.solver or scene.pressure_solver.value
     numerics = (("density_iteration", args.density_iteration or scene.density_iteration.value),
                 ("wall_model", args.wall_model or scene.wall_model.value),
-                ("initial_state", args.initial_state or scene.initial_state.value,
+                ("initial_state", args.initial_state or scene.initial_state.value),
                 ("wall_pressure", args.wall_pressure or scene.wall_pressure.value))
     if args.density_tolerance is not None:
         numerics += (("density_tolerance", args.density_tolerance),)
