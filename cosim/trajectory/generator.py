@@ -153,21 +153,33 @@ def _quadratic_derivatives(times: list[float], points: list[np.ndarray]) -> tupl
     return qd, qdd
 
 
-def _spline_state(points: np.ndarray, u: float, period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(q, qd, qdd)`` at ``u`` in [0, 1] of the uniform cubic B-spline segment with control points ``points``
-    (4, n) spaced ``period`` s (de Boor, A Practical Guide to Splines, 1978): ``q(u) = sum_i B_i(u) P_i`` with the
-    basis ``B = ((1-u)^3, 3u^3 - 6u^2 + 4, -3u^3 + 3u^2 + 3u + 1, u^3) / 6``; the velocity, the quadratic B-spline of
-    the differences ``D_i = P_{i+1} - P_i``, ``((1-u)^2 D_0 + (1 + 2u - 2u^2) D_1 + u^2 D_2) / (2 period)``; the
-    acceleration, the line between the second differences, ``((1-u) E_0 + u E_1) / period^2``. Written out term by
-    term (no BLAS, whose kernels round differently) and in differences, which keeps the velocity and acceleration
-    within the hull of theirs up to one rounding."""
-    w = 1.0 - u
+def _spline_states(points: np.ndarray, us: list[float], period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, qd, qdd)``, each (len(us), n), at each ``u`` of ``us`` in [0, 1] of the uniform cubic B-spline segment
+    with control points ``points`` (4, n) spaced ``period`` s (de Boor, A Practical Guide to Splines, 1978):
+    ``q(u) = sum_i B_i(u) P_i`` with the basis ``B = ((1-u)^3, 3u^3 - 6u^2 + 4, -3u^3 + 3u^2 + 3u + 1, u^3) / 6``; the
+    velocity, the quadratic B-spline of the differences ``D_i = P_{i+1} - P_i``, ``((1-u)^2 D_0 + (1 + 2u - 2u^2) D_1
+    + u^2 D_2) / (2 period)``; the acceleration, the line between the second differences, ``((1-u) E_0 + u E_1) /
+    period^2``. Written out term by term (no BLAS, whose kernels round differently) and in differences, which keeps
+    the velocity and acceleration within the hull of theirs up to one rounding. The basis weights are computed per
+    ``u`` in floats and applied to all rows at once: each entry is the same sequence of roundings as for one ``u``."""
+    def column(values) -> np.ndarray:
+        return np.array(values)[:, None]
+
+    ws = [1.0 - u for u in us]
     p0, p1, p2, p3 = points
     d0, d1, d2 = p1 - p0, p2 - p1, p3 - p2
-    position = (w * w * w * p0 + (3.0 * u**3 - 6.0 * u * u + 4.0) * p1 + (1.0 + 3.0 * u + 3.0 * u * u - 3.0 * u**3) * p2 + u**3 * p3) / 6.0
-    velocity = (w * w * d0 + (1.0 + 2.0 * u - 2.0 * u * u) * d1 + u * u * d2) / (2.0 * period)
-    acceleration = (w * (d1 - d0) + u * (d2 - d1)) / (period * period)
+    position = (column([w * w * w for w in ws]) * p0 + column([3.0 * u**3 - 6.0 * u * u + 4.0 for u in us]) * p1
+                + column([1.0 + 3.0 * u + 3.0 * u * u - 3.0 * u**3 for u in us]) * p2 + column([u**3 for u in us]) * p3) / 6.0
+    velocity = (column([w * w for w in ws]) * d0 + column([1.0 + 2.0 * u - 2.0 * u * u for u in us]) * d1
+                + column([u * u for u in us]) * d2) / (2.0 * period)
+    acceleration = (column(ws) * (d1 - d0) + column(us) * (d2 - d1)) / (period * period)
     return position, velocity, acceleration
+
+
+def _spline_state(points: np.ndarray, u: float, period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, qd, qdd)`` (n,) at ``u`` in [0, 1] of the B-spline segment with control points ``points`` (4, n)
+    (:func:`_spline_states`)."""
+    return tuple(a[0] for a in _spline_states(points, [u], period))  # type: ignore[return-value]
 
 
 def _peak_speed(points: np.ndarray, period: float) -> np.ndarray:
@@ -264,6 +276,9 @@ class TrajectoryGenerator:
         self._path_lead = 0.0  # s, how far ahead of now _path lies (a spline segment's end: one period)
         self._points: list[np.ndarray] = []  # the spline path's last control points (at most four)
         self._segment: tuple[np.ndarray, int] | None = None  # (control points (4, n), start step) of a spline segment
+        # the segment's (q, qd, qdd), each (rows, n): at its start, its end, then after each of its steps
+        self._segment_states: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._unsent_state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # the arm's state not yet in ruckig's input
         self._on_segment = False  # the last step followed the spline segment
         self._history_steps: list[int] = []  # step index of each recent target (at most three)
         self._history_q: list[np.ndarray] = []
@@ -297,14 +312,15 @@ class TrajectoryGenerator:
         q = np.clip(q, self._lo, self._hi)
         self._history_steps = (self._history_steps + [self._steps])[-3:]
         self._history_q = (self._history_q + [q])[-3:]
-        times = [s * self.settings.cycle_time for s in self._history_steps]
-        est_qd, est_qdd = _quadratic_derivatives(times, self._history_q)
-        qd = est_qd if qd is None else _vector(f"{self.limits.arm}: target velocity", qd, n)
-        qdd = est_qdd if qdd is None else _vector(f"{self.limits.arm}: target acceleration", qdd, n)
         if explicit:
+            times = [s * self.settings.cycle_time for s in self._history_steps]
+            est_qd, est_qdd = _quadratic_derivatives(times, self._history_q)
+            qd = est_qd if qd is None else _vector(f"{self.limits.arm}: target velocity", qd, n)
+            qdd = est_qdd if qdd is None else _vector(f"{self.limits.arm}: target acceleration", qdd, n)
             if self.settings.stop_beyond_velocity_limit:
                 self._check_trackable(qd, clamped)
             self._points, self._segment = [], None
+            self._sync_input()
             error = float(np.max(np.abs(np.array(self._input.current_position) - q)))
             self._follow_with_ruckig(q, qd, qdd, clamped, interval, 0.0, error)
             return
@@ -315,14 +331,19 @@ class TrajectoryGenerator:
         points = np.array(self._points)
         if self.settings.stop_beyond_velocity_limit:
             self._check_trackable(_peak_speed(points, period), clamped)
-        start = _spline_state(points, 0.0, period)
-        end = _spline_state(points, 1.0, period)
+        # the segment's states at its start, its end and each step it may be played for, at once
+        cycle, steps = self.settings.cycle_time, 1
+        while steps * cycle / period < 1.0 - TIME_EPSILON:
+            steps += 1
+        states = _spline_states(points, [0.0, 1.0] + [k * cycle / period for k in range(1, steps + 1)], period)
+        start, end = (tuple(a[i] for a in states) for i in (0, 1))
         error = float(np.max(np.abs(self._state[0] - start[0])))
         offset = max(error, float(np.max(np.abs(self._state[1] - start[1]))) * period,
                      float(np.max(np.abs(self._state[2] - start[2]))) * period * period)
         if offset <= SPLINE_TOLERANCE and abs(interval - period) <= TIME_EPSILON and self._spline_within_limits(points, end):
             self._max_target_error = max(self._max_target_error, error)
             self._segment = (points, self._steps)
+            self._segment_states = states
             inp = self._input
             inp.target_position, inp.target_velocity, inp.target_acceleration = (list(a) for a in end)
             self._new_target = True
@@ -358,6 +379,7 @@ class TrajectoryGenerator:
         """Plan ruckig toward the path state ``(q, qd, qdd)`` (n,) at ``lead`` s from now (0: a target now; one
         period: a spline segment's end), clamped joints at rest, made admissible, met at the shortest horizon
         (:meth:`_intercept_horizon`); ``error`` (rad) is the arm's distance to the path now."""
+        self._sync_input()
         self._max_target_error = max(self._max_target_error, error)
         qd = np.where(clamped, 0.0, np.clip(qd, -self._vmax, self._vmax))
         qdd = np.where(clamped, 0.0, np.clip(qdd, -self._amax, self._amax))
@@ -473,6 +495,7 @@ class TrajectoryGenerator:
         inp.control_interface = ruckig.ControlInterface.Position
         inp.minimum_duration = None
         inp.current_position, inp.current_velocity, inp.current_acceleration = list(q), list(qd), list(qdd)
+        self._unsent_state = None
         inp.target_position, inp.target_velocity, inp.target_acceleration = list(q), [0.0] * n, [0.0] * n
         self._state = (q.copy(), qd.copy(), qdd.copy())
         self._path = self._state
@@ -504,11 +527,13 @@ class TrajectoryGenerator:
         if self._finished and not self._new_target and self._target_moving():
             self.hold()  # the last target was reached and no new one came: do not extrapolate its motion
         if self._segment is not None:
-            state = _spline_state(self._segment[0], self._segment_u(self._steps + 1), self.settings.control_period)
-            inp.current_position, inp.current_velocity, inp.current_acceleration = (a.tolist() for a in state)
+            row = 1 + self._steps + 1 - self._segment[1]  # after the start's and the end's rows
+            state = tuple(a[row] for a in self._segment_states)
+            self._unsent_state = state
             self._on_segment = True
             self._finished = self._segment_u(self._steps + 1) >= 1.0 - TIME_EPSILON
         else:
+            self._sync_input()
             try:
                 result = self._otg.update(inp, self._output)
             except ruckig.RuckigError as exc:
@@ -524,6 +549,14 @@ class TrajectoryGenerator:
         self._new_target = False
         self._state = state
         return self.state
+
+    def _sync_input(self) -> None:
+        """Give ruckig's input the arm's state played on a spline segment (held back while the segment plays: only
+        ruckig reads it)."""
+        if self._unsent_state is not None:
+            inp = self._input
+            inp.current_position, inp.current_velocity, inp.current_acceleration = (a.tolist() for a in self._unsent_state)
+            self._unsent_state = None
 
     def _segment_u(self, step: int) -> float:
         """The spline segment's parameter in [0, 1] at generator step ``step``."""
