@@ -239,6 +239,19 @@ class TrajectoryGenerator:
         self._lo_floats, self._hi_floats, self._vmax_floats = self._lo.tolist(), self._hi.tolist(), self._vmax.tolist()
         self._jmax = limits.array("max_jerk")
         self._jmax_floats = self._jmax.tolist()
+        period = settings.control_period
+        # a spline segment's first, second and third differences of control points within the limits
+        # (:meth:`_spline_within_limits`)
+        self._step_limits = (self._vmax * period, self._amax * period**2, self._jmax * period**3)
+        # first differences within which the segment's speed is below max_velocity (the hull bound, less a margin far
+        # beyond the round-off of the exact peak, :func:`_peak_speed`)
+        self._trackable_step = self._vmax * period * (1.0 - 1e-9)
+        # the parameter u of a spline segment at its start, its end and after each step it may be played for
+        # (:meth:`_segment_u`: while below 1)
+        played = [1]
+        while played[-1] * settings.cycle_time / period < 1.0 - TIME_EPSILON:
+            played.append(played[-1] + 1)
+        self._segment_us = [0.0, 1.0] + [k * settings.cycle_time / period for k in played]
         q0 = _vector(f"{limits.arm}: start position", q0, n)
         outside = np.flatnonzero((q0 < self._lo) | (q0 > self._hi))
         if outside.size:
@@ -329,43 +342,46 @@ class TrajectoryGenerator:
             self._points = _control_points(*self._state, period)
         self._points = self._points[-3:] + [q]
         points = np.array(self._points)
-        if self.settings.stop_beyond_velocity_limit:
+        differences = np.diff(points, axis=0)
+        sizes = np.abs(differences)
+        # the segment's speed stays within the hull of the differences / T (:meth:`_spline_within_limits`): within the bound
+        # no joint can be above its limit and the exact peak need not be computed
+        if self.settings.stop_beyond_velocity_limit and not (sizes <= self._trackable_step).all():
             self._check_trackable(_peak_speed(points, period), clamped)
-        # the segment's states at its start, its end and each step it may be played for, at once
-        cycle, steps = self.settings.cycle_time, 1
-        while steps * cycle / period < 1.0 - TIME_EPSILON:
-            steps += 1
-        states = _spline_states(points, [0.0, 1.0] + [k * cycle / period for k in range(1, steps + 1)], period)
+        states = _spline_states(points, self._segment_us, period)
         start, end = (tuple(a[i] for a in states) for i in (0, 1))
         error = float(np.max(np.abs(self._state[0] - start[0])))
         offset = max(error, float(np.max(np.abs(self._state[1] - start[1]))) * period,
                      float(np.max(np.abs(self._state[2] - start[2]))) * period * period)
-        if offset <= SPLINE_TOLERANCE and abs(interval - period) <= TIME_EPSILON and self._spline_within_limits(points, end):
+        if offset <= SPLINE_TOLERANCE and abs(interval - period) <= TIME_EPSILON and self._spline_within_limits(points, differences, sizes, end):
             self._max_target_error = max(self._max_target_error, error)
             self._segment = (points, self._steps)
             self._segment_states = states
             inp = self._input
-            inp.target_position, inp.target_velocity, inp.target_acceleration = (list(a) for a in end)
+            inp.target_position, inp.target_velocity, inp.target_acceleration = (a.tolist() for a in end)
             self._new_target = True
             return
         self._segment = None
         self._follow_with_ruckig(end[0], end[1], end[2], clamped, interval, period, error)
 
-    def _spline_within_limits(self, points: np.ndarray, end: tuple[np.ndarray, np.ndarray, np.ndarray]) -> bool:
+    def _spline_within_limits(
+        self, points: np.ndarray, differences: np.ndarray, sizes: np.ndarray, end: tuple[np.ndarray, np.ndarray, np.ndarray]
+    ) -> bool:
         """Whether the B-spline segment with control points ``points`` (4, n) keeps every limit, exactly: its
         velocity is a quadratic B-spline with control points ``dP / T``, its acceleration the line between the
         ``d^2 P / T^2``, its jerk ``d^3 P / T^3`` (``T`` the control period), so each lies within the hull of those
         differences; its positions lie within the hull of the control points, which must lie in the joint range (the
         targets are clamped onto it, the points made from the arm's state may not be). And its end state is
-        admissible (:func:`_admissible_acceleration`), so that ruckig can take over from it within the limits."""
-        period = self.settings.control_period
-        if np.any((points < self._lo) | (points > self._hi)):  # a state's virtual control points may lie beyond
+        admissible (:func:`_admissible_acceleration`), so that ruckig can take over from it within the limits.
+        ``differences`` (3, n): the points' first differences, ``sizes`` their magnitudes."""
+        if ((points < self._lo) | (points > self._hi)).any():  # a state's virtual control points may lie beyond
             return False
-        if np.any(np.abs(np.diff(points, 1, axis=0)) > self._vmax * period):
+        if (sizes > self._step_limits[0]).any():
             return False
-        if np.any(np.abs(np.diff(points, 2, axis=0)) > self._amax * period**2):
+        second = np.diff(differences, axis=0)
+        if (np.abs(second) > self._step_limits[1]).any():
             return False
-        if np.any(np.abs(np.diff(points, 3, axis=0)) > self._jmax * period**3):
+        if (np.abs(np.diff(second, axis=0)) > self._step_limits[2]).any():
             return False
         _, v, a = end
         return all(
