@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from cosim.trajectory.generator import (GeneratorSettings, TrajectoryGenerator, UntrackablePathError, _peak_speed,
-                                        _spline_states)
+                                        _spline_states, _spline_weights)
 from cosim.trajectory.limits import ArmLimits, JointLimits
 
 
@@ -27,7 +27,7 @@ def test_the_rows_match_the_one_u_formula_bit_for_bit():
     us = [0.0, 1.0] + [k * 0.002 / 0.01 for k in range(1, 6)] + list(rng.uniform(0.0, 1.0, 20))
     for _ in range(50):
         points = rng.normal(0.0, 0.3, (4, 6))
-        batch = _spline_states(points, us, 0.01)
+        batch = _spline_states(points, _spline_weights(us), 0.01)
         for row, u in enumerate(us):
             for got, expected in zip((a[row] for a in batch), _one_state(points, u, 0.01)):
                 assert got.tobytes() == expected.tobytes()

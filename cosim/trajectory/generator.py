@@ -153,33 +153,42 @@ def _quadratic_derivatives(times: list[float], points: list[np.ndarray]) -> tupl
     return qd, qdd
 
 
-def _spline_states(points: np.ndarray, us: list[float], period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(q, qd, qdd)``, each (len(us), n), at each ``u`` of ``us`` in [0, 1] of the uniform cubic B-spline segment
-    with control points ``points`` (4, n) spaced ``period`` s (de Boor, A Practical Guide to Splines, 1978):
-    ``q(u) = sum_i B_i(u) P_i`` with the basis ``B = ((1-u)^3, 3u^3 - 6u^2 + 4, -3u^3 + 3u^2 + 3u + 1, u^3) / 6``; the
-    velocity, the quadratic B-spline of the differences ``D_i = P_{i+1} - P_i``, ``((1-u)^2 D_0 + (1 + 2u - 2u^2) D_1
-    + u^2 D_2) / (2 period)``; the acceleration, the line between the second differences, ``((1-u) E_0 + u E_1) /
-    period^2``. Written out term by term (no BLAS, whose kernels round differently) and in differences, which keeps
-    the velocity and acceleration within the hull of theirs up to one rounding. The basis weights are computed per
-    ``u`` in floats and applied to all rows at once: each entry is the same sequence of roundings as for one ``u``."""
+def _spline_weights(us: list[float]) -> tuple[np.ndarray, ...]:
+    """The weights of :func:`_spline_states` at each ``u`` of ``us`` in [0, 1], as columns (len(us), 1), computed per
+    ``u`` in floats: the position's basis ``(1-u)^3, 3u^3 - 6u^2 + 4, -3u^3 + 3u^2 + 3u + 1, u^3``, the velocity's
+    ``(1-u)^2, 1 + 2u - 2u^2, u^2`` and the acceleration's ``1-u, u``."""
     def column(values) -> np.ndarray:
         return np.array(values)[:, None]
 
     ws = [1.0 - u for u in us]
+    return (column([w * w * w for w in ws]), column([3.0 * u**3 - 6.0 * u * u + 4.0 for u in us]),
+            column([1.0 + 3.0 * u + 3.0 * u * u - 3.0 * u**3 for u in us]), column([u**3 for u in us]),
+            column([w * w for w in ws]), column([1.0 + 2.0 * u - 2.0 * u * u for u in us]), column([u * u for u in us]),
+            column(ws), column(us))
+
+
+def _spline_states(points: np.ndarray, weights: tuple[np.ndarray, ...], period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, qd, qdd)``, each (rows, n), at the parameters ``u`` whose :func:`_spline_weights` are ``weights`` of the
+    uniform cubic B-spline segment with control points ``points`` (4, n) spaced ``period`` s (de Boor, A Practical
+    Guide to Splines, 1978): ``q(u) = sum_i B_i(u) P_i`` with the basis ``B = ((1-u)^3, 3u^3 - 6u^2 + 4, -3u^3 + 3u^2
+    + 3u + 1, u^3) / 6``; the velocity, the quadratic B-spline of the differences ``D_i = P_{i+1} - P_i``, ``((1-u)^2
+    D_0 + (1 + 2u - 2u^2) D_1 + u^2 D_2) / (2 period)``; the acceleration, the line between the second differences,
+    ``((1-u) E_0 + u E_1) / period^2``. Written out term by term (no BLAS, whose kernels round differently) and in
+    differences, which keeps the velocity and acceleration within the hull of theirs up to one rounding. The weights
+    apply to all rows at once: each entry is the same sequence of roundings as for one ``u``."""
+    b0, b1, b2, b3, v0, v1, v2, a0, a1 = weights
     p0, p1, p2, p3 = points
     d0, d1, d2 = p1 - p0, p2 - p1, p3 - p2
-    position = (column([w * w * w for w in ws]) * p0 + column([3.0 * u**3 - 6.0 * u * u + 4.0 for u in us]) * p1
-                + column([1.0 + 3.0 * u + 3.0 * u * u - 3.0 * u**3 for u in us]) * p2 + column([u**3 for u in us]) * p3) / 6.0
-    velocity = (column([w * w for w in ws]) * d0 + column([1.0 + 2.0 * u - 2.0 * u * u for u in us]) * d1
-                + column([u * u for u in us]) * d2) / (2.0 * period)
-    acceleration = (column(ws) * (d1 - d0) + column(us) * (d2 - d1)) / (period * period)
+    position = (b0 * p0 + b1 * p1 + b2 * p2 + b3 * p3) / 6.0
+    velocity = (v0 * d0 + v1 * d1 + v2 * d2) / (2.0 * period)
+    acceleration = (a0 * (d1 - d0) + a1 * (d2 - d1)) / (period * period)
     return position, velocity, acceleration
 
 
 def _spline_state(points: np.ndarray, u: float, period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(q, qd, qdd)`` (n,) at ``u`` in [0, 1] of the B-spline segment with control points ``points`` (4, n)
     (:func:`_spline_states`)."""
-    return tuple(a[0] for a in _spline_states(points, [u], period))  # type: ignore[return-value]
+    return tuple(a[0] for a in _spline_states(points, _spline_weights([u]), period))  # type: ignore[return-value]
 
 
 def _peak_speed(points: np.ndarray, period: float) -> np.ndarray:
@@ -246,12 +255,12 @@ class TrajectoryGenerator:
         # first differences within which the segment's speed is below max_velocity (the hull bound, less a margin far
         # beyond the round-off of the exact peak, :func:`_peak_speed`)
         self._trackable_step = self._vmax * period * (1.0 - 1e-9)
-        # the parameter u of a spline segment at its start, its end and after each step it may be played for
-        # (:meth:`_segment_u`: while below 1)
+        # the spline weights at a segment's start, its end and after each step it may be played for (its parameter u
+        # as :meth:`_segment_u` gives it, while below 1): the same for every segment
         played = [1]
         while played[-1] * settings.cycle_time / period < 1.0 - TIME_EPSILON:
             played.append(played[-1] + 1)
-        self._segment_us = [0.0, 1.0] + [k * settings.cycle_time / period for k in played]
+        self._segment_weights = _spline_weights([0.0, 1.0] + [k * settings.cycle_time / period for k in played])
         q0 = _vector(f"{limits.arm}: start position", q0, n)
         outside = np.flatnonzero((q0 < self._lo) | (q0 > self._hi))
         if outside.size:
@@ -348,7 +357,7 @@ class TrajectoryGenerator:
         # no joint can be above its limit and the exact peak need not be computed
         if self.settings.stop_beyond_velocity_limit and not (sizes <= self._trackable_step).all():
             self._check_trackable(_peak_speed(points, period), clamped)
-        states = _spline_states(points, self._segment_us, period)
+        states = _spline_states(points, self._segment_weights, period)
         start, end = (tuple(a[i] for a in states) for i in (0, 1))
         error = float(np.max(np.abs(self._state[0] - start[0])))
         offset = max(error, float(np.max(np.abs(self._state[1] - start[1]))) * period,
