@@ -351,7 +351,7 @@ class TrajectoryGenerator:
             self._points = _control_points(*self._state, period)
         self._points = self._points[-3:] + [q]
         points = np.array(self._points)
-        differences = np.diff(points, axis=0)
+        differences = points[1:] - points[:-1]  # np.diff's own subtraction, without its dispatch
         sizes = np.abs(differences)
         # the segment's speed stays within the hull of the differences / T (:meth:`_spline_within_limits`): within the bound
         # no joint can be above its limit and the exact peak need not be computed
@@ -359,9 +359,9 @@ class TrajectoryGenerator:
             self._check_trackable(_peak_speed(points, period), clamped)
         states = _spline_states(points, self._segment_weights, period)
         start, end = (tuple(a[i] for a in states) for i in (0, 1))
-        error = float(np.max(np.abs(self._state[0] - start[0])))
-        offset = max(error, float(np.max(np.abs(self._state[1] - start[1]))) * period,
-                     float(np.max(np.abs(self._state[2] - start[2]))) * period * period)
+        error = float(np.abs(self._state[0] - start[0]).max())
+        offset = max(error, float(np.abs(self._state[1] - start[1]).max()) * period,
+                     float(np.abs(self._state[2] - start[2]).max()) * period * period)
         if offset <= SPLINE_TOLERANCE and abs(interval - period) <= TIME_EPSILON and self._spline_within_limits(points, differences, sizes, end):
             self._max_target_error = max(self._max_target_error, error)
             self._segment = (points, self._steps)
@@ -387,10 +387,10 @@ class TrajectoryGenerator:
             return False
         if (sizes > self._step_limits[0]).any():
             return False
-        second = np.diff(differences, axis=0)
+        second = differences[1:] - differences[:-1]
         if (np.abs(second) > self._step_limits[1]).any():
             return False
-        if (np.abs(np.diff(second, axis=0)) > self._step_limits[2]).any():
+        if (np.abs(second[1:] - second[:-1]) > self._step_limits[2]).any():
             return False
         _, v, a = end
         return all(
