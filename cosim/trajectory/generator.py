@@ -227,7 +227,7 @@ def _vector(name: str, value: object, n: int) -> np.ndarray:
         raise InputError(f"{name}: must be {n} finite numbers, got {type(value).__name__}") from None
     if array.shape != (n,):
         raise InputError(f"{name}: must be {n} finite numbers, got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
+    if not np.isfinite(array).all():
         raise InputError(f"{name}: must be {n} finite numbers, got {array.tolist()}")
     return array
 
@@ -519,9 +519,9 @@ class TrajectoryGenerator:
         inp = self._input
         inp.control_interface = ruckig.ControlInterface.Position
         inp.minimum_duration = None
-        inp.current_position, inp.current_velocity, inp.current_acceleration = list(q), list(qd), list(qdd)
+        inp.current_position, inp.current_velocity, inp.current_acceleration = q.tolist(), qd.tolist(), qdd.tolist()
         self._unsent_state = None
-        inp.target_position, inp.target_velocity, inp.target_acceleration = list(q), [0.0] * n, [0.0] * n
+        inp.target_position, inp.target_velocity, inp.target_acceleration = q.tolist(), [0.0] * n, [0.0] * n
         self._state = (q.copy(), qd.copy(), qdd.copy())
         self._path = self._state
         self._path_floats = tuple(a.tolist() for a in self._path)
