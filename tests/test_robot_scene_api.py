@@ -104,24 +104,3 @@ def test_vessel_pose_and_com_are_those_of_the_full_state(scene):
         np.testing.assert_array_equal(com, state.com)
         pos[:] = com[:] = 0.0
         assert np.any(scene.vessel_pose(role)[0] != 0.0) and np.any(scene.vessel_com(role) != 0.0)
-
-
-def test_vessel_frame_is_the_vessel_pose_made_once_per_frame(scene):
-    """The pose the exchange and the payload compensation share: the same bits as a Pose made from vessel_pose, the
-    same object while the frame stands, a new one once the kinematics move it, and read-only (it is shared)."""
-    from cosim.frames import Pose
-
-    role = ArmRole.POUR
-    first = scene.vessel_frame(role)
-    made = Pose.from_quat_wxyz(*scene.vessel_pose(role))
-    assert first.position.tobytes() == made.position.tobytes() and first.rotation.tobytes() == made.rotation.tobytes()
-    assert scene.vessel_frame(role) is first
-    with pytest.raises(ValueError):
-        first.position[0] = 0.0
-    scene.data.qpos[scene.arms[role].qpos_adr[0]] += 0.1
-    assert scene.vessel_frame(role) is first  # the frames are the kinematics', not yet recomputed
-    mujoco.mj_kinematics(scene.model, scene.data)
-    moved = scene.vessel_frame(role)
-    assert moved is not first
-    assert moved.rotation.tobytes() == Pose.from_quat_wxyz(*scene.vessel_pose(role)).rotation.tobytes()
-    assert not np.array_equal(moved.position, first.position)

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cosim.coupling.settings import Compensation
+from cosim.frames import Pose
 from cosim.robots.scene import RobotScene, shift_wrench
 from cosim.robots.scene_config import ArmRole
 from cosim.vessel import VesselSpec
@@ -62,7 +63,7 @@ def compensation_torque(
         return -scene.wrench_joint_torque(role, force, torque)
     if payload is None or payload.mass == 0.0:
         return None
-    pose = scene.vessel_frame(role)
+    pose = Pose.from_quat_wxyz(*scene.vessel_pose(role))
     centre = pose.transform(payload.com_local[None, :])[0]
     weight = payload.mass * scene.model.opt.gravity
     return -scene.wrench_joint_torque(role, weight, shift_wrench(weight, np.zeros(3), centre, scene.vessel_com(role)))

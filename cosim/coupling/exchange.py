@@ -20,7 +20,7 @@ ROLES = (ArmRole.POUR, ArmRole.CATCH)  # fluid vessel index k <-> ROLES[k]
 
 def vessel_poses(scene: RobotScene) -> list[Pose]:
     """World poses of the pourer and the catcher frames, in the fluid's vessel order."""
-    return [scene.vessel_frame(role) for role in ROLES]
+    return [Pose.from_quat_wxyz(*scene.vessel_pose(role)) for role in ROLES]
 
 
 def wrench_at_body_com(scene: RobotScene, role: ArmRole, pose: Pose, wrench: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

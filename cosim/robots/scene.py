@@ -36,7 +36,7 @@ from cosim.robots.planar import PlanarPose, planar_to_world
 from cosim.robots.scene_builder import CUSTOM_PREFIX, HOME_KEY, build_scene_spec
 from cosim.robots.scene_config import ArmRole, SceneConfig
 from cosim.robots.vessel_mjcf import frame_site, lip_site
-from cosim.frames import Pose, cross3
+from cosim.frames import cross3
 from cosim.mesh_vessel import load_vessel_mesh
 from cosim.vessel import VesselShape, VesselSpec, mesh_vessel_spec
 
@@ -227,7 +227,6 @@ class RobotScene:
         self._inverse_data: mujoco.MjData | None = None
         self._jacobian_data: mujoco.MjData | None = None
         self._jacobians: tuple[np.ndarray, np.ndarray] | None = None  # (3, nv) positional and rotational, reused
-        self._frames: dict[ArmRole, tuple[bytes, Pose]] = {}  # vessel_frame's last pose per arm, by its xpos and xquat
 
     # ---- construction --------------------------------------------------------------------------------------------
     @classmethod
@@ -361,21 +360,6 @@ class RobotScene:
         after mj_forward or mj_kinematics, not mj_step alone, whose forward pass precedes its integration): :meth:`vessel_state` without the velocity, for the every-step exchange."""
         body, d = self.arms[role].vessel_body, self.data
         return d.xpos[body].copy(), d.xquat[body].copy()
-
-    def vessel_frame(self, role: ArmRole) -> Pose:
-        """The held vessel frame's world pose (:meth:`vessel_pose` as a :class:`cosim.frames.Pose`, read-only arrays).
-        The step loop asks for it twice per configuration (the exchange after the step, the payload compensation
-        before the next): the pose is made once per frame, recognised by its ``xpos`` and ``xquat`` as bytes."""
-        body, d = self.arms[role].vessel_body, self.data
-        key = d.xpos[body].tobytes() + d.xquat[body].tobytes()
-        cached = self._frames.get(role)
-        if cached is not None and cached[0] == key:
-            return cached[1]
-        pose = Pose.from_quat_wxyz(*self.vessel_pose(role))
-        pose.position.flags.writeable = False
-        pose.rotation.flags.writeable = False
-        self._frames[role] = (key, pose)
-        return pose
 
     def vessel_com(self, role: ArmRole) -> np.ndarray:
         """(3,) m, world position of the held vessel body's centre of mass (the point ``xfrc_applied`` acts at)."""
