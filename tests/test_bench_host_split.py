@@ -7,18 +7,24 @@ import mujoco
 
 from cosim.bench import host_split
 from cosim.coupling import loop
+from cosim.coupling.pose_filter import PoseFilter
 
 
 def test_the_parts_are_timed_within_the_steps_and_put_back():
     scene = host_split.default_scene(1)
     scene = dataclasses.replace(scene, fluid=dataclasses.replace(scene.fluid, particles_across=12))
-    original_step, original_poses = mujoco.mj_step, loop.vessel_poses
+    original_step, original_poses, original_filter = mujoco.mj_step, loop.vessel_poses, PoseFilter.__call__
     calls, steps, wall, substeps = host_split.split_pour(scene, 0.02)
     assert steps == 10
     assert mujoco.mj_step is original_step and loop.vessel_poses is original_poses
+    assert PoseFilter.__call__ is original_filter
     assert len(calls[host_split.ADVANCE]) == 10 and len(calls["trajectory generators' step"]) == 20  # two arms
     assert len(calls["mj_step (the live arms and the load monitor's twin)"]) == 20  # the live arms and the twin
     assert len(calls["controller, every control period (measurement, IK, filters, generator targets)"]) == 2  # every 10 ms
+    inside = {label.removeprefix(host_split.CONTROLLER): len(times) for label, times in calls.items() if label.startswith(host_split.CONTROLLER)}
+    assert inside == {"liquid probe's measurement (launches and read-backs)": 2, "control law": 2, "pose filters": 4,
+                      "pose smoothers": 4, "IK": 4, "the arms' generators' targets": 4,
+                      "landing probe (stream crossing the rim)": 2}  # per control period: once, or once per arm
     assert 0.0 < sum(calls[host_split.SUBSTEPS]) <= substeps < sum(calls[host_split.ADVANCE]) < wall
 
 

@@ -90,3 +90,24 @@ def test_pose_filter_hands_its_state_to_and_from_tracking_without_a_jump() -> No
     k = np.arange(300)
     x = _tilts(_pose_filter(), 0.3 + RAMP_RATE * k * PERIOD, (k >= 100) & (k < 200))
     _assert_within_limits(x)
+
+
+def test_the_linear_step_made_once_per_state_is_the_one_made_anew():
+    """The law's step, kept for a repeated state and target, is what a filter that never saw them computes, to the
+    bit; a state changed in place (the same arrays) is a new state."""
+    def fresh() -> TrackingFilter:
+        return TrackingFilter(np.array([VELOCITY]), np.array([ACCELERATION]), np.array([JERK]), TRACKING_BANDWIDTH, PERIOD)
+
+    used = fresh()
+    target, state = np.array([1e-5]), (np.array([0.0]), np.array([0.0]), np.array([0.0]))
+    first = used.limited_step(target, *state)
+    assert first is not None
+    again = used.follow(target, state)  # the same state and target: the kept step
+    expected = fresh().follow(target, state)
+    assert all(a.tobytes() == b.tobytes() for a, b in zip(again, expected))
+    state[1][0] = 1e-4  # in place
+    moved = used.limited_step(target, *state)
+    expected = fresh().limited_step(target, *state)
+    assert moved is not None and expected is not None
+    assert all(a.tobytes() == b.tobytes() for a, b in zip(moved, expected))
+    assert moved[0].tobytes() != first[0].tobytes()

@@ -3,9 +3,11 @@
 ``python -m cosim.bench.host_overhead`` splits a pour's wall time into the liquid's substeps and the rest (the host's
 share). This tool splits the rest: it builds the default pour, steps it through a warm-up, then wraps named parts of
 the step (the controller, the arms' trajectory generators, the exchange, ``mj_step``, the liquid's host work around
-its substeps, the arms' load monitor) with wall-clock timers around each call, steps ``--duration`` simulated seconds
-and prints each part's ms per MuJoCo step. The timers change no result; each costs about a microsecond a call, so
-the parts sum to slightly more than they cost unwrapped. Parts nest where the table says so.
+its substeps, the arms' load monitor) and the controller's own parts (the liquid probe, the control law, the pose
+filters and smoothers, the IK, the generators' targets, the landing probe) with wall-clock timers around each call,
+steps ``--duration`` simulated seconds and prints each part's ms per MuJoCo step. The timers change no result; each
+costs about a microsecond a call, so the parts sum to slightly more than they cost unwrapped. Parts nest where the
+table says so (the rows named "controller: ..." are inside the controller's row, and so are the generators' targets).
 
     python -m cosim.bench.host_split [--duration 1] [--threads 1]
 """
@@ -29,6 +31,7 @@ from cosim.bench.host_overhead import POUR_WARM_UP, time_steps
 from cosim.bench.options import DURATION
 from cosim.coupling import loop
 from cosim.coupling.loop import CoupledPour
+from cosim.coupling.pose_filter import PoseFilter, PoseSmoother
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig
 from cosim.pour_run import prepare
@@ -37,6 +40,7 @@ from cosim.pour_scene import FluidSettings, LoggingSettings, PourScene
 
 SUBSTEPS = "the liquid's substeps (replay)"
 ADVANCE = "liquid: advance (its substeps included)"
+CONTROLLER = "controller: "  # the rows inside the controller's period
 
 
 @contextlib.contextmanager
@@ -76,6 +80,13 @@ def parts(pour: CoupledPour) -> list[tuple[object, str, str]]:
         (fluid.lanes, "replay", SUBSTEPS),
         (fluid.scratch.diagnostics, "read", "liquid: diagnostics read back (in advance)"),
         (fluid.energy_account, "update", "liquid: energy account (in advance)"),
+        (pour.probe, "measure", CONTROLLER + "liquid probe's measurement (launches and read-backs)"),
+        (pour.controller, "step", CONTROLLER + "control law"),
+        (PoseFilter, "__call__", CONTROLLER + "pose filters"),
+        (PoseSmoother, "__call__", CONTROLLER + "pose smoothers"),
+        *((ik, "solve_or_raise", CONTROLLER + "IK") for ik in pour._ik.values()),
+        *((generator, "set_target", CONTROLLER + "the arms' generators' targets") for generator in pour.generators.values()),
+        (pour.probe, "stream_crossing_x", CONTROLLER + "landing probe (stream crossing the rim)"),
     ]
 
 
@@ -119,9 +130,8 @@ def main(argv: list[str] | None = None) -> int:
           "whatever part runs then).\n")
     print("| part | calls per step | ms per step, mean | ms per step, median | share of the host's time (mean) |")
     print("|---|---|---|---|---|")
-    nested = (SUBSTEPS, ADVANCE)
     for label, times in sorted(calls.items(), key=lambda item: -sum(item[1])):
-        share = "" if label in nested else f"{100 * sum(times) / host:.0f} %"
+        share = "" if label in (SUBSTEPS, ADVANCE) or label.startswith(CONTROLLER) else f"{100 * sum(times) / host:.0f} %"
         per_step = len(times) / steps
         print(f"| {label} | {per_step:.2f} | {1e3 * sum(times) / steps:.3f} | {1e3 * statistics.median(times) * per_step:.3f} | {share} |")
     advance = sum(calls[ADVANCE]) - sum(calls[SUBSTEPS])

@@ -80,6 +80,9 @@ class ArmLoadMonitor:
         arms = [scene.arms[role] for role in ROLES]
         self._bodies = np.array([arm.vessel_body for arm in arms])
         self._dofs = np.concatenate([arm.dof_adr for arm in arms])
+        # both arms' servo law at once (RobotScene.servo_controls, u = q + kv qd / kp, entry by entry)
+        self._ctrl_adr = np.concatenate([arm.ctrl_adr for arm in arms])
+        self._kv, self._kp = np.concatenate([arm.kv for arm in arms]), np.concatenate([arm.kp for arm in arms])
         self._joint_ranges = np.cumsum([0] + [len(arm.joints) for arm in arms])
         self._live_pos, self._twin_pos = np.empty((BATCH_STEPS, len(ROLES), 3)), np.empty((BATCH_STEPS, len(ROLES), 3))
         self._live_quat, self._twin_quat = np.empty((BATCH_STEPS, len(ROLES), 4)), np.empty((BATCH_STEPS, len(ROLES), 4))
@@ -90,12 +93,12 @@ class ArmLoadMonitor:
         self._peak_torque = np.zeros(len(self._dofs))  # N m
         self._quaternions = np.empty((2, 4))  # rotation_angle's scratch
 
-    def step(self, targets: Mapping[ArmRole, tuple[np.ndarray, np.ndarray | None]]) -> None:
+    def step(self, targets: Mapping[ArmRole, tuple[np.ndarray, np.ndarray]]) -> None:
         """Step the twin with ``targets`` (per arm: desired q (n,) rad, qd (n,) rad/s) and record the step."""
         scene, twin, live = self.scene, self.twin, self.scene.data
-        for role in ROLES:
-            q, qd = targets[role]
-            twin.ctrl[scene.arms[role].ctrl_adr] = scene.servo_controls(role, q, qd)
+        q = np.concatenate([targets[role][0] for role in ROLES])
+        qd = np.concatenate([targets[role][1] for role in ROLES])
+        twin.ctrl[self._ctrl_adr] = q + self._kv * qd / self._kp
         mujoco.mj_step(scene.model, twin)
         mujoco.mj_kinematics(scene.model, twin)  # the frames at the new qpos, as the coupled step brings the live ones
         k, bodies = self._recorded, self._bodies

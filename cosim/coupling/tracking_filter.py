@@ -64,6 +64,7 @@ class TrackingFilter:
         self.lag = k1 / k0  # s: how far the state follows a ramp behind, once the start has died away
         n = len(self.velocity_limit)
         self.reference = (np.zeros(n), np.zeros(n), np.zeros(n))  # the law's own path, unlimited
+        self._last_step: tuple[bytes, tuple[np.ndarray, np.ndarray, np.ndarray]] | None = None  # _linear_step's last
 
     def follow(self, target: np.ndarray, state: tuple[np.ndarray, np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Advance the law's own unlimited path one period toward ``target`` (from ``state`` where given: the
@@ -85,7 +86,7 @@ class TrackingFilter:
         jerk would break a limit (the module docstring)."""
         state = self._linear_step(target, position, velocity, acceleration)
         low, high = self._admissible_range(velocity, acceleration)
-        if np.any(state[2] < low) or np.any(state[2] > high):
+        if (state[2] < low).any() or (state[2] > high).any():
             return None
         return state
 
@@ -104,10 +105,17 @@ class TrackingFilter:
         return np.minimum(np.maximum(low, acceleration - step), acceleration + step), np.minimum(high, acceleration + step)
 
     def _linear_step(self, target, x, v, a) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The state one period on by the linear law's jerk, unlimited."""
-        x, v, a = (np.asarray(q, dtype=float) for q in (x, v, a))
-        j = self._gains[0] * (np.asarray(target, dtype=float) - x) - self._gains[1] * v - self._gains[2] * a
-        return self._advance(x, v, a, a + self.period * j)
+        """The state one period on by the linear law's jerk, unlimited. A period's calls ask for it up to four times
+        from one state (the limited step, the saturation, the clipped step, the law's own path): it is computed once
+        per state and target, recognised by their bytes."""
+        target, x, v, a = (np.asarray(q, dtype=float) for q in (target, x, v, a))
+        key = target.tobytes() + x.tobytes() + v.tobytes() + a.tobytes()
+        if self._last_step is not None and self._last_step[0] == key:
+            return self._last_step[1]
+        j = self._gains[0] * (target - x) - self._gains[1] * v - self._gains[2] * a
+        step = self._advance(x, v, a, a + self.period * j)
+        self._last_step = (key, step)
+        return step
 
     def _advance(self, x, v, a, a_next) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The state one period on with the jerk (a_next - a) / h held over the period."""

@@ -114,6 +114,11 @@ class ArmIK:
         self._data = mujoco.MjData(model)  # private: never the live simulation's data
         self._jacp = np.zeros((3, model.nv))
         self._jacr = np.zeros((3, model.nv))
+        n = len(ids)
+        self._jac = np.empty((6, n))  # the weighted task Jacobian [J_pos ; L J_rot], filled each iteration
+        self._err = np.empty(6)  # the weighted error [e_pos ; L e_rot]
+        self._damping2 = settings.damping**2 * np.eye(6)
+        self._redundant = n > 6 and settings.posture_gain > 0.0
 
     def solve(self, target_pos: np.ndarray, target_quat: np.ndarray, seed_q: np.ndarray) -> IKResult:
         """Solve for the site pose ``target_pos`` (3,) m, ``target_quat`` (4,) [w, x, y, z] from ``seed_q`` (n,) rad.
@@ -128,8 +133,7 @@ class ArmIK:
         target_mat = target_mat.reshape(3, 3)
         q = np.clip(np.asarray(seed_q, dtype=float).copy(), self.lower, self.upper)
         n = q.size
-        damping2 = s.damping**2 * np.eye(6)
-        redundant = n > 6 and s.posture_gain > 0.0
+        damping2, redundant, jac, err = self._damping2, self._redundant, self._jac, self._err
         best_norm, best_iter = math.inf, 0
         err_p = err_r = math.inf
         task_ok = False
@@ -151,8 +155,10 @@ class ArmIK:
                     break
             mujoco.mj_comPos(model, data)
             mujoco.mj_jacSite(model, data, self._jacp, self._jacr, self.site_id)
-            jac = np.vstack((self._jacp[:, self.dof_adr], s.rotation_length * self._jacr[:, self.dof_adr]))
-            err = np.concatenate((e_pos, s.rotation_length * e_rot))
+            np.take(self._jacp, self.dof_adr, axis=1, out=jac[:3])
+            np.multiply(s.rotation_length, np.take(self._jacr, self.dof_adr, axis=1), out=jac[3:])
+            err[:3] = e_pos
+            np.multiply(s.rotation_length, e_rot, out=err[3:])
             dq = np.linalg.solve(jac @ jac.T + damping2, jac).T @ err  # J^T (J J^T + l^2 I)^-1 e
             if redundant:  # pull toward home in the exact task nullspace until that pull is negligible
                 nullspace = np.eye(n) - jac.T @ np.linalg.solve(jac @ jac.T + _NULLSPACE_REG * np.eye(6), jac)

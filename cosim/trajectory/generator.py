@@ -153,21 +153,42 @@ def _quadratic_derivatives(times: list[float], points: list[np.ndarray]) -> tupl
     return qd, qdd
 
 
-def _spline_state(points: np.ndarray, u: float, period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(q, qd, qdd)`` at ``u`` in [0, 1] of the uniform cubic B-spline segment with control points ``points``
-    (4, n) spaced ``period`` s (de Boor, A Practical Guide to Splines, 1978): ``q(u) = sum_i B_i(u) P_i`` with the
-    basis ``B = ((1-u)^3, 3u^3 - 6u^2 + 4, -3u^3 + 3u^2 + 3u + 1, u^3) / 6``; the velocity, the quadratic B-spline of
-    the differences ``D_i = P_{i+1} - P_i``, ``((1-u)^2 D_0 + (1 + 2u - 2u^2) D_1 + u^2 D_2) / (2 period)``; the
-    acceleration, the line between the second differences, ``((1-u) E_0 + u E_1) / period^2``. Written out term by
-    term (no BLAS, whose kernels round differently) and in differences, which keeps the velocity and acceleration
-    within the hull of theirs up to one rounding."""
-    w = 1.0 - u
+def _spline_weights(us: list[float]) -> tuple[np.ndarray, ...]:
+    """The weights of :func:`_spline_states` at each ``u`` of ``us`` in [0, 1], as columns (len(us), 1), computed per
+    ``u`` in floats: the position's basis ``(1-u)^3, 3u^3 - 6u^2 + 4, -3u^3 + 3u^2 + 3u + 1, u^3``, the velocity's
+    ``(1-u)^2, 1 + 2u - 2u^2, u^2`` and the acceleration's ``1-u, u``."""
+    def column(values) -> np.ndarray:
+        return np.array(values)[:, None]
+
+    ws = [1.0 - u for u in us]
+    return (column([w * w * w for w in ws]), column([3.0 * u**3 - 6.0 * u * u + 4.0 for u in us]),
+            column([1.0 + 3.0 * u + 3.0 * u * u - 3.0 * u**3 for u in us]), column([u**3 for u in us]),
+            column([w * w for w in ws]), column([1.0 + 2.0 * u - 2.0 * u * u for u in us]), column([u * u for u in us]),
+            column(ws), column(us))
+
+
+def _spline_states(points: np.ndarray, weights: tuple[np.ndarray, ...], period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, qd, qdd)``, each (rows, n), at the parameters ``u`` whose :func:`_spline_weights` are ``weights`` of the
+    uniform cubic B-spline segment with control points ``points`` (4, n) spaced ``period`` s (de Boor, A Practical
+    Guide to Splines, 1978): ``q(u) = sum_i B_i(u) P_i`` with the basis ``B = ((1-u)^3, 3u^3 - 6u^2 + 4, -3u^3 + 3u^2
+    + 3u + 1, u^3) / 6``; the velocity, the quadratic B-spline of the differences ``D_i = P_{i+1} - P_i``, ``((1-u)^2
+    D_0 + (1 + 2u - 2u^2) D_1 + u^2 D_2) / (2 period)``; the acceleration, the line between the second differences,
+    ``((1-u) E_0 + u E_1) / period^2``. Written out term by term (no BLAS, whose kernels round differently) and in
+    differences, which keeps the velocity and acceleration within the hull of theirs up to one rounding. The weights
+    apply to all rows at once: each entry is the same sequence of roundings as for one ``u``."""
+    b0, b1, b2, b3, v0, v1, v2, a0, a1 = weights
     p0, p1, p2, p3 = points
     d0, d1, d2 = p1 - p0, p2 - p1, p3 - p2
-    position = (w * w * w * p0 + (3.0 * u**3 - 6.0 * u * u + 4.0) * p1 + (1.0 + 3.0 * u + 3.0 * u * u - 3.0 * u**3) * p2 + u**3 * p3) / 6.0
-    velocity = (w * w * d0 + (1.0 + 2.0 * u - 2.0 * u * u) * d1 + u * u * d2) / (2.0 * period)
-    acceleration = (w * (d1 - d0) + u * (d2 - d1)) / (period * period)
+    position = (b0 * p0 + b1 * p1 + b2 * p2 + b3 * p3) / 6.0
+    velocity = (v0 * d0 + v1 * d1 + v2 * d2) / (2.0 * period)
+    acceleration = (a0 * (d1 - d0) + a1 * (d2 - d1)) / (period * period)
     return position, velocity, acceleration
+
+
+def _spline_state(points: np.ndarray, u: float, period: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, qd, qdd)`` (n,) at ``u`` in [0, 1] of the B-spline segment with control points ``points`` (4, n)
+    (:func:`_spline_states`)."""
+    return tuple(a[0] for a in _spline_states(points, _spline_weights([u]), period))  # type: ignore[return-value]
 
 
 def _peak_speed(points: np.ndarray, period: float) -> np.ndarray:
@@ -206,7 +227,7 @@ def _vector(name: str, value: object, n: int) -> np.ndarray:
         raise InputError(f"{name}: must be {n} finite numbers, got {type(value).__name__}") from None
     if array.shape != (n,):
         raise InputError(f"{name}: must be {n} finite numbers, got shape {array.shape}")
-    if not np.all(np.isfinite(array)):
+    if not np.isfinite(array).all():
         raise InputError(f"{name}: must be {n} finite numbers, got {array.tolist()}")
     return array
 
@@ -227,6 +248,19 @@ class TrajectoryGenerator:
         self._lo_floats, self._hi_floats, self._vmax_floats = self._lo.tolist(), self._hi.tolist(), self._vmax.tolist()
         self._jmax = limits.array("max_jerk")
         self._jmax_floats = self._jmax.tolist()
+        period = settings.control_period
+        # a spline segment's first, second and third differences of control points within the limits
+        # (:meth:`_spline_within_limits`)
+        self._step_limits = (self._vmax * period, self._amax * period**2, self._jmax * period**3)
+        # first differences within which the segment's speed is below max_velocity (the hull bound, less a margin far
+        # beyond the round-off of the exact peak, :func:`_peak_speed`)
+        self._trackable_step = self._vmax * period * (1.0 - 1e-9)
+        # the spline weights at a segment's start, its end and after each step it may be played for (its parameter u
+        # as :meth:`_segment_u` gives it, while below 1): the same for every segment
+        played = [1]
+        while played[-1] * settings.cycle_time / period < 1.0 - TIME_EPSILON:
+            played.append(played[-1] + 1)
+        self._segment_weights = _spline_weights([0.0, 1.0] + [k * settings.cycle_time / period for k in played])
         q0 = _vector(f"{limits.arm}: start position", q0, n)
         outside = np.flatnonzero((q0 < self._lo) | (q0 > self._hi))
         if outside.size:
@@ -264,6 +298,9 @@ class TrajectoryGenerator:
         self._path_lead = 0.0  # s, how far ahead of now _path lies (a spline segment's end: one period)
         self._points: list[np.ndarray] = []  # the spline path's last control points (at most four)
         self._segment: tuple[np.ndarray, int] | None = None  # (control points (4, n), start step) of a spline segment
+        # the segment's (q, qd, qdd), each (rows, n): at its start, its end, then after each of its steps
+        self._segment_states: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._unsent_state: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # the arm's state not yet in ruckig's input
         self._on_segment = False  # the last step followed the spline segment
         self._history_steps: list[int] = []  # step index of each recent target (at most three)
         self._history_q: list[np.ndarray] = []
@@ -297,14 +334,15 @@ class TrajectoryGenerator:
         q = np.clip(q, self._lo, self._hi)
         self._history_steps = (self._history_steps + [self._steps])[-3:]
         self._history_q = (self._history_q + [q])[-3:]
-        times = [s * self.settings.cycle_time for s in self._history_steps]
-        est_qd, est_qdd = _quadratic_derivatives(times, self._history_q)
-        qd = est_qd if qd is None else _vector(f"{self.limits.arm}: target velocity", qd, n)
-        qdd = est_qdd if qdd is None else _vector(f"{self.limits.arm}: target acceleration", qdd, n)
         if explicit:
+            times = [s * self.settings.cycle_time for s in self._history_steps]
+            est_qd, est_qdd = _quadratic_derivatives(times, self._history_q)
+            qd = est_qd if qd is None else _vector(f"{self.limits.arm}: target velocity", qd, n)
+            qdd = est_qdd if qdd is None else _vector(f"{self.limits.arm}: target acceleration", qdd, n)
             if self.settings.stop_beyond_velocity_limit:
                 self._check_trackable(qd, clamped)
             self._points, self._segment = [], None
+            self._sync_input()
             error = float(np.max(np.abs(np.array(self._input.current_position) - q)))
             self._follow_with_ruckig(q, qd, qdd, clamped, interval, 0.0, error)
             return
@@ -313,38 +351,46 @@ class TrajectoryGenerator:
             self._points = _control_points(*self._state, period)
         self._points = self._points[-3:] + [q]
         points = np.array(self._points)
-        if self.settings.stop_beyond_velocity_limit:
+        differences = points[1:] - points[:-1]  # np.diff's own subtraction, without its dispatch
+        sizes = np.abs(differences)
+        # the segment's speed stays within the hull of the differences / T (:meth:`_spline_within_limits`): within the bound
+        # no joint can be above its limit and the exact peak need not be computed
+        if self.settings.stop_beyond_velocity_limit and not (sizes <= self._trackable_step).all():
             self._check_trackable(_peak_speed(points, period), clamped)
-        start = _spline_state(points, 0.0, period)
-        end = _spline_state(points, 1.0, period)
-        error = float(np.max(np.abs(self._state[0] - start[0])))
-        offset = max(error, float(np.max(np.abs(self._state[1] - start[1]))) * period,
-                     float(np.max(np.abs(self._state[2] - start[2]))) * period * period)
-        if offset <= SPLINE_TOLERANCE and abs(interval - period) <= TIME_EPSILON and self._spline_within_limits(points, end):
+        states = _spline_states(points, self._segment_weights, period)
+        start, end = (tuple(a[i] for a in states) for i in (0, 1))
+        error = float(np.abs(self._state[0] - start[0]).max())
+        offset = max(error, float(np.abs(self._state[1] - start[1]).max()) * period,
+                     float(np.abs(self._state[2] - start[2]).max()) * period * period)
+        if offset <= SPLINE_TOLERANCE and abs(interval - period) <= TIME_EPSILON and self._spline_within_limits(points, differences, sizes, end):
             self._max_target_error = max(self._max_target_error, error)
             self._segment = (points, self._steps)
+            self._segment_states = states
             inp = self._input
-            inp.target_position, inp.target_velocity, inp.target_acceleration = (list(a) for a in end)
+            inp.target_position, inp.target_velocity, inp.target_acceleration = (a.tolist() for a in end)
             self._new_target = True
             return
         self._segment = None
         self._follow_with_ruckig(end[0], end[1], end[2], clamped, interval, period, error)
 
-    def _spline_within_limits(self, points: np.ndarray, end: tuple[np.ndarray, np.ndarray, np.ndarray]) -> bool:
+    def _spline_within_limits(
+        self, points: np.ndarray, differences: np.ndarray, sizes: np.ndarray, end: tuple[np.ndarray, np.ndarray, np.ndarray]
+    ) -> bool:
         """Whether the B-spline segment with control points ``points`` (4, n) keeps every limit, exactly: its
         velocity is a quadratic B-spline with control points ``dP / T``, its acceleration the line between the
         ``d^2 P / T^2``, its jerk ``d^3 P / T^3`` (``T`` the control period), so each lies within the hull of those
         differences; its positions lie within the hull of the control points, which must lie in the joint range (the
         targets are clamped onto it, the points made from the arm's state may not be). And its end state is
-        admissible (:func:`_admissible_acceleration`), so that ruckig can take over from it within the limits."""
-        period = self.settings.control_period
-        if np.any((points < self._lo) | (points > self._hi)):  # a state's virtual control points may lie beyond
+        admissible (:func:`_admissible_acceleration`), so that ruckig can take over from it within the limits.
+        ``differences`` (3, n): the points' first differences, ``sizes`` their magnitudes."""
+        if ((points < self._lo) | (points > self._hi)).any():  # a state's virtual control points may lie beyond
             return False
-        if np.any(np.abs(np.diff(points, 1, axis=0)) > self._vmax * period):
+        if (sizes > self._step_limits[0]).any():
             return False
-        if np.any(np.abs(np.diff(points, 2, axis=0)) > self._amax * period**2):
+        second = differences[1:] - differences[:-1]
+        if (np.abs(second) > self._step_limits[1]).any():
             return False
-        if np.any(np.abs(np.diff(points, 3, axis=0)) > self._jmax * period**3):
+        if (np.abs(second[1:] - second[:-1]) > self._step_limits[2]).any():
             return False
         _, v, a = end
         return all(
@@ -358,6 +404,7 @@ class TrajectoryGenerator:
         """Plan ruckig toward the path state ``(q, qd, qdd)`` (n,) at ``lead`` s from now (0: a target now; one
         period: a spline segment's end), clamped joints at rest, made admissible, met at the shortest horizon
         (:meth:`_intercept_horizon`); ``error`` (rad) is the arm's distance to the path now."""
+        self._sync_input()
         self._max_target_error = max(self._max_target_error, error)
         qd = np.where(clamped, 0.0, np.clip(qd, -self._vmax, self._vmax))
         qdd = np.where(clamped, 0.0, np.clip(qdd, -self._amax, self._amax))
@@ -472,8 +519,9 @@ class TrajectoryGenerator:
         inp = self._input
         inp.control_interface = ruckig.ControlInterface.Position
         inp.minimum_duration = None
-        inp.current_position, inp.current_velocity, inp.current_acceleration = list(q), list(qd), list(qdd)
-        inp.target_position, inp.target_velocity, inp.target_acceleration = list(q), [0.0] * n, [0.0] * n
+        inp.current_position, inp.current_velocity, inp.current_acceleration = q.tolist(), qd.tolist(), qdd.tolist()
+        self._unsent_state = None
+        inp.target_position, inp.target_velocity, inp.target_acceleration = q.tolist(), [0.0] * n, [0.0] * n
         self._state = (q.copy(), qd.copy(), qdd.copy())
         self._path = self._state
         self._path_floats = tuple(a.tolist() for a in self._path)
@@ -504,11 +552,13 @@ class TrajectoryGenerator:
         if self._finished and not self._new_target and self._target_moving():
             self.hold()  # the last target was reached and no new one came: do not extrapolate its motion
         if self._segment is not None:
-            state = _spline_state(self._segment[0], self._segment_u(self._steps + 1), self.settings.control_period)
-            inp.current_position, inp.current_velocity, inp.current_acceleration = (a.tolist() for a in state)
+            row = 1 + self._steps + 1 - self._segment[1]  # after the start's and the end's rows
+            state = tuple(a[row] for a in self._segment_states)
+            self._unsent_state = state
             self._on_segment = True
             self._finished = self._segment_u(self._steps + 1) >= 1.0 - TIME_EPSILON
         else:
+            self._sync_input()
             try:
                 result = self._otg.update(inp, self._output)
             except ruckig.RuckigError as exc:
@@ -524,6 +574,14 @@ class TrajectoryGenerator:
         self._new_target = False
         self._state = state
         return self.state
+
+    def _sync_input(self) -> None:
+        """Give ruckig's input the arm's state played on a spline segment (held back while the segment plays: only
+        ruckig reads it)."""
+        if self._unsent_state is not None:
+            inp = self._input
+            inp.current_position, inp.current_velocity, inp.current_acceleration = (a.tolist() for a in self._unsent_state)
+            self._unsent_state = None
 
     def _segment_u(self, step: int) -> float:
         """The spline segment's parameter in [0, 1] at generator step ``step``."""
