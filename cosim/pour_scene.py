@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, GridReset, KernelType, PressureSolver, WallModel
+from cosim.fluid.config import DISCRETISATION, DensityIteration, FluidConfig, FreeLiquidRule, GridReset, KernelType, PressureSolver, WallModel
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -77,6 +77,8 @@ class FluidSettings:
     sound_speed_factor: float = like(FluidConfig, "sound_speed_factor")
     artificial_viscosity: float = like(FluidConfig, "artificial_viscosity")
     free_liquid: bool = like(FluidConfig, "free_liquid")
+    free_liquid_rule: FreeLiquidRule = like(FluidConfig, "free_liquid_rule")
+    free_surface_threshold: float = like(FluidConfig, "free_surface_threshold")
     free_artificial_viscosity: float = like(FluidConfig, "free_artificial_viscosity")
     # ---- WCSPH
     gamma: float = like(FluidConfig, "gamma")

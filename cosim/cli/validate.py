@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
-from cosim.fluid.config import DensityIteration, FluidConfig, PressureSolver, WallModel
+from cosim.fluid.config import DensityIteration, FluidConfig, FreeLiquidRule, PressureSolver, WallModel
 from cosim.validation import CASES, DEFAULT_CASES
 from declared_settings.setting import declared
 
@@ -61,6 +61,11 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--wall-model", choices=[m.value for m in WallModel],
                    help="the walls' dummy particles: kernel_layers or real_thickness (docs/walls.md) (default: the default "
                    "scene's fluid.wall_model)")
+    p.add_argument("--free-liquid-rule", choices=[r.value for r in FreeLiquidRule],
+                   help="where liquid may become free: outside_vessels or free_surface (docs/free_surface.md) (default: the "
+                   "default scene's fluid.free_liquid_rule)")
+    p.add_argument("--free-surface-threshold", type=float, help="free_surface rule: the free-surface indicator below which "
+                   "liquid is at the surface (default: the default scene's fluid.free_surface_threshold)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
@@ -74,7 +79,10 @@ def _case_params(name: str, args) -> list:
     scene = FluidSettings()
     solver = args.solver or scene.pressure_solver.value
     numerics = (("density_iteration", args.density_iteration or scene.density_iteration.value),
-                ("wall_model", args.wall_model or scene.wall_model.value))
+                ("wall_model", args.wall_model or scene.wall_model.value),
+                ("free_liquid_rule", args.free_liquid_rule or scene.free_liquid_rule.value))
+    if args.free_surface_threshold is not None:
+        numerics += (("free_surface_threshold", args.free_surface_threshold),)
     if args.density_tolerance is not None:
         numerics += (("density_tolerance", args.density_tolerance),)
     common = {"dim": declared(FluidConfig, "dim").check("--dim", args.dim), "device": args.device, "spacing": args.spacing, "solver": solver, "numerics": numerics}
