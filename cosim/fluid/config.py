@@ -148,10 +148,13 @@ class FluidConfig:
                                                "liquid must also have separated (summation density below rho0) and "
                                                "is bound again once packed (summation density >= rho0) where the "
                                                "rule no longer holds.")
-    free_surface_threshold: float = setting(0.75, PRESSURE, "free_liquid_rule 'free_surface': liquid whose indicator "
+    free_surface_threshold: float = setting(0.4, PRESSURE, "free_liquid_rule 'free_surface': liquid whose indicator "
                                             "lambda is below this is at the free surface (about 1 inside the liquid, "
                                             "0.5 at a flat surface's top row, 0 for a lone particle; Marrone et al. "
-                                            "2010: <= 0.2 certainly at the surface, <= 0.75 near it).", "", 0.0, 1.0)
+                                            "2010: <= 0.2 certainly at the surface, <= 0.75 near it). 0.4, chosen on "
+                                            "the validation cases: below a resting surface's 0.5, which DFSPH's "
+                                            "hydrostatic column needs bound; WCSPH's free fall needs 0.75 "
+                                            "(docs/free_surface.md).", "", 0.0, 1.0)
     free_artificial_viscosity: float = setting(0.25, PRESSURE, "Monaghan's alpha of every pair with a free particle "
                                                "(and of a free particle against walls): free liquid has no tension, so "
                                                "this makes its impacts inelastic; alpha acts only on approaching "

@@ -9,7 +9,8 @@ vessel; it lands where it first crosses the plane ``drop`` below the lip (linear
 Its landing error is the landed x minus the x its own launch state predicts for free fall (z = z0 + v_z t -
 g t^2 / 2, x = x0 + v_x t; the ballistic jet of Camporredondo et al. 2019, Eqs. 6-7).
 
-Each landed particle's share of its flight samples in which it was free liquid is reported too (``free_in_flight``):
+Each landed particle's share of its flight samples in which it was free liquid is reported too (``free_in_flight``,
+and ``free_after_launch``, s from its launch to the first such sample, NaN for never):
 under ``fluid.free_liquid_rule`` 'outside_vessels' the stream is free, and so without tension, by construction;
 under 'free_surface' only where the free-surface indicator finds it at the surface (docs/free_surface.md).
 
@@ -67,8 +68,9 @@ class Params(FluidCaseParams):
 
 
 class ParticleFollower:
-    """Observer of :func:`run_scripted`: each particle's launch state and landing x (world frame, m, m/s), and how
-    many of its samples in flight (launched, not yet landed) found it free liquid (``FluidSolver.free_mask``)."""
+    """Observer of :func:`run_scripted`: each particle's launch state and landing x (world frame, m, m/s), how many
+    of its samples in flight (launched, not yet landed) found it free liquid (``FluidSolver.free_mask``) and the
+    time of the first that did (s)."""
 
     def __init__(self, spec: VesselSpec, launch_offset: float, drop: float) -> None:
         self.spec = spec
@@ -83,6 +85,7 @@ class ParticleFollower:
         self.landed_x = np.full(n, np.nan)
         self.flight_samples = np.zeros(n, dtype=int)
         self.free_samples = np.zeros(n, dtype=int)
+        self.first_free = np.full(n, np.nan)
         self.previous = solver.positions()
         self.t_previous = solver.time
 
@@ -99,7 +102,9 @@ class ParticleFollower:
         self.landed_x[crossing] = self.previous[crossing, 0] + s * (x[crossing, 0] - self.previous[crossing, 0])
         flying = np.isfinite(self.launch[:, 0]) & (np.isnan(self.landed_x) | crossing)
         self.flight_samples[flying] += 1
-        self.free_samples[flying & solver.free_mask()] += 1
+        free = flying & solver.free_mask()
+        self.free_samples[free] += 1
+        self.first_free[free & np.isnan(self.first_free)] = solver.time
         self.previous = x
 
     def errors(self) -> tuple[np.ndarray, np.ndarray]:
@@ -109,10 +114,11 @@ class ParticleFollower:
         fall = (vz + np.sqrt(vz * vz + 2.0 * GRAVITY * self.drop)) / GRAVITY
         return t, self.landed_x[done] - (x0 + vx * fall)
 
-    def free_in_flight(self) -> np.ndarray:
-        """The fraction of its flight samples in which each landed particle was free liquid."""
+    def free_in_flight(self) -> tuple[np.ndarray, np.ndarray]:
+        """Of each landed particle: the fraction of its flight samples in which it was free liquid, and the time from
+        its launch to the first of them (s; NaN: never free in flight)."""
         done = np.isfinite(self.landed_x)
-        return self.free_samples[done] / np.maximum(self.flight_samples[done], 1)
+        return self.free_samples[done] / np.maximum(self.flight_samples[done], 1), self.first_free[done] - self.launch[done, 0]
 
 
 def run(p: Params) -> CaseResult:
@@ -124,6 +130,7 @@ def run(p: Params) -> CaseResult:
     follower = ParticleFollower(spec, p.launch_spacings * dx, p.drop)
     run_ = run_scripted(spec, p.fill, cfg, pose_at, duration, device=p.device, observer=follower)
     t_launch, errors = follower.errors()
+    free_share, free_after = follower.free_in_flight()
     count = len(errors)
     median = float(np.median(np.abs(errors))) if count else float("nan")
     mean = float(np.mean(errors)) if count else float("nan")
@@ -138,7 +145,8 @@ def run(p: Params) -> CaseResult:
         "launch_time": t_launch.tolist(),
         "landing_error": errors.tolist(),
         "median_abs_error": median,
-        "free_in_flight": follower.free_in_flight().tolist(),
+        "free_in_flight": free_share.tolist(),
+        "free_after_launch": free_after.tolist(),
         "mean_error": mean,
         "p90_abs_error": float(np.quantile(np.abs(errors), 0.9)) if count else float("nan"),
         "particles": run_.solver.n_particles,
