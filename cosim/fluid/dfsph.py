@@ -239,7 +239,9 @@ def compute_density_factor(
     pair's mass, m_j or rho0 V_b, as the solves use it), which the later stages loop over instead of the cell grid;
     the divergence solve's warm start (increment = a fraction of the last substep's stiffness, applied by the first
     iteration; ``increment_per_rho`` = increment / rho, as the neighbours read it) and its counters. More than
-    ``capacity`` neighbours (impossible below ~2x compression) count as an overflow, an instability."""
+    ``capacity`` neighbours (impossible below ~2x compression) count as an overflow, an instability. Under the
+    'free_surface' rule (``free_liquid`` = FREE_AT_SURFACE) also each particle's free-surface indicator, from the same
+    walk (``indicator``, ``cosim.fluid.free_surface``)."""
     i = wp.tid()
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)
