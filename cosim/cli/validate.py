@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 
 from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
-from cosim.fluid.config import ArtificialViscosityScale, DensityIteration, FluidConfig, InitialState, PressureSolver, WallModel, WallPressure
+from cosim.fluid.config import ArtificialViscosityScale, DensityIteration, FluidConfig, FreeLiquidRule, InitialState, PressureSolver, WallModel, WallPressure
 from cosim.validation import CASES, DEFAULT_CASES
 from declared_settings.setting import declared
 
@@ -75,6 +75,11 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--wall-pressure", choices=[m.value for m in WallPressure],
                    help="DFSPH: how the walls carry pressure: solved_layer, solved_rest_sum or mirrored (docs/walls.md) (default: the default "
                    "scene's fluid.wall_pressure)")
+    p.add_argument("--free-liquid-rule", choices=[r.value for r in FreeLiquidRule],
+                   help="where liquid may become free: outside_vessels or free_surface (docs/free_surface.md) (default: the "
+                   "default scene's fluid.free_liquid_rule)")
+    p.add_argument("--free-surface-threshold", type=float, help="free_surface rule: the free-surface indicator below which "
+                   "liquid is at the surface (default: the default scene's fluid.free_surface_threshold)")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
@@ -90,7 +95,10 @@ def _case_params(name: str, args) -> list:
     numerics = (("density_iteration", args.density_iteration or scene.density_iteration.value),
                 ("wall_model", args.wall_model or scene.wall_model.value),
                 ("initial_state", args.initial_state or scene.initial_state.value),
-                ("wall_pressure", args.wall_pressure or scene.wall_pressure.value))
+                ("wall_pressure", args.wall_pressure or scene.wall_pressure.value),
+                ("free_liquid_rule", args.free_liquid_rule or scene.free_liquid_rule.value))
+    if args.free_surface_threshold is not None:
+        numerics += (("free_surface_threshold", args.free_surface_threshold),)
     if args.density_tolerance is not None:
         numerics += (("density_tolerance", args.density_tolerance),)
     numerics += (("artificial_viscosity", scene.artificial_viscosity if args.artificial_viscosity is None else args.artificial_viscosity),

@@ -71,6 +71,13 @@ class ArtificialViscosityScale(Enum):
     SIGNAL_VELOCITY = "signal_velocity"  # DFSPH: sqrt(|g| h) + 2 x each pair's approach speed (Monaghan 1997); WCSPH: c0
 
 
+class FreeLiquidRule(Enum):
+    """Where liquid may become free liquid (``cosim.fluid.free_surface``)."""
+
+    OUTSIDE_VESSELS = "outside_vessels"  # outside every vessel's inner volume: the stream, spray, liquid above a rim
+    FREE_SURFACE = "free_surface"  # at the free surface (Marrone et al. 2010's indicator), wherever it is
+
+
 class DensityIteration(Enum):
     """How DFSPH's density solve iterates (its divergence solve, about one iteration a substep, is always Jacobi)."""
 
@@ -178,7 +185,25 @@ class FluidConfig:
                                 "(cosim.fluid.wcsph.update_free_liquid; false: the continuity density everywhere, whose "
                                 "tension lands the stream short of its free-fall parabola, `cosim validate free-fall`); "
                                 "DFSPH holds it to its plain summation density (cosim.fluid.dfsph.bound_or_free_density). "
-                                "Either way its pairs use free_artificial_viscosity.")
+                                "Either way its pairs use free_artificial_viscosity. Where liquid may become free: "
+                                "free_liquid_rule.")
+    free_liquid_rule: FreeLiquidRule = setting(FreeLiquidRule.OUTSIDE_VESSELS, PRESSURE, "Where liquid may become free "
+                                               "(with free_liquid): 'outside_vessels', outside every vessel's inner "
+                                               "volume (so the liquid over a weir's or a tilted pourer's crest is free "
+                                               "as well as the stream), or 'free_surface', at the free surface wherever "
+                                               "it is: Marrone et al. (2010)'s indicator, the smallest eigenvalue of "
+                                               "the renormalisation matrix, below free_surface_threshold "
+                                               "(cosim.fluid.free_surface; docs/free_surface.md). Either way the "
+                                               "liquid must also have separated (summation density below rho0) and "
+                                               "is bound again once packed (summation density >= rho0) where the "
+                                               "rule no longer holds.")
+    free_surface_threshold: float = setting(0.4, PRESSURE, "free_liquid_rule 'free_surface': liquid whose indicator "
+                                            "lambda is below this is at the free surface (about 1 inside the liquid, "
+                                            "0.5 at a flat surface's top row, 0 for a lone particle; Marrone et al. "
+                                            "2010: <= 0.2 certainly at the surface, <= 0.75 near it). 0.4, chosen on "
+                                            "the validation cases: below a resting surface's 0.5, which DFSPH's "
+                                            "hydrostatic column needs bound; WCSPH's free fall needs 0.75 "
+                                            "(docs/free_surface.md).", "", 0.0, 1.0)
     free_artificial_viscosity: float | None = setting(None, PRESSURE, "Monaghan's alpha of every pair with a free "
                                                       "particle (and of a free particle against walls): free liquid "
                                                       "has no tension, so this makes its impacts inelastic; alpha acts "

@@ -90,6 +90,7 @@ from cosim.fluid.diagnostics import (
     DIAG_MAX_DENSITY_ERROR,
     DIAG_PAIR_OVERFLOW,
 )
+from cosim.fluid.free_surface import FREE_AT_SURFACE, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
 from cosim.fluid.neighbors import GridSpec, Neighborhood, first_neighbor, next_neighbor
 from cosim.fluid.params import SPHParams
@@ -97,7 +98,6 @@ from cosim.fluid.sph_common import (
     add_wall_reaction,
     diag_slot,
     finish_particle,
-    inside_any_vessel,
     kernel_gradient,
     neighbor_mass,
     next_free_state,
@@ -173,6 +173,8 @@ def bound_or_free_density(
     i: int,
     xi: wp.vec3,
     summation: float,
+    indicator: float,
+    threshold: float,
     free: wp.array(dtype=wp.int32),
     rest_offset: wp.array(dtype=float),
 ) -> float:
@@ -183,16 +185,18 @@ def bound_or_free_density(
     reach rho0 (without it a resting column's top rows merge below their spacing). With 'relaxed' every offset is 0
     from the start (``cosim.fluid.dfsph_step.DFSPHStep.initialise``): standard DFSPH, the surface rows settle before
     t = 0 (``cosim.fluid.relaxation``). Bound liquid is held to summation + offset; free liquid
-    (WCSPH's rules, ``cosim.fluid.wcsph.update_free_liquid``; ``free_liquid`` 0: all liquid stays bound) to its
-    plain summation density: a bound particle outside every vessel becomes free once separated (summation below
-    rho0), a free one bound again, with no offset, when packed (summation >= rho0) inside a vessel. (Only
+    (WCSPH's rules, ``cosim.fluid.wcsph.update_free_liquid``; ``free_liquid`` the rule's mode,
+    ``cosim.fluid.free_surface``, 0: all liquid stays bound) to its plain summation density: a bound particle where
+    the rule lets liquid be free (outside every vessel, or at the free surface: its ``indicator`` below
+    ``threshold``) becomes free once separated (summation below rho0), a free one bound again, with no offset, when
+    packed (summation >= rho0) where the rule no longer holds. (Only
     compression is corrected, so neither has tension.) Updates ``free[i]`` and ``rest_offset[i]``."""
     offset = rest_offset[i]
     if offset == UNSEEDED_OFFSET:
         offset = wp.max(prm.rest_density - summation, 0.0)
         rest_offset[i] = offset
     if free_liquid != 0:
-        state = next_free_state(free[i], inside_any_vessel(prm, vessels, motions, xi), summation, prm.rest_density)
+        state = next_free_state(free[i], exposed_liquid(prm, vessels, motions, free_liquid, xi, indicator, threshold), summation, prm.rest_density)
         if free[i] != 0 and state == 0:
             offset = 0.0
             rest_offset[i] = 0.0
@@ -210,6 +214,7 @@ def compute_density_factor(
     b_volume: wp.array(dtype=float),
     capacity: int,
     free_liquid: int,
+    threshold: float,
     # State in
     motions: wp.array(dtype=VesselMotion),
     nb: Neighborhood,
@@ -229,6 +234,7 @@ def compute_density_factor(
     pair_index: wp.array2d(dtype=wp.int32),
     pair_grad: wp.array2d(dtype=wp.vec3),
     pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    indicator: wp.array(dtype=float),
     solve_stats: wp.array(dtype=wp.int64),
     keep_going: wp.array(dtype=wp.int32),
     diag_f: wp.array2d(dtype=float),
@@ -241,7 +247,9 @@ def compute_density_factor(
     pair's mass, m_j or rho0 V_b, as the solves use it), which the later stages loop over instead of the cell grid;
     the divergence solve's warm start (increment = a fraction of the last substep's stiffness, applied by the first
     iteration; ``increment_per_rho`` = increment / rho, as the neighbours read it) and its counters. More than
-    ``capacity`` neighbours (impossible below ~2x compression) count as an overflow, an instability."""
+    ``capacity`` neighbours (impossible below ~2x compression) count as an overflow, an instability. Under the
+    'free_surface' rule (``free_liquid`` = FREE_AT_SURFACE) also each particle's free-surface indicator, from the same
+    walk (``indicator``, ``cosim.fluid.free_surface``)."""
     i = wp.tid()
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)
@@ -261,6 +269,7 @@ def compute_density_factor(
     density = mi * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     grad_sum = wp.vec3(0.0)
     grad_sq = float(0.0)
+    moment = wp.mat33(0.0)
     count = int(0)
     walk = first_neighbor(nb, xi, prm.support)
     while walk.index >= 0:
@@ -268,6 +277,8 @@ def compute_density_factor(
         density += summation_term(prm, mj, walk)
         gw = kernel_gradient(prm, walk.r, walk.r2)
         gm = mj * gw
+        if free_liquid == FREE_AT_SURFACE:
+            moment += renormalisation_term(mj / prm.rest_density, walk.r, gw)
         grad_sum += gm
         if walk.wall == 0:
             grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
@@ -280,7 +291,11 @@ def compute_density_factor(
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
-    density = bound_or_free_density(prm, vessels, motions, free_liquid, i, xi, density / prm.lattice_density, free, rest_offset)
+    lam = float(0.0)
+    if free_liquid == FREE_AT_SURFACE:
+        lam = surface_indicator(prm.dim, moment)
+        indicator[i] = lam
+    density = bound_or_free_density(prm, vessels, motions, free_liquid, i, xi, density / prm.lattice_density, lam, threshold, free, rest_offset)
     denominator = wp.max(wp.dot(grad_sum, grad_sum) + grad_sq, MIN_FACTOR_DENOMINATOR * prm.lattice_factor_denominator)
     rho[i] = density
     alpha[i] = density / denominator

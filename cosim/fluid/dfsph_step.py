@@ -24,6 +24,7 @@ import warp as wp
 from cosim.fluid import dfsph, wcsph
 from cosim.fluid.config import DensityIteration, InitialState, WallPressure
 from cosim.fluid.device_layout import pair_table
+from cosim.fluid.free_surface import free_liquid_mode
 from cosim.fluid.lanes import LANE_CHUNK, Lanes, PerLane
 from cosim.fluid.launch import launch_now
 from cosim.fluid.model import FluidModel, FluidState
@@ -89,11 +90,11 @@ def compute_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
     divergence solve's warm start and counters."""
     rec.launch(
         dfsph.compute_density_factor, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume,
-        capacity=sh.pair_capacity, free_liquid=int(m.config.free_liquid), motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active,
+        capacity=sh.pair_capacity, free_liquid=free_liquid_mode(m.config), threshold=m.config.free_surface_threshold, motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active,
         mass=st.mass, row=sh.row, kappa_divergence=st.kappa_divergence, free=st.free, rest_offset=st.rest_offset,
         rho=st.rho, alpha=sc.alpha, increment=sc.increment, increment_per_rho=sc.increment_per_rho,
         pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, pair_mass_grad=sc.pair_mass_grad,
-        solve_stats=sc.lane_stats, keep_going=sc.keep_going, diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
+        indicator=sh.free_surface, solve_stats=sc.lane_stats, keep_going=sc.keep_going, diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
     )
 
 

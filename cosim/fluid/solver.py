@@ -287,9 +287,15 @@ class FluidSolver:
         return self._in_id_order(self.state.active).astype(bool)
 
     def free_mask(self) -> np.ndarray:
-        """(N,) bool: free liquid (outside every vessel, or back inside but not yet packed: summation density, no
-        tension; ``FluidConfig.free_liquid``), under both solvers."""
+        """(N,) bool: free liquid (outside every vessel or at the free surface, by ``FluidConfig.free_liquid_rule``, or
+        not yet packed again: summation density, no tension; ``FluidConfig.free_liquid``), under both solvers."""
         return self._in_id_order(self.state.free).astype(bool)
+
+    def free_surface_indicator(self) -> np.ndarray:
+        """(N,) Marrone et al. (2010)'s free-surface indicator of each particle at the last substep's start (about 1
+        inside the liquid, 0.5 at a flat surface, 0 alone; ``cosim.fluid.free_surface``). Measured only under
+        ``FluidConfig.free_liquid_rule`` 'free_surface' (with ``free_liquid``); otherwise zeros."""
+        return self._in_id_order(self.scratch.free_surface).astype(np.float64)
 
     def vessel_poses(self) -> list[Pose]:
         """Current world poses of the vessel frames (as simulated: projected onto the pour plane in 2-D)."""

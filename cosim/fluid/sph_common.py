@@ -50,13 +50,14 @@ def inside_any_vessel(prm: SPHParams, vessels: wp.array(dtype=VesselGeometry), m
 
 
 @wp.func
-def next_free_state(free_now: int, inside: bool, summation: float, rest_density: float) -> int:
+def next_free_state(free_now: int, exposed: bool, summation: float, rest_density: float) -> int:
     """The free-liquid rule both solvers share (``FluidConfig.free_liquid``): 1 free, 0 bound. Bound liquid becomes
-    free once it is outside every vessel and has separated (summation density below rho0); free liquid becomes
-    bound again when it is packed (summation density >= rho0) inside a vessel."""
+    free once it is exposed (where ``FluidConfig.free_liquid_rule`` lets liquid be free: outside every vessel, or at
+    the free surface; :func:`cosim.fluid.free_surface.exposed_liquid`) and has separated (summation density below
+    rho0); free liquid becomes bound again when it is packed (summation density >= rho0) where it is not exposed."""
     if free_now == 0:
-        return wp.where(not inside and summation < rest_density, 1, 0)
-    return wp.where(inside and summation >= rest_density, 0, 1)
+        return wp.where(exposed and summation < rest_density, 1, 0)
+    return wp.where(not exposed and summation >= rest_density, 0, 1)
 
 
 @wp.func

@@ -44,7 +44,9 @@ class SubstepScratch:
     particles' world positions (m) and velocities (m/s); b_active: (Nb,) all ones (the wall grid sorts every wall
     particle); wall_force, wall_torque: (V, N) each particle's force (N) and torque (N m) on each vessel this substep;
     force_sum, torque_sum: (V,) their sums over the interval (reduced in a fixed order through ``partial_wrench``);
-    pair_capacity: entries of each particle's pair list; diagnostics: the substeps' rows, per lane.
+    pair_capacity: entries of each particle's pair list; free_surface: (N,) each particle's free-surface indicator
+    at its last substep's start, in that substep's particle order (written under ``FluidConfig.free_liquid_rule``
+    'free_surface' only; ``cosim.fluid.free_surface``); diagnostics: the substeps' rows, per lane.
     """
 
     def __init__(self, model: FluidModel, lanes: Lanes, layout: DeviceLayout):
@@ -74,6 +76,7 @@ class SubstepScratch:
         self.torque_sum = wp.zeros(v_count, dtype=wp.vec3, device=d)
         self._wrench_views = (self.force_sum.numpy(), self.torque_sum.numpy()) if d.is_cpu else None  # shared memory
         self._counter_views = (self.row.numpy(), *self._wrench_views) if d.is_cpu else None  # cleared every interval
+        self.free_surface = wp.zeros(n, dtype=float, device=d)
         self.diagnostics = DiagnosticBuffers(lanes.count, layout.atomic_replicas, nv, d)
 
     def set_motions(self, poses: list[Pose], lin_vel: np.ndarray, ang_vel: np.ndarray, lin_acc: np.ndarray, ang_acc: np.ndarray) -> None:

@@ -1,6 +1,7 @@
 """Weakly compressible SPH stages (warp kernels).
 
-update_free_liquid: free liquid (``FluidConfig.free_liquid``): a particle outside every vessel's inner volume that
+update_free_liquid: free liquid (``FluidConfig.free_liquid``): a particle outside every vessel's inner volume (or,
+  by ``FluidConfig.free_liquid_rule`` 'free_surface', at the free surface, ``cosim.fluid.free_surface``) that
   has separated from the liquid (summation density below rho0) takes the memoryless, tension-free summation density
   max(sum_j m W_ij, rho0) each substep; back inside a vessel it stays free until packed (summation density >= rho0),
   then the continuity equation takes over from there. Why: the continuity density's tension (a stretched stream is
@@ -32,6 +33,7 @@ import warp as wp
 
 from cosim.fluid.boundary import VesselGeometry, VesselMotion
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
+from cosim.fluid.free_surface import FREE_AT_SURFACE, FREE_OUTSIDE_VESSELS, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
 from cosim.fluid.neighbors import Neighborhood, first_neighbor, next_neighbor
 from cosim.fluid.params import SPHParams
@@ -89,6 +91,8 @@ def update_free_liquid(
     prm: SPHParams,
     vessels: wp.array(dtype=VesselGeometry),
     b_volume: wp.array(dtype=float),
+    mode: int,
+    threshold: float,
     # State in
     motions: wp.array(dtype=VesselMotion),
     nb: Neighborhood,
@@ -98,34 +102,44 @@ def update_free_liquid(
     free: wp.array(dtype=wp.int32),
     rho: wp.array(dtype=float),
     p: wp.array(dtype=float),
+    # Out
+    indicator: wp.array(dtype=float),
 ):
-    """Free liquid: a particle outside every vessel's inner volume (the falling stream, spray, a splash above a
-    rim) is free, and stays free until, back inside a vessel, it is packed into the liquid there. Liquid leaving a
-    vessel becomes free once it has separated (summation density below rho0); until then the continuity density
-    goes on, so its pressure does not jump when it passes the rim. A free particle's density is the summation
+    """Free liquid: a particle where the rule ``mode`` lets liquid be free (outside every vessel's inner volume:
+    the falling stream, spray, a splash above a rim; or at the free surface, its indicator below ``threshold``,
+    stored in ``indicator``: ``cosim.fluid.free_surface``) is free once it has separated, and stays free until it
+    is packed where the rule no longer holds. Until it has separated (summation density below rho0) the continuity
+    density goes on, so its pressure does not jump when it passes a rim. A free particle's density is the summation
     density sum_j m_j W_ij + sum_b rho0 V_b W_ib (normalised by a resting lattice's kernel sum), clamped below at
     rho0: memoryless (it sees the packing, whatever the particle went through in flight) and without tension
     (liquid in the air is at ambient pressure; the continuity density's tension would pull the stream back toward
-    the vessel it left). It becomes bound when its summation density reaches rho0 inside a
-    vessel; the continuity equation then continues from that density, so the pressure is continuous and the
-    caught liquid keeps no memory of the loose packing it arrived in."""
+    the vessel it left). It becomes bound when its summation density reaches rho0; the continuity equation then
+    continues from that density, so the pressure is continuous and the caught liquid keeps no memory of the loose
+    packing it arrived in."""
     i = wp.tid()
     if active[i] == 0:
         return
     xi = nb.x[i]
-    inside = inside_any_vessel(prm, vessels, motions, xi)
-    if inside and free[i] == 0:
-        return
+    if mode == FREE_OUTSIDE_VESSELS and free[i] == 0 and inside_any_vessel(prm, vessels, motions, xi):
+        return  # bound liquid inside a vessel stays bound
     density = mass[i] * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
+    moment = wp.mat33(0.0)
     walk = first_neighbor(nb, xi, prm.support)
     while walk.index >= 0:
-        density += summation_term(prm, neighbor_mass(prm, mass, b_volume, walk), walk)
+        mj = neighbor_mass(prm, mass, b_volume, walk)
+        density += summation_term(prm, mj, walk)
+        if mode == FREE_AT_SURFACE:
+            moment += renormalisation_term(mj / prm.rest_density, walk.r, kernel_gradient(prm, walk.r, walk.r2))
         walk = next_neighbor(nb, walk)
     density = density / prm.lattice_density
-    state = next_free_state(free[i], inside, density, prm.rest_density)
+    lam = float(0.0)
+    if mode == FREE_AT_SURFACE:
+        lam = surface_indicator(prm.dim, moment)
+        indicator[i] = lam
+    state = next_free_state(free[i], exposed_liquid(prm, vessels, motions, mode, xi, lam, threshold), density, prm.rest_density)
     if free[i] == 0 and state == 0:
-        # bound liquid outside every vessel (leaving over a lip) stays bound while it is packed: its summation
-        # density then still carries the particle disorder's +-2-5 %, whose Tait pressure would kick it off the lip
+        # bound liquid leaving over a lip (or at the surface) stays bound while it is packed: its summation density
+        # then still carries the particle disorder's +-2-5 %, whose Tait pressure would kick it off the lip
         return
     free[i] = state
     rhoi = wp.max(density, prm.rest_density)
@@ -209,7 +223,7 @@ def compute_forces(
             vij = vi - v[j]
             rhoj = rho[j]
             vol = mj / rhoj
-            moment += vol * wp.outer(-r, gw)
+            moment += renormalisation_term(vol, r, gw)
             gsum += (vol * (rhoj - rhoi)) * gw
             a -= mj * (pi_term + p[j] / (rhoj * rhoj)) * gw
             alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)

@@ -17,6 +17,7 @@ import warp as wp
 from cosim.fluid import boundary as bd
 from cosim.fluid import wcsph
 from cosim.fluid.device_layout import pair_table
+from cosim.fluid.free_surface import free_liquid_mode
 from cosim.fluid.launch import launch_now
 from cosim.fluid.model import FluidModel, FluidState
 from cosim.fluid.program import Recorder
@@ -42,13 +43,14 @@ class WCSPHScratch:
 
 
 def update_free_liquid(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch) -> None:
-    """Free liquid (outside every vessel and separated, or back inside but not yet packed) takes the tension-free
-    summation density (``cosim.fluid.wcsph.update_free_liquid``)."""
+    """Free liquid (outside every vessel or at the free surface, by ``FluidConfig.free_liquid_rule``, and separated;
+    or not yet packed again) takes the tension-free summation density (``cosim.fluid.wcsph.update_free_liquid``)."""
     if not m.config.free_liquid:
         return
     rec.launch(
-        wcsph.update_free_liquid, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, motions=sh.motions,
-        nb=sh.neighborhood(m, st), active=st.active, mass=st.mass, free=st.free, rho=st.rho, p=st.p,
+        wcsph.update_free_liquid, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, mode=free_liquid_mode(m.config),
+        threshold=m.config.free_surface_threshold, motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active, mass=st.mass, free=st.free,
+        rho=st.rho, p=st.p, indicator=sh.free_surface,
     )
 
 

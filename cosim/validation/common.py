@@ -14,8 +14,11 @@ from cosim.fluid.config import GRAVITY, FluidConfig, PressureSolver
 from declared_settings.setting import check_settings, declared, like
 
 # FluidConfig fields a case's numerics may override (the rest is the case's geometry, physics and solver).
-NUMERICS_FIELDS = ("kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "density_iteration", "density_tolerance", "wall_model",
-                   "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity", "initial_state", "wall_pressure")
+NUMERICS_FIELDS = (
+    "kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "free_liquid_rule", "free_surface_threshold", "density_iteration",
+    "density_tolerance", "wall_model", "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity", "initial_state",
+    "wall_pressure",
+)
 
 
 @dataclass(frozen=True)

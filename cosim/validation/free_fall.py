@@ -9,6 +9,11 @@ vessel; it lands where it first crosses the plane ``drop`` below the lip (linear
 Its landing error is the landed x minus the x its own launch state predicts for free fall (z = z0 + v_z t -
 g t^2 / 2, x = x0 + v_x t; the ballistic jet of Camporredondo et al. 2019, Eqs. 6-7).
 
+Each landed particle's share of its flight samples in which it was free liquid is reported too (``free_in_flight``,
+and ``free_after_launch``, s from its launch to the first such sample, NaN for never):
+under ``fluid.free_liquid_rule`` 'outside_vessels' the stream is free, and so without tension, by construction;
+under 'free_surface' only where the free-surface indicator finds it at the surface (docs/free_surface.md).
+
 This isolates the liquid's physics from the controller's measurement of the jet (``cosim pour``'s landing
 prediction from the mean outflow velocity at the lip): a stream that the liquid's own forces pull back while it
 falls (continuity WCSPH's tension; docs/physics-and-validation.md, The falling stream) lands short of every
@@ -63,7 +68,9 @@ class Params(FluidCaseParams):
 
 
 class ParticleFollower:
-    """Observer of :func:`run_scripted`: each particle's launch state and landing x (world frame, m, m/s)."""
+    """Observer of :func:`run_scripted`: each particle's launch state and landing x (world frame, m, m/s), how many
+    of its samples in flight (launched, not yet landed) found it free liquid (``FluidSolver.free_mask``) and the
+    time of the first that did (s)."""
 
     def __init__(self, spec: VesselSpec, launch_offset: float, drop: float) -> None:
         self.spec = spec
@@ -76,6 +83,9 @@ class ParticleFollower:
         n = solver.n_particles
         self.launch = np.full((n, 5), np.nan)  # t, x, z, v_x, v_z at launch
         self.landed_x = np.full(n, np.nan)
+        self.flight_samples = np.zeros(n, dtype=int)
+        self.free_samples = np.zeros(n, dtype=int)
+        self.first_free = np.full(n, np.nan)
         self.previous = solver.positions()
         self.t_previous = solver.time
 
@@ -90,6 +100,11 @@ class ParticleFollower:
         crossing &= np.abs(x[:, 2] - self.previous[:, 2]) > 0.0
         s = (self.previous[crossing, 2] - plane[crossing]) / (self.previous[crossing, 2] - x[crossing, 2])
         self.landed_x[crossing] = self.previous[crossing, 0] + s * (x[crossing, 0] - self.previous[crossing, 0])
+        flying = np.isfinite(self.launch[:, 0]) & (np.isnan(self.landed_x) | crossing)
+        self.flight_samples[flying] += 1
+        free = flying & solver.free_mask()
+        self.free_samples[free] += 1
+        self.first_free[free & np.isnan(self.first_free)] = solver.time
         self.previous = x
 
     def errors(self) -> tuple[np.ndarray, np.ndarray]:
@@ -98,6 +113,12 @@ class ParticleFollower:
         t, x0, z0, vx, vz = self.launch[done].T
         fall = (vz + np.sqrt(vz * vz + 2.0 * GRAVITY * self.drop)) / GRAVITY
         return t, self.landed_x[done] - (x0 + vx * fall)
+
+    def free_in_flight(self) -> tuple[np.ndarray, np.ndarray]:
+        """Of each landed particle: the fraction of its flight samples in which it was free liquid, and the time from
+        its launch to the first of them (s; NaN: never free in flight)."""
+        done = np.isfinite(self.landed_x)
+        return self.free_samples[done] / np.maximum(self.flight_samples[done], 1), self.first_free[done] - self.launch[done, 0]
 
 
 def run(p: Params) -> CaseResult:
@@ -109,6 +130,7 @@ def run(p: Params) -> CaseResult:
     follower = ParticleFollower(spec, p.launch_spacings * dx, p.drop)
     run_ = run_scripted(spec, p.fill, cfg, pose_at, duration, device=p.device, observer=follower)
     t_launch, errors = follower.errors()
+    free_share, free_after = follower.free_in_flight()
     count = len(errors)
     median = float(np.median(np.abs(errors))) if count else float("nan")
     mean = float(np.mean(errors)) if count else float("nan")
@@ -123,6 +145,8 @@ def run(p: Params) -> CaseResult:
         "launch_time": t_launch.tolist(),
         "landing_error": errors.tolist(),
         "median_abs_error": median,
+        "free_in_flight": free_share.tolist(),
+        "free_after_launch": free_after.tolist(),
         "mean_error": mean,
         "p90_abs_error": float(np.quantile(np.abs(errors), 0.9)) if count else float("nan"),
         "particles": run_.solver.n_particles,
