@@ -70,7 +70,7 @@ def register(subparsers, summary: str) -> None:
                    help="the artificial viscosity's velocity scale: sound_speed or signal_velocity (docs/artificial_viscosity.md) "
                    "(default: the default scene's fluid.artificial_viscosity_scale)")
     p.add_argument("--free-artificial-viscosity", metavar="ALPHA|none",
-                   help="Monaghan's alpha of pairs with free liquid, or none for the velocity scale's own (the one alpha under the signal velocity) (default: the "
+                   help="Monaghan's alpha of pairs with free liquid, or none for the one alpha of all liquid (default: the "
                    "default scene's fluid.free_artificial_viscosity)")
     p.add_argument("--wall-pressure", choices=[m.value for m in WallPressure],
                    help="DFSPH: how the walls carry pressure: solved_layer, solved_rest_sum or mirrored (docs/walls.md) (default: the default "
@@ -124,7 +124,7 @@ def _case_params(name: str, args) -> list:
 
 
 def _free_alpha(text: str | None, default: float | None) -> float | None:
-    """--free-artificial-viscosity: a number, 'none' (the velocity scale's own) or not given (``default``)."""
+    """--free-artificial-viscosity: a number, 'none' (the one alpha) or not given (``default``)."""
     if text is None:
         return default
     if text.strip().lower() == "none":
