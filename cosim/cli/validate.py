@@ -17,13 +17,14 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from enum import Enum
 from pathlib import Path
 
 from typing import TYPE_CHECKING
 
 from cosim.atomic_files import atomic_path, check_output_folder
 from cosim.errors import InputError
-from cosim.fluid.config import ArtificialViscosityScale, DensityIteration, FluidConfig, FreeLiquidRule, InitialState, PressureSolver, WallModel, WallPressure
+from cosim.fluid.config import FluidConfig, PressureSolver
 from cosim.validation import CASES, DEFAULT_CASES
 from declared_settings.setting import declared
 
@@ -31,6 +32,10 @@ if TYPE_CHECKING:
     from cosim.validation.common import CaseResult
 
 DEFAULT_OUT = Path("recordings") / "validate"
+# The FluidConfig fields `cosim validate` takes as options (--wall-model for wall_model, ...), each parsed, checked
+# and described from its declaration; not given, the default scene's value (`cosim scene --dump`)
+NUMERICS_OPTIONS = ("density_iteration", "density_tolerance", "wall_model", "wall_pressure", "initial_state", "free_liquid_rule",
+                    "free_surface_threshold", "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity")
 
 
 def register(subparsers, summary: str) -> None:
@@ -53,33 +58,7 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--solver", choices=[s.value for s in PressureSolver],
                    help="pressure solver: wcsph (weakly compressible) or dfsph (divergence-free) (default: the default scene's "
                    "fluid.pressure_solver, as `cosim scene --dump` prints it)")
-    p.add_argument("--density-iteration", choices=[d.value for d in DensityIteration],
-                   help="DFSPH's density solve: gauss_seidel or jacobi, each at its own default tolerance (default: the default "
-                   "scene's fluid.density_iteration)")
-    p.add_argument("--density-tolerance", type=float, help="DFSPH's density solve stops at this average compression "
-                   "(default: the density iteration's own, fluid.density_tolerance)")
-    p.add_argument("--wall-model", choices=[m.value for m in WallModel],
-                   help="the walls' dummy particles: kernel_layers or real_thickness (docs/walls.md) (default: the default "
-                   "scene's fluid.wall_model)")
-    p.add_argument("--initial-state", choices=[s.value for s in InitialState],
-                   help="how the liquid starts: seeded or relaxed (docs/relaxed_start.md) (default: the default scene's "
-                   "fluid.initial_state)")
-    p.add_argument("--artificial-viscosity", type=float, metavar="ALPHA",
-                   help="Monaghan's alpha (default: the default scene's fluid.artificial_viscosity)")
-    p.add_argument("--artificial-viscosity-scale", choices=[s.value for s in ArtificialViscosityScale],
-                   help="the artificial viscosity's velocity scale: sound_speed or signal_velocity (docs/artificial_viscosity.md) "
-                   "(default: the default scene's fluid.artificial_viscosity_scale)")
-    p.add_argument("--free-artificial-viscosity", metavar="ALPHA|none",
-                   help="Monaghan's alpha of pairs with free liquid, or none for the one alpha of all liquid (default: the "
-                   "default scene's fluid.free_artificial_viscosity)")
-    p.add_argument("--wall-pressure", choices=[m.value for m in WallPressure],
-                   help="DFSPH: how the walls carry pressure: solved_layer, solved_rest_sum or mirrored (docs/walls.md) (default: the default "
-                   "scene's fluid.wall_pressure)")
-    p.add_argument("--free-liquid-rule", choices=[r.value for r in FreeLiquidRule],
-                   help="where liquid may become free: outside_vessels or free_surface (docs/free_surface.md) (default: the "
-                   "default scene's fluid.free_liquid_rule)")
-    p.add_argument("--free-surface-threshold", type=float, help="free_surface rule: the free-surface indicator below which "
-                   "liquid is at the surface (default: the default scene's fluid.free_surface_threshold)")
+    _add_numerics_options(p)
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help=f"folder for the PNG plots (default {DEFAULT_OUT})")
     p.add_argument("--no-plot", action="store_true", help="skip the PNG plots")
     p.add_argument("--strict", action="store_true", help="exit with status 1 if any validation fails")
@@ -90,20 +69,8 @@ def _case_params(name: str, args) -> list:
     from cosim.pour_scene import FluidSettings
     from cosim.validation import slosh, weir
 
-    scene = FluidSettings()
-    solver = args.solver or scene.pressure_solver.value
-    numerics = (("density_iteration", args.density_iteration or scene.density_iteration.value),
-                ("wall_model", args.wall_model or scene.wall_model.value),
-                ("initial_state", args.initial_state or scene.initial_state.value),
-                ("wall_pressure", args.wall_pressure or scene.wall_pressure.value),
-                ("free_liquid_rule", args.free_liquid_rule or scene.free_liquid_rule.value))
-    if args.free_surface_threshold is not None:
-        numerics += (("free_surface_threshold", args.free_surface_threshold),)
-    if args.density_tolerance is not None:
-        numerics += (("density_tolerance", args.density_tolerance),)
-    numerics += (("artificial_viscosity", scene.artificial_viscosity if args.artificial_viscosity is None else args.artificial_viscosity),
-                 ("artificial_viscosity_scale", args.artificial_viscosity_scale or scene.artificial_viscosity_scale.value),
-                 ("free_artificial_viscosity", _free_alpha(args.free_artificial_viscosity, scene.free_artificial_viscosity)))
+    solver = args.solver or FluidSettings().pressure_solver.value
+    numerics = _numerics(args, FluidSettings())
     common = {"dim": declared(FluidConfig, "dim").check("--dim", args.dim), "device": args.device, "spacing": args.spacing, "solver": solver, "numerics": numerics}
     geometry = {k: v for k, v in (("width", args.width), ("fill", args.fill)) if v is not None}
     params = CASES[name].params
@@ -123,16 +90,44 @@ def _case_params(name: str, args) -> list:
     return [params(**common, **geometry)]
 
 
-def _free_alpha(text: str | None, default: float | None) -> float | None:
-    """--free-artificial-viscosity: a number, 'none' (the one alpha) or not given (``default``)."""
-    if text is None:
-        return default
-    if text.strip().lower() == "none":
+def _option(name: str) -> str:
+    """The command-line flag of FluidConfig field ``name``: --wall-model for wall_model."""
+    return "--" + name.replace("_", "-")
+
+
+def _add_numerics_options(p: argparse.ArgumentParser) -> None:
+    """One option per :data:`NUMERICS_OPTIONS` field, its allowed values from the field's declaration."""
+    for name in NUMERICS_OPTIONS:
+        spec = declared(FluidConfig, name)
+        unset = "; 'none' leaves it unset" if spec.optional else ""
+        p.add_argument(_option(name), dest=name, metavar=name.upper(),
+                       help=f"fluid.{name}: {spec.allowed()}{unset} (default: the default scene's)")
+
+
+def _numerics(args: argparse.Namespace, scene) -> tuple[tuple[str, object], ...]:
+    """The (field, value) overrides every case runs with: each :data:`NUMERICS_OPTIONS` field as given on the command
+    line (checked against its declaration; 'none' unsets an optional one) or else as in the default ``scene``."""
+    pairs = []
+    for name in NUMERICS_OPTIONS:
+        text = getattr(args, name)
+        value = getattr(scene, name) if text is None else _parse_setting(name, text)
+        pairs.append((name, value.value if isinstance(value, Enum) else value))
+    return tuple(pairs)
+
+
+def _parse_setting(name: str, text: str):
+    """FluidConfig field ``name``'s value from the command line's ``text``; one :class:`InputError` line naming the
+    option and its allowed values where it is not one of them."""
+    spec = declared(FluidConfig, name)
+    if spec.optional and text.strip().lower() == "none":
         return None
+    if spec.kind == "choice":
+        return spec.check(_option(name), text)
     try:
-        return float(text)
+        number = int(text) if spec.kind == "int" else float(text)
     except ValueError:
-        raise InputError(f"--free-artificial-viscosity: must be a number in [0, 1] or 'none', got {text!r}") from None
+        raise InputError(f"{_option(name)}: must be {spec.allowed()}, got {text!r}") from None
+    return spec.check(_option(name), number)
 
 
 def _json_value(value):
