@@ -109,17 +109,17 @@ class ArmLoadMonitor:
         if self._recorded == BATCH_STEPS:
             self._take_maxima()
         k, bodies = self._recorded, self._bodies
-        np.take(live.xpos, bodies, axis=0, out=self._live_pos[k])  # the coupled step brought the live frames to the new qpos
-        np.take(live.xquat, bodies, axis=0, out=self._live_quat[k])
-        np.take(live.qfrc_actuator, self._dofs, out=self._torques[k])
+        live.xpos.take(bodies, axis=0, out=self._live_pos[k])  # the coupled step brought the live frames to the new qpos
+        live.xquat.take(bodies, axis=0, out=self._live_quat[k])
+        live.qfrc_actuator.take(self._dofs, out=self._torques[k])
         self._recorded += 1
         self._twin_pending = True
 
     def _record_twin(self) -> None:
         """The twin's frames, as they are, into the last record."""
         k, twin = self._recorded - 1, self.twin
-        np.take(twin.xpos, self._bodies, axis=0, out=self._twin_pos[k])
-        np.take(twin.xquat, self._bodies, axis=0, out=self._twin_quat[k])
+        twin.xpos.take(self._bodies, axis=0, out=self._twin_pos[k])
+        twin.xquat.take(self._bodies, axis=0, out=self._twin_quat[k])
         self._twin_pending = False
 
     def _take_maxima(self) -> None:
