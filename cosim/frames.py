@@ -88,16 +88,22 @@ def rotation_vector(r: np.ndarray) -> np.ndarray:
     return np.array([angle * a / scale for a in axis])
 
 
+_IDENTITY = np.eye(3)
+_IDENTITY.flags.writeable = False
+
+
 def rotation_from_vector(w: np.ndarray) -> np.ndarray:
     """Rotation matrix of an axis-angle vector (rad): the exp map (Rodrigues), the inverse of
-    :func:`rotation_vector`."""
+    :func:`rotation_vector`: ``R = I + sin(a) K + (1 - cos(a)) K K`` with ``a = |w|`` and ``K`` the cross-product
+    matrix of ``w / a`` (I below 1e-12 rad). The axis is taken apart as plain floats and the identity is made once
+    (the energy account calls this for every vessel every MuJoCo step): the same double operations, the same bits."""
     w = np.asarray(w, dtype=float)
     angle = float(vector_norm(w))
     if angle < 1e-12:
-        return np.eye(3)
-    k = w / angle
-    kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + math.sin(angle) * kx + (1.0 - math.cos(angle)) * (kx @ kx)
+        return _IDENTITY.copy()
+    k0, k1, k2 = (w / angle).tolist()
+    kx = np.array([[0.0, -k2, k1], [k2, 0.0, -k0], [-k1, k0, 0.0]])
+    return _IDENTITY + math.sin(angle) * kx + (1.0 - math.cos(angle)) * (kx @ kx)
 
 
 def cross3(a, b) -> np.ndarray:

@@ -32,3 +32,11 @@ def test_bad_input_is_refused(capsys):
     assert host_split.main(["--duration", "0"]) == 2
     assert capsys.readouterr().err.strip() == "error: --duration: must be in (0, 60] s, got 0"
     assert host_split.main(["--threads", "-1"]) == 2
+
+
+def test_the_calls_per_step_are_counted_the_same_on_a_second_pour():
+    scene = host_split.default_scene(1)
+    scene = dataclasses.replace(scene, fluid=dataclasses.replace(scene.fluid, particles_across=12))
+    first, second = host_split.calls_per_step(scene, 0.02), host_split.calls_per_step(scene, 0.02)
+    assert first == second  # a pour's Python work is deterministic, whatever the machine's load
+    assert 300 < first < 5000  # the step loop's few hundred to thousand calls a step, the substeps' replay one

@@ -147,3 +147,36 @@ def test_largest_is_the_exact_maximum_where_the_screen_rounds_differently():
     approximate[2] -= 1e-19
     assert largest(approximate, lambda s: float(exact[s])) == exact[2]
     assert largest(np.full(3, np.nan), lambda s: float("nan")) == 0.0
+
+
+def test_the_monitor_s_maxima_are_those_of_each_step_s_frames_taken_after_it():
+    """The twin's frames are recorded from its next step's forward pass (the last one when read): the maxima are,
+    to the bit, those of the frames computed after each step, across batches and with a read mid-run."""
+    from cosim.coupling.arm_load import BATCH_STEPS, ArmLoadMonitor, rotation_angle
+    from cosim.coupling.exchange import ROLES
+    from cosim.frames import vector_norm
+
+    scene = RobotScene.load()
+    monitor = ArmLoadMonitor(scene)
+    reference = mujoco.MjData(scene.model)  # the twin stepped alike, its frames computed after every step
+    mujoco.mj_copyData(reference, scene.model, scene.data)
+    body = {role: scene.arms[role].vessel_body for role in ROLES}
+    scene.data.xfrc_applied[body[ArmRole.POUR]] = (0.0, 0.0, -30.0, 0.0, 0.5, 0.0)  # a load on the live pourer only
+    position, rotation = dict.fromkeys(ROLES, 0.0), dict.fromkeys(ROLES, 0.0)
+    for step in range(BATCH_STEPS + 60):
+        targets = {role: (scene.arms[role].home_q + 1e-3 * step, np.full(len(scene.arms[role].joints), 0.5)) for role in ROLES}
+        for role in ROLES:
+            scene.set_joint_targets(role, *targets[role])
+            reference.ctrl[scene.arms[role].ctrl_adr] = scene.servo_controls(role, *targets[role])
+        for data in (scene.data, reference):
+            mujoco.mj_step(scene.model, data)
+            mujoco.mj_kinematics(scene.model, data)
+        monitor.step(targets)
+        for role in ROLES:
+            live, twin = body[role], body[role]
+            position[role] = max(position[role], float(vector_norm(scene.data.xpos[live] - reference.xpos[twin])))
+            rotation[role] = max(rotation[role], rotation_angle(reference.xquat[twin], scene.data.xquat[live]))
+        if step in (10, BATCH_STEPS - 1):  # read mid-run: the pending twin frames computed there
+            assert monitor.max_position == position and monitor.max_rotation == rotation
+    assert monitor.max_position == position and monitor.max_rotation == rotation
+    assert position[ArmRole.POUR] > 1e-6 and rotation[ArmRole.POUR] > 1e-6  # the load moved the live pourer

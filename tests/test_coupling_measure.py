@@ -217,3 +217,11 @@ def test_probe_equals_the_numpy_contract_on_a_pouring_sph_liquid(dim, across, cr
     run = run_scripted(spec, 0.5 * spec.inner_height, cfg, tilt_about_lip(spec, 4.0, math.radians(80.0)), 0.5, observer=observer)
     assert run.failure == ""
     assert observer.samples == 250 and observer.leaving >= 20 and observer.crossing >= crossings  # the stream was measured
+
+
+def test_a_launch_s_key_reads_the_array_arguments_its_signature_names():
+    from cosim.coupling.measure import argument_layout, collect_rim_crossing, sum_leaving_stream
+
+    # frame, lip, dx, top, n, chunk, then x, v, active, sums
+    assert argument_layout(sum_leaving_stream) == ((6, 7, 8, 9), (0, 1, 2, 3, 4, 5))
+    assert argument_layout(collect_rim_crossing) == ((3, 4, 5, 6, 7), (0, 1, 2))

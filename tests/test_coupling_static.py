@@ -28,9 +28,9 @@ def test_one_way_coupling_keeps_the_liquid_off_the_arm():
     cfg = fluid.config
     settings = CouplingSettings(coupling=Coupling.ONE_WAY)
     targets = {r: (scene.arms[r].home_q, None) for r in ROLES}
-    wrench = np.zeros((2, 6))
+    wrench, frames = np.zeros((2, 6)), None
     for _ in range(50):
-        wrench = coupled_step(scene, fluid, wrench, targets, settings)
+        wrench, frames = coupled_step(scene, fluid, wrench, targets, settings, frames=frames)
     weight = fluid.n_particles * cfg.particle_volume * 1000.0 * 9.81
     assert -wrench[0, 2] == pytest.approx(weight, rel=0.05)  # measured on the vessel ...
     body = scene.arms[ArmRole.POUR].vessel_body

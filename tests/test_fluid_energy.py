@@ -90,3 +90,29 @@ def test_energy_creating_configuration_stops_with_the_instability_error():
 def test_energy_bound_is_validated():
     with pytest.raises(InputError, match="fluid.max_energy_creation"):
         FluidConfig(max_energy_creation=0.0)
+
+
+def test_the_walls_work_of_the_vessels_at_once_is_each_vessel_s_own_to_the_bit():
+    # the account (its exp map on plain floats) against the formula written out with numpy scalars, to the bit
+    from cosim.fluid.energy import EnergyAccount
+    from cosim.frames import cross3, rotation_y
+
+    from tests.support.rodrigues import rodrigues
+
+    spec = seed_pouring_vessel()
+    cfg = FluidConfig(dim=2, spacing=spec.inner_width / 8)
+    vessels = [spec, replace(spec, name="other", inner_width=0.7 * spec.inner_width)]
+    account = EnergyAccount(cfg, vessels, np.zeros((4, 3)), np.zeros((4, 3)), 0.0)
+    rng = np.random.default_rng(3)
+    work = 0.0
+    for interval in range(50):
+        before = [Pose(rng.normal(size=3), rotation_y(rng.uniform(-2.0, 2.0))) for _ in vessels]
+        wrenches, lin_vel, ang_vel = rng.normal(size=(2, 6)), rng.normal(size=(2, 3)), rng.normal(size=(2, 3))
+        ang_vel[interval % 2] = 0.0  # one vessel not turning
+        account.update(1.0, 2.0, 0.0, wrenches, before, lin_vel, ang_vel, 0.002)
+        for k, pose in enumerate(before):
+            rotation_mid = rodrigues(0.5 * 0.002 * ang_vel[k]) @ pose.rotation
+            v_com = lin_vel[k] + cross3(ang_vel[k], rotation_mid @ np.asarray(vessels[k].com_local, dtype=float))
+            work -= float(wrenches[k, :3] @ v_com + wrenches[k, 3:] @ ang_vel[k]) * 0.002
+        assert account.wall_work == work
+    assert work != 0.0

@@ -104,3 +104,21 @@ def test_vessel_pose_and_com_are_those_of_the_full_state(scene):
         np.testing.assert_array_equal(com, state.com)
         pos[:] = com[:] = 0.0
         assert np.any(scene.vessel_pose(role)[0] != 0.0) and np.any(scene.vessel_com(role) != 0.0)
+
+
+def test_the_live_kinematics_give_the_private_jacobians_bit_for_bit(scene):
+    """The step loop keeps the live frames current (mj_kinematics and mj_comPos after each mj_step): the wrench's
+    joint torques read there are those the private data computes again, to the bit; stale frames are not."""
+    force, torque = np.array([0.3, -0.2, -35.0]), np.array([0.01, 0.4, -0.02])
+    for role in (ArmRole.POUR, ArmRole.CATCH):
+        scene.set_joint_targets(role, scene.arms[role].home_q + 0.2)
+    for _ in range(5):
+        mujoco.mj_step(scene.model, scene.data)
+    stale = scene.wrench_joint_torque(ArmRole.POUR, force, torque, kinematics_current=True)  # mj_step's frames: before its integration
+    mujoco.mj_kinematics(scene.model, scene.data)
+    mujoco.mj_comPos(scene.model, scene.data)
+    for role in (ArmRole.POUR, ArmRole.CATCH):
+        live = scene.wrench_joint_torque(role, force, torque, kinematics_current=True)
+        private = scene.wrench_joint_torque(role, force, torque)
+        assert live.tobytes() == private.tobytes()
+    assert np.any(stale != scene.wrench_joint_torque(ArmRole.POUR, force, torque))

@@ -8,16 +8,21 @@ filters and smoothers, the IK, the generators' targets, the landing probe) with 
 steps ``--duration`` simulated seconds and prints each part's ms per MuJoCo step. The timers change no result; each
 costs about a microsecond a call, so the parts sum to slightly more than they cost unwrapped. Parts nest where the
 table says so (the rows named "controller: ..." are inside the controller's row, and so are the generators' targets).
+``--calls`` also counts the Python function calls per MuJoCo step over the same stretch of a second pour (cProfile's
+count, builtins included): a measure of the host's per-step work that, unlike its time, the machine's load does not
+change.
 
-    python -m cosim.bench.host_split [--duration 1] [--threads 1]
+    python -m cosim.bench.host_split [--duration 1] [--threads 1] [--calls]
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import cProfile
 import dataclasses
 import os
+import pstats
 import statistics
 import sys
 import time
@@ -109,10 +114,26 @@ def split_pour(scene: PourScene, duration: float) -> tuple[dict[str, list[float]
     return dict(calls), split.steps, split.wall_s, split.substep_s
 
 
+def calls_per_step(scene: PourScene, duration: float) -> float:
+    """Python function calls (cProfile's count, builtins included) per MuJoCo step over ``duration`` s of ``scene``'s
+    pour after the warm-up."""
+    scene = dataclasses.replace(scene, coupling=dataclasses.replace(scene.coupling, max_duration=POUR_WARM_UP + duration))
+    pour = prepare(scene)
+    time_steps(pour, POUR_WARM_UP)
+    profile, steps = cProfile.Profile(), pour.steps
+    profile.enable()
+    try:
+        time_steps(pour, duration)
+    finally:
+        profile.disable()
+    return pstats.Stats(profile).total_calls / (pour.steps - steps)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m cosim.bench.host_split", description=__doc__.split("\n\n")[0])
     ap.add_argument("--duration", type=float, default=1.0, help="simulated s timed after the warm-up (default 1)")
     ap.add_argument("--threads", type=int, default=1, help="the liquid solver's CPU threads, 0: one per core (default 1)")
+    ap.add_argument("--calls", action="store_true", help="also count the Python function calls per MuJoCo step (a second pour)")
     args = ap.parse_args(argv)
     try:
         DURATION.check("--duration", args.duration)
@@ -136,6 +157,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"| {label} | {per_step:.2f} | {1e3 * sum(times) / steps:.3f} | {1e3 * statistics.median(times) * per_step:.3f} | {share} |")
     advance = sum(calls[ADVANCE]) - sum(calls[SUBSTEPS])
     print(f"| liquid: advance less its substeps (host work) | 1.00 | {1e3 * advance / steps:.3f} | | {100 * advance / host:.0f} % |")
+    if args.calls:
+        print(f"\nPython function calls per MuJoCo step (cProfile, the same stretch of a second pour): "
+              f"{calls_per_step(default_scene(args.threads), args.duration):.1f}")
     return 0
 
 

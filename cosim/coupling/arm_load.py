@@ -71,7 +71,10 @@ class ArmLoadMonitor:
     Each step records the vessels' poses (live and twin) and the drives' torques; the maxima are taken over a batch
     of :data:`BATCH_STEPS` records at once (numpy over the batch instead of a dozen small calls per step) and when
     read. The deviations are screened vectorised and the largest evaluated exactly (:func:`largest`): the same values,
-    to the bit, as taken step by step."""
+    to the bit, as taken step by step. The twin's frames of a step are recorded from its next ``mj_step``, whose
+    forward pass computes them at the same positions before it integrates (the same bits as an ``mj_kinematics``
+    after the step, which would change nothing the twin's next step computes); the last step's are computed when
+    the maxima are read."""
 
     def __init__(self, scene: RobotScene) -> None:
         self.scene = scene
@@ -88,6 +91,7 @@ class ArmLoadMonitor:
         self._live_quat, self._twin_quat = np.empty((BATCH_STEPS, len(ROLES), 4)), np.empty((BATCH_STEPS, len(ROLES), 4))
         self._torques = np.empty((BATCH_STEPS, len(self._dofs)))
         self._recorded = 0  # records in the batch
+        self._twin_pending = False  # the last record still lacks the twin's frames
         self._max_position = np.zeros(len(ROLES))  # m
         self._max_rotation = np.zeros(len(ROLES))  # rad
         self._peak_torque = np.zeros(len(self._dofs))  # N m
@@ -99,20 +103,31 @@ class ArmLoadMonitor:
         q = np.concatenate([targets[role][0] for role in ROLES])
         qd = np.concatenate([targets[role][1] for role in ROLES])
         twin.ctrl[self._ctrl_adr] = q + self._kv * qd / self._kp
-        mujoco.mj_step(scene.model, twin)
-        mujoco.mj_kinematics(scene.model, twin)  # the frames at the new qpos, as the coupled step brings the live ones
-        k, bodies = self._recorded, self._bodies
-        np.take(live.xpos, bodies, axis=0, out=self._live_pos[k])
-        np.take(twin.xpos, bodies, axis=0, out=self._twin_pos[k])
-        np.take(live.xquat, bodies, axis=0, out=self._live_quat[k])
-        np.take(twin.xquat, bodies, axis=0, out=self._twin_quat[k])
-        np.take(live.qfrc_actuator, self._dofs, out=self._torques[k])
-        self._recorded += 1
+        mujoco.mj_step(scene.model, twin)  # its forward pass leaves the frames of the previous step's end
+        if self._twin_pending:
+            self._record_twin()
         if self._recorded == BATCH_STEPS:
             self._take_maxima()
+        k, bodies = self._recorded, self._bodies
+        live.xpos.take(bodies, axis=0, out=self._live_pos[k])  # the coupled step brought the live frames to the new qpos
+        live.xquat.take(bodies, axis=0, out=self._live_quat[k])
+        live.qfrc_actuator.take(self._dofs, out=self._torques[k])
+        self._recorded += 1
+        self._twin_pending = True
+
+    def _record_twin(self) -> None:
+        """The twin's frames, as they are, into the last record."""
+        k, twin = self._recorded - 1, self.twin
+        twin.xpos.take(self._bodies, axis=0, out=self._twin_pos[k])
+        twin.xquat.take(self._bodies, axis=0, out=self._twin_quat[k])
+        self._twin_pending = False
 
     def _take_maxima(self) -> None:
-        """The batch's records into the maxima; the batch starts again."""
+        """The batch's records into the maxima (the last step's twin frames computed at its positions); the batch
+        starts again."""
+        if self._twin_pending:
+            mujoco.mj_kinematics(self.scene.model, self.twin)
+            self._record_twin()
         n = self._recorded
         if n == 0:
             return

@@ -51,19 +51,22 @@ def compensation_torque(
     force: np.ndarray,
     torque: np.ndarray,
     payload: Payload | None,
+    frame: Pose,
 ) -> np.ndarray | None:
     """Feedforward joint torques (n,) N m of ``role``'s arm at its current configuration, or None (``NONE``).
 
-    force (3,) N, torque (3,) N m: the liquid's measured wrench on the vessel about the vessel body's centre of mass,
-    world frame (what goes into ``xfrc_applied``); used by ``IDEAL_FORCE_TORQUE``. payload: the arm's payload setting
-    (the payload modes; None: no payload)."""
+    The scene's kinematics must be those of its current configuration (``mj_forward``, or ``mj_kinematics`` and
+    ``mj_comPos`` since the positions last changed, as :func:`cosim.coupling.loop.coupled_step` keeps them): its
+    Jacobians are read where they are. force (3,) N, torque (3,) N m: the liquid's measured wrench on the vessel
+    about the vessel body's centre of mass, world frame (what goes into ``xfrc_applied``); used by
+    ``IDEAL_FORCE_TORQUE``. payload: the arm's payload setting (the payload modes; None: no payload). frame: the
+    vessel frame's world pose at this configuration (:func:`cosim.coupling.exchange.vessel_poses`)."""
     if compensation is Compensation.NONE:
         return None
     if compensation is Compensation.IDEAL_FORCE_TORQUE:
-        return -scene.wrench_joint_torque(role, force, torque)
+        return -scene.wrench_joint_torque(role, force, torque, kinematics_current=True)
     if payload is None or payload.mass == 0.0:
         return None
-    pose = Pose.from_quat_wxyz(*scene.vessel_pose(role))
-    centre = pose.transform(payload.com_local[None, :])[0]
+    centre = frame.transform(payload.com_local[None, :])[0]
     weight = payload.mass * scene.model.opt.gravity
-    return -scene.wrench_joint_torque(role, weight, shift_wrench(weight, np.zeros(3), centre, scene.vessel_com(role)))
+    return -scene.wrench_joint_torque(role, weight, shift_wrench(weight, np.zeros(3), centre, scene.vessel_com(role)), kinematics_current=True)

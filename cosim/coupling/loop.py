@@ -44,6 +44,7 @@ from cosim.coupling.settings import Compensation, Coupling, CouplingSettings
 from cosim.fluid.config import FluidConfig
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
+from cosim.frames import Pose
 from cosim.robots.ik import ArmIK, IKSettings
 from cosim.robots.planar import PlanarPose
 from cosim.robots.scene import RobotScene
@@ -78,18 +79,23 @@ def coupled_step(
     targets: dict[ArmRole, tuple[np.ndarray, np.ndarray | None]],
     settings: CouplingSettings,
     payloads: dict[ArmRole, Payload] | None = None,
-) -> np.ndarray:
+    frames: list[Pose] | None = None,
+) -> tuple[np.ndarray, list[Pose]]:
     """Steps 2-5 of the exchange order above for one MuJoCo step: servo targets ``(q, qd)`` per arm (+ the
     compensation ``settings.compensation`` of ``wrench``, the liquid's (2, 6) wrench from the previous interval, or of
     the arms' ``payloads``), the wrench into MuJoCo (two-way), ``mj_step``, then the fluid over the same dt; returns
-    the new averaged wrench (2, 6)."""
+    the new averaged wrench (2, 6) and the vessel frames' world poses after the step, which the next step takes as
+    ``frames`` (None: read from the scene, whose kinematics must be those of its current configuration, as
+    ``mj_forward`` leaves them)."""
     two_way = settings.coupling is Coupling.TWO_WAY
     poses = fluid.vessel_poses()
+    if frames is None:
+        frames = vessel_poses(scene)
     for k, role in enumerate(ROLES):
         q, qd = targets[role]
         force, torque = wrench_at_body_com(scene, role, poses[k], wrench[k])
         payload = payloads.get(role) if payloads else None
-        tau_ff = compensation_torque(scene, role, settings.compensation, force, torque, payload) if two_way else None
+        tau_ff = compensation_torque(scene, role, settings.compensation, force, torque, payload, frames[k]) if two_way else None
         scene.set_joint_targets(role, q, qd, tau_ff)
         if two_way:
             scene.apply_vessel_wrench(role, force, torque)
@@ -99,9 +105,10 @@ def coupled_step(
     # and the Jacobians' frame (mj_comPos), to the new qpos so the liquid's target is the pose at t + dt.
     mujoco.mj_kinematics(scene.model, scene.data)
     mujoco.mj_comPos(scene.model, scene.data)
-    fluid.set_vessel_poses(vessel_poses(scene))
+    frames = vessel_poses(scene)
+    fluid.set_vessel_poses(frames)
     fluid.advance(dt)
-    return fluid.vessel_wrenches()
+    return fluid.vessel_wrenches(), frames
 
 
 @dataclass
@@ -159,6 +166,7 @@ class CoupledPour:
         self.payloads = {role: self._payload(role, volume) for role, volume in zip(ROLES, (geometry.initial_volume, 0.0))}
         self.arm_load = ArmLoadMonitor(scene)
         self.wrench_history: list[np.ndarray] = []  # (2, 6) the liquid's wrench acting during each MuJoCo step
+        self._frames: list[Pose] | None = None  # the vessel frames' world poses at the arms' current configuration
 
     def _payload(self, role: ArmRole, volume: float) -> Payload:
         """The payload setting of ``role``'s arm for ``volume`` (m^3) of liquid in its vessel."""
@@ -176,7 +184,7 @@ class CoupledPour:
             targets[role] = (q, qd)
         self.recorder.record()
         self.wrench_history.append(self.wrench)
-        self.wrench = coupled_step(scene, self.fluid, self.wrench, targets, self.settings, self.payloads)
+        self.wrench, self._frames = coupled_step(scene, self.fluid, self.wrench, targets, self.settings, self.payloads, self._frames)
         self.arm_load.step(targets)
         self.steps += 1
         self.time = self.steps * self.dt

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import warp as wp
@@ -37,6 +38,11 @@ CHUNKS = 64  # fixed-order reductions: per-chunk sums, then the chunks in order
 STREAM_SUM_COLUMNS = 5  # per chunk: count, sum vx, sum vz, sum x, sum z of the leaving particles
 
 
+def _read_only(values: np.ndarray) -> np.ndarray:
+    values.flags.writeable = False
+    return values
+
+
 @dataclass(frozen=True)
 class MeasurementGeometry:
     """What the measurement needs to know: the pourer (spec, wall thickness the liquid sees), the catcher's
@@ -50,15 +56,16 @@ class MeasurementGeometry:
     initial_volume: float
     dim: int
 
-    @property
+    # made once (the probe reads them several times a control period): read-only arrays
+    @cached_property
     def crest_local(self) -> np.ndarray:
-        return np.array([0.5 * self.pourer.inner_width, 0.0, self.pourer.inner_height])
+        return _read_only(np.array([0.5 * self.pourer.inner_width, 0.0, self.pourer.inner_height]))
 
-    @property
+    @cached_property
     def lip_local(self) -> np.ndarray:
-        return np.array([0.5 * self.pourer.inner_width + self.wall_thickness, 0.0, self.pourer.inner_height])
+        return _read_only(np.array([0.5 * self.pourer.inner_width + self.wall_thickness, 0.0, self.pourer.inner_height]))
 
-    @property
+    @cached_property
     def columns(self) -> int:
         """Number of free-surface columns (:func:`cosim.coupling.free_surface.column_count`)."""
         return column_count(self.pourer.inner_width, self.spacing)
@@ -145,6 +152,13 @@ def _packed_scalar(value: object) -> tuple | None:
     return None
 
 
+def argument_layout(kernel) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """(the positions of ``kernel``'s array arguments, those of the others), from its signature: what a launch's
+    key reads and what it may have to pack again, without looking at each argument's type on every launch."""
+    arrays = tuple(k for k, arg in enumerate(kernel.adj.args) if wp.types.is_array(arg.type))
+    return arrays, tuple(k for k in range(len(kernel.adj.args)) if k not in arrays)
+
+
 class LiquidProbe:
     """The controller's measurement of a liquid of ``n_particles`` on ``device`` (scratch arrays allocated once).
 
@@ -165,6 +179,7 @@ class LiquidProbe:
         self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
         self._crossing_x = wp.zeros(max(n_particles, 1), dtype=float, device=device)
         self._commands: dict[tuple, tuple[wp.Launch, list]] = {}  # the launch and its scalar arguments as packed
+        self._layouts: dict[str, tuple[tuple[int, ...], tuple[int, ...]]] = {}  # each kernel's argument_layout
         spec = geo.pourer
         self._pourer_frame = PourerFrame()  # the fixed fields once; :meth:`_frame` sets the pose (warp struct fields are costly to set)
         self._pourer_frame.half_width = 0.5 * spec.inner_width
@@ -178,16 +193,20 @@ class LiquidProbe:
         solver's particle arrays alternate between two): each call packs only the arguments that are not arrays
         (packing them all was most of the probe's host time), and of those only the ones that changed (a plain
         int or float the launch holds already, to the bit, is not packed again; structs and vectors always are)."""
-        key = (kernel.key, dim, *(a.ptr for a in (*inputs, *outputs) if isinstance(a, wp.array)))
+        layout = self._layouts.get(kernel.key)
+        if layout is None:
+            layout = self._layouts[kernel.key] = argument_layout(kernel)
+        arrays, values = layout
+        arguments = (*inputs, *outputs)
+        key = (kernel.key, dim, *[arguments[k].ptr for k in arrays])
         entry = self._commands.get(key)
         if entry is None:
             command = wp.launch(kernel, dim=dim, inputs=inputs, outputs=outputs, device=self.device, record_cmd=True)
             self._commands[key] = (command, [_packed_scalar(value) for value in inputs])
         else:
             command, packed = entry
-            for k, value in enumerate(inputs):
-                if isinstance(value, wp.array):
-                    continue
+            for k in values:
+                value = inputs[k]
                 scalar = _packed_scalar(value)
                 if scalar is None or scalar != packed[k]:
                     command.set_param_at_index(k, value)

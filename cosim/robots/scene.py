@@ -322,11 +322,14 @@ class RobotScene:
         mujoco.mj_inverse(m, d)
         return d.qfrc_inverse[arm.dof_adr] - d.qfrc_gravcomp[arm.dof_adr]
 
-    def wrench_joint_torque(self, role: ArmRole, force: np.ndarray, torque: np.ndarray) -> np.ndarray:
+    def wrench_joint_torque(self, role: ArmRole, force: np.ndarray, torque: np.ndarray, kinematics_current: bool = False) -> np.ndarray:
         """Joint torques (n,) N m that a wrench on the vessel exerts on the arm: ``J_p^T force + J_r^T torque``.
 
         ``force`` (3,) N and ``torque`` (3,) N m act at the vessel's centre of mass, world frame (as
-        :meth:`apply_vessel_wrench`); the Jacobians are taken at the current joint positions on a private MjData.
+        :meth:`apply_vessel_wrench`); the Jacobians are taken at the current joint positions on a private MjData,
+        or, with ``kinematics_current``, on the live data itself, whose caller vouches that its frames are those of
+        its current positions (``mj_forward``, or ``mj_kinematics`` and ``mj_comPos`` since the positions last
+        changed, as the coupled step loop keeps them): the same values, without computing them again.
         Pass ``tau_ff = -wrench_joint_torque(...)`` to :meth:`set_joint_targets` to feed forward a known external
         wrench (e.g. the liquid's reaction), as a controller that knows its payload would.
         """
@@ -336,10 +339,12 @@ class RobotScene:
             self._jacobian_data.qpos[:] = np.nan  # no kinematics computed yet
             self._jacobians = (np.empty((3, m.nv)), np.empty((3, m.nv)))  # mj_jac writes every entry
         d, live = self._jacobian_data, self.data
+        if kinematics_current:
+            d = live
         # the step loop asks for both arms at one configuration: its kinematics once (compared as bytes: exact, and
         # without array_equal's dispatch)
-        if not (d.qpos.tobytes() == live.qpos.tobytes() and d.mocap_pos.tobytes() == live.mocap_pos.tobytes()
-                and d.mocap_quat.tobytes() == live.mocap_quat.tobytes()):
+        elif not (d.qpos.tobytes() == live.qpos.tobytes() and d.mocap_pos.tobytes() == live.mocap_pos.tobytes()
+                  and d.mocap_quat.tobytes() == live.mocap_quat.tobytes()):
             d.qpos[:], d.mocap_pos[:], d.mocap_quat[:] = live.qpos, live.mocap_pos, live.mocap_quat
             mujoco.mj_kinematics(m, d)
             mujoco.mj_comPos(m, d)

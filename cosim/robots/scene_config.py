@@ -30,6 +30,10 @@ class ArmRole(Enum):
     POUR = "pour_arm"
     CATCH = "catch_arm"
 
+    # hashed by identity, as the members compare (Enum's own hash is a Python function of the name, and the step
+    # loop looks the arms' parts up by role some thirty times a MuJoCo step); dicts keep their insertion order
+    __hash__ = object.__hash__
+
 
 class MountSide(Enum):
     """Which vessel wall the arm's flange holds: the flange's z axis points into that wall."""

@@ -91,12 +91,12 @@ def run(p: Params) -> CaseResult:
     dt = float(scene.model.opt.timestep)
     steps = int(round(p.duration / dt))
     window = max(1, int(round(AVERAGE_WINDOW / dt)))
-    state = {"wrench": np.zeros((2, 6))}
+    state = {"wrench": np.zeros((2, 6)), "frames": None}
     forces = []
     targets = {role: (scene.arms[role].home_q, None) for role in ROLES}
 
     def step() -> None:
-        state["wrench"] = coupled_step(scene, fluid, state["wrench"], targets, settings)
+        state["wrench"], state["frames"] = coupled_step(scene, fluid, state["wrench"], targets, settings, frames=state["frames"])
         forces.append(state["wrench"][0, 2])
 
     start = time.perf_counter()
