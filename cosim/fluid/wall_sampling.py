@@ -96,8 +96,11 @@ def fit_wall_volumes(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, vol
     reach of the walls: FIT_SWEEPS multiplicative sweeps V_b <- V_b sum_p W_pb S_ref(p) / S(p) / sum_p W_pb (each
     particle scaled by the mean shortfall of the probes it reaches, weighted by its kernel there; volumes stay
     positive). Inner edges and corners, where the missing support is largest, get the largest volumes. Particles no
-    probe reaches keep their slab volumes. One volume per particle cannot also match the kernel-gradient sums, nor
-    the sums of the wall particles themselves, which lack the layers behind them (docs/walls.md).
+    probe reaches keep their slab volumes. The kept layers lie where the covering walls' first layers lie (module
+    doc), so the fitted sums match theirs to 0.26 % of rho0 for one layer: the liquid seeded against the wall is
+    compressed by at most that, which DFSPH (correcting any compression at once) removes without setting it moving.
+    One volume per particle cannot also match the kernel-gradient sums, nor the sums of the wall particles
+    themselves, which lack the layers behind them (docs/walls.md).
     """
     from cosim.fluid.seeding import fill_vessel
 
@@ -216,12 +219,12 @@ def covers_support(spec: VesselSpec, cfg: FluidConfig) -> bool:
 def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
     """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim), for ``cfg``'s spacing,
     kernel support, dimension and wall model; a thin wall's volumes fitted (:func:`fit_wall_volumes`). Raises
-    InputError for a mesh wall too thin to hold a layer."""
+    InputError for a wall too thin to hold a layer."""
     points, volumes = slab_particles(spec, cfg)
     if len(points) == 0:
-        raise InputError(f"fluid.wall_model: the {spec.name} vessel's wall ({spec.wall_thickness:.4g} m) holds no dummy "
-                         f"particle at spacing {cfg.spacing:.4g} m under 'real_thickness' (a wall needs to be thicker than "
-                         "dx / 2; or 'kernel_layers')")
+        raise InputError(f"fluid.wall_model: the {spec.name} vessel's wall ({spec.wall_thickness:.4g} m) holds no "
+                         f"dummy particle at spacing {cfg.spacing:.4g} m under 'real_thickness' (a wall needs to be "
+                         "thicker than dx / 2; or 'kernel_layers')")
     if covers_support(spec, cfg):
         return points, volumes
     return points, fit_wall_volumes(spec, cfg, points, volumes)
@@ -233,8 +236,8 @@ def wall_rest_offsets(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, vo
     over the vessel's own particles ``points`` (volumes ``volumes``) and the liquid's initial lattice filling the
     vessel to its rim (the points :func:`fit_wall_volumes` fits at; s: a resting lattice's kernel sum, as the
     solver divides by). A wall thinner than the kernel support lacks the layers behind its particles, so liquid at
-    rest against it leaves them short (0.76 rho0 at 32 across, less at inner corners); held to rho0 they would never
-    be compressed. Walls covering the support need no offset (zeros)."""
+    rest against it leaves them short (0.79 rho0 for one layer, 0.59 at the inner corners); held to rho0 they would
+    never be compressed. Walls covering the support need no offset (zeros)."""
     from cosim.fluid.seeding import fill_vessel
 
     if covers_support(spec, cfg):
