@@ -54,7 +54,7 @@ onto it, and the column settles low (a thin wall cannot hold them off at all); m
 onto the wall is not a constraint gradient and blows a resting column up (the measurements:
 docs/physics-and-validation.md, Design notes). The deeper layers lack the layers beyond the last in their kernel
 support, so they only contribute density. A wall thinner than the support lacks those layers behind its facing one
-too: liquid resting against it sums it to 0.76 rho0 (32 across), so held to rho0 it is never compressed and carries
+too: liquid resting against it sums it to 0.79 rho0 (one layer), so held to rho0 it is never compressed and carries
 nothing; ``FluidConfig.wall_pressure`` 'solved_rest_sum' holds each of its particles to that rest sum instead (its
 summation density plus ``FluidModel.b_rest_offset``, as the liquid's surface rows keep their seeded deficiency). The
 stiffness each particle applied over both solves, kappa_i, is kept: it gives the reported pressure p_i = rho_i

@@ -7,10 +7,13 @@ The walls hold layers of dummy particles (Adami, Hu & Adams 2012), filled one of
   wetted face. Where the vessel's wall is thinner than that, the layers extend beyond its outer face: the liquid
   sees a wall ``numerical_wall_thickness`` thick (the inner faces, which hold the liquid, are exact; the outer faces
   and the pour lip move outwards by the difference).
-- ``real_thickness``: the layers fill the vessel's own wall and nothing beyond it, round(t / dx) of them (at least
-  one) across a wall t thick, so the outer faces and the pour lip are the vessel's. A wall thinner than the kernel
-  support then lacks the particles behind it that a liquid particle near its face would sum over; their volumes
-  are fitted to make that up (:func:`fit_wall_volumes`).
+- ``real_thickness``: the same lattice, the liquid's own continued behind every wetted face (layers at depths
+  dx/2, 3 dx/2, ... as Adami, Hu & Adams 2012 place theirs), kept only where it lies inside the vessel's own wall
+  (depth behind the inner faces at most t), so the outer faces and the pour lip are the vessel's: the layers whose
+  centres fit in the wall, at least one, which needs t >= dx/2 (as a mesh wall's, :mod:`cosim.fluid.mesh_sampling`).
+  A wall thinner than the kernel support then lacks the particles behind it that a liquid particle near its face
+  would sum over; their volumes are fitted to make that up (:func:`fit_wall_volumes`). On the liquid's lattice the
+  kept layer sits where the covering walls' first layer sits, so the fit only has to scale it.
 
 Layers sit below the rim, so liquid flowing over the rim sees the wall beneath it. In 2-D only the section in the
 pour plane (local y = 0) is filled: the floor and the +x / -x walls; a cylinder's section is that of a box of width
@@ -93,8 +96,11 @@ def fit_wall_volumes(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, vol
     reach of the walls: FIT_SWEEPS multiplicative sweeps V_b <- V_b sum_p W_pb S_ref(p) / S(p) / sum_p W_pb (each
     particle scaled by the mean shortfall of the probes it reaches, weighted by its kernel there; volumes stay
     positive). Inner edges and corners, where the missing support is largest, get the largest volumes. Particles no
-    probe reaches keep their slab volumes. One volume per particle cannot also match the kernel-gradient sums, nor
-    the sums of the wall particles themselves, which lack the layers behind them (docs/walls.md).
+    probe reaches keep their slab volumes. The kept layers lie where the covering walls' first layers lie (module
+    doc), so the fitted sums match theirs to 0.26 % of rho0 for one layer: the liquid seeded against the wall is
+    compressed by at most that, which DFSPH (correcting any compression at once) removes without setting it moving.
+    One volume per particle cannot also match the kernel-gradient sums, nor the sums of the wall particles
+    themselves, which lack the layers behind them (docs/walls.md).
     """
     from cosim.fluid.seeding import fill_vessel
 
@@ -162,12 +168,14 @@ def _fill_disc(radius: float, z0: float, z1: float, step: float) -> tuple[np.nda
 
 def slab_particles(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
     """The walls' dummy particles (n, 3) in the vessel frame and their slab volumes (n,) (m^dim), before any fit
-    (:func:`sample_vessel_walls`)."""
+    (:func:`sample_vessel_walls`). Box and cylinder walls are filled as ``kernel_layers`` fills them (at least the
+    vessel's own thickness); under ``real_thickness`` only the particles inside the vessel's own wall are kept."""
     h = spec.inner_height
-    t = numerical_wall_thickness(spec, cfg)
     spacing, dim = cfg.spacing, cfg.dim
+    confined = cfg.wall_model is WallModel.REAL_THICKNESS
     if spec.is_mesh:
-        return sample_mesh_walls(spec, spacing, t, dim, confined=cfg.wall_model is WallModel.REAL_THICKNESS)
+        return sample_mesh_walls(spec, spacing, numerical_wall_thickness(spec, cfg), dim, confined=confined)
+    t = numerical_wall_thickness(spec, replace(cfg, wall_model=WallModel.KERNEL_LAYERS))
     if dim == 2 or spec.is_box:
         b = 0.5 * spec.inner_width
         d = 0.5 * spec.section_depth
@@ -182,7 +190,24 @@ def slab_particles(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.n
     else:
         r = 0.5 * spec.inner_width
         parts = [_fill_disc(r + t, -t, 0.0, spacing), _fill_cylinder_shells(r, r + t, 0.0, h, spacing)]
-    return np.concatenate([p for p, _ in parts]), np.concatenate([v for _, v in parts])
+    points, volumes = np.concatenate([p for p, _ in parts]), np.concatenate([v for _, v in parts])
+    if confined:
+        inside = _depths_outside(spec, points, dim).max(axis=1) <= spec.wall_thickness * (1.0 + 1e-9)
+        points, volumes = points[inside], volumes[inside]
+    return points, volumes
+
+
+def _depths_outside(spec: VesselSpec, points: np.ndarray, dim: int) -> np.ndarray:
+    """(n, k) m: how far each vessel-frame point of a box or cylinder lies outside the inner volume along each
+    wall's normal (|x| - b, then |y| - d for a 3-D box, or r - R for a cylinder; -z), zero on the inner side. The
+    largest is the depth inside a wall solid of any thickness, their norm the distance to the inner volume."""
+    x, y, z = points[:, 0], points[:, 1], points[:, 2]
+    below = np.maximum(-z, 0.0)
+    if dim == 2 or spec.is_box:
+        out_x = np.maximum(np.abs(x) - 0.5 * spec.inner_width, 0.0)
+        out_y = np.maximum(np.abs(y) - 0.5 * spec.section_depth, 0.0) if dim == 3 else np.zeros_like(y)
+        return np.stack([out_x, out_y, below], axis=1)
+    return np.stack([np.maximum(np.hypot(x, y) - 0.5 * spec.inner_width, 0.0), below], axis=1)
 
 
 def covers_support(spec: VesselSpec, cfg: FluidConfig) -> bool:
@@ -194,11 +219,11 @@ def covers_support(spec: VesselSpec, cfg: FluidConfig) -> bool:
 def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
     """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim), for ``cfg``'s spacing,
     kernel support, dimension and wall model; a thin wall's volumes fitted (:func:`fit_wall_volumes`). Raises
-    InputError for a mesh wall too thin to hold a layer."""
+    InputError for a wall too thin to hold a layer."""
     points, volumes = slab_particles(spec, cfg)
     if len(points) == 0:
-        raise InputError(f"fluid.wall_model: the {spec.name} vessel's wall ({spec.wall_thickness:.4g} m) holds no dummy "
-                         f"particle at spacing {cfg.spacing:.4g} m under 'real_thickness' (a mesh wall needs to be "
+        raise InputError(f"fluid.wall_model: the {spec.name} vessel's wall ({spec.wall_thickness:.4g} m) holds no "
+                         f"dummy particle at spacing {cfg.spacing:.4g} m under 'real_thickness' (a wall needs to be "
                          "thicker than dx / 2; or 'kernel_layers')")
     if covers_support(spec, cfg):
         return points, volumes
@@ -211,8 +236,8 @@ def wall_rest_offsets(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, vo
     over the vessel's own particles ``points`` (volumes ``volumes``) and the liquid's initial lattice filling the
     vessel to its rim (the points :func:`fit_wall_volumes` fits at; s: a resting lattice's kernel sum, as the
     solver divides by). A wall thinner than the kernel support lacks the layers behind its particles, so liquid at
-    rest against it leaves them short (0.76 rho0 at 32 across, less at inner corners); held to rho0 they would never
-    be compressed. Walls covering the support need no offset (zeros)."""
+    rest against it leaves them short (0.79 rho0 for one layer, 0.59 at the inner corners); held to rho0 they would
+    never be compressed. Walls covering the support need no offset (zeros)."""
     from cosim.fluid.seeding import fill_vessel
 
     if covers_support(spec, cfg):
@@ -231,13 +256,4 @@ def wetted_layer(spec: VesselSpec, points: np.ndarray, spacing: float, dim: int)
     the last), so only it can be held to rest density (DFSPH's pressure-carrying wall, ``cosim.fluid.dfsph``)."""
     if spec.is_mesh:
         return mesh_wetted_layer(spec, points, spacing)
-    x, y, z = points[:, 0], points[:, 1], points[:, 2]
-    below = np.maximum(-z, 0.0)
-    if dim == 2 or spec.is_box:
-        out_x = np.maximum(np.abs(x) - 0.5 * spec.inner_width, 0.0)
-        out_y = np.maximum(np.abs(y) - 0.5 * spec.section_depth, 0.0) if dim == 3 else np.zeros_like(y)
-        distance = np.sqrt(out_x**2 + out_y**2 + below**2)
-    else:
-        out_r = np.maximum(np.hypot(x, y) - 0.5 * spec.inner_width, 0.0)
-        distance = np.hypot(out_r, below)
-    return distance < spacing
+    return np.linalg.norm(_depths_outside(spec, points, dim), axis=1) < spacing
