@@ -324,7 +324,7 @@ def divergence_error(prm: SPHParams, past_rest: int, rate_error: float, rho: flo
     divergence_constraint 'past_rest_density') only the rate past that slack is removed,
     max(rate_error - max(rho0 - rho, 0), 0): a particle at or above rest density is treated as before, a rarefied one
     may close by its shortfall within the step (SPlisHSPlasH skips the divergence solve outright for a particle short
-    of neighbours, fewer than 7 in 2-D and 20 in 3-D; this is the same idea measured by the density itself)."""
+    of neighbours, fewer than 7 in 2-D and 20 in 3-D; here the density itself measures the deficiency)."""
     if past_rest != 0:
         return wp.max(rate_error - wp.max(prm.rest_density - rho, 0.0), 0.0)
     return wp.max(rate_error, 0.0)
