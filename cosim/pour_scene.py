@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, PressureSolver, WallModel, WallPressure
+from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, DivergenceConstraint, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, PressureSolver, WallModel, WallPressure
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -89,6 +89,7 @@ class FluidSettings:
     # ---- DFSPH
     density_iteration: DensityIteration = like(FluidConfig, "density_iteration")
     density_tolerance: float | None = like(FluidConfig, "density_tolerance")
+    divergence_constraint: DivergenceConstraint = like(FluidConfig, "divergence_constraint")
     divergence_tolerance: float = like(FluidConfig, "divergence_tolerance")
     wall_pressure: WallPressure = like(FluidConfig, "wall_pressure")
     max_solver_iterations: int = like(FluidConfig, "max_solver_iterations")

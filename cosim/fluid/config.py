@@ -85,6 +85,13 @@ class DensityIteration(Enum):
     JACOBI = "jacobi"  # every particle at once from the last iteration's velocities (Bender & Koschier's)
 
 
+class DivergenceConstraint(Enum):
+    """Which density rates DFSPH's divergence solve removes (``cosim.fluid.dfsph.divergence_error``)."""
+
+    EVERY_COMPRESSION = "every_compression"  # every compressing rate (Bender & Koschier 2017)
+    PAST_REST_DENSITY = "past_rest_density"  # only the rate that would compress the particle past rho0 within the step
+
+
 # The density solve's stopping tolerance when none is given, per iteration (see FluidConfig.density_tolerance): the
 # two measure differently (a Gauss-Seidel sweep measures each particle before relaxing it, after the particles
 # before it), so each has its own, chosen by the validations (docs/benchmarks.md, docs/performance.md).
@@ -236,6 +243,14 @@ class FluidConfig:
                                               lo_open=True, kind="float", none_means="the density iteration's own, "
                                               + ", ".join(f"{t:g} for {it.value!r}" for it, t in
                                                           DEFAULT_DENSITY_TOLERANCE.items()))
+    divergence_constraint: DivergenceConstraint = setting(
+        DivergenceConstraint.EVERY_COMPRESSION, DFSPH, "Which density rates the divergence solve removes: "
+        "'every_compression' (every compressing rate, dt Drho/Dt > 0, Bender & Koschier 2017: liquid below rest "
+        "density is held at the density it has, so a loose packing, such as liquid that landed in a splash, is never "
+        "closed and stands taller than its volume) or 'past_rest_density' (only the rate that would compress the "
+        "particle past rest density within the step, dt Drho/Dt > rho0 - rho_i: liquid below rest density closes "
+        "under its weight, as the density solve, which corrects compression only, lets it; "
+        "docs/divergence_constraint.md).")
     divergence_tolerance: float = setting(0.001, DFSPH, "The divergence solve stops when the average density rate "
                                           "times dt, over rho0, is below this (Bender & Koschier's 0.1 % per step).",
                                           "", 0.0, 0.05, lo_open=True)

@@ -40,7 +40,9 @@ One Jacobi iteration, for stiffness increments k_i (m^2/s^2, a pressure over den
   Drho_i/Dt = sum_j m_j (v_i - v_j) . grad W_ij + sum_b rho0 V_b (v_i - v_b) . grad W_ib   (wall velocity v_b: the
   moving vessel enters the divergence term),
   v_i -= dt [sum_j m_j (k_i / rho_i + k_j / rho_j) grad W_ij + sum_b rho0 V_b (k_i / rho_i + k_b / rho_b) grad W_ib].
-Only compression is corrected (e_i >= 0): a free surface's kernel deficiency is not a pressure.
+Only compression is corrected (e_i >= 0): a free surface's kernel deficiency is not a pressure. The divergence solve
+removes every compressing rate, or with ``divergence_constraint`` 'past_rest_density' only the part that would carry
+the particle past rest density within the step (:func:`divergence_error`).
 
 Pressure-carrying walls (Band et al. 2018 solve boundary pressures with the liquid's; this is that idea in DFSPH's
 constraint form): the layer of dummy wall particles that faces the liquid (``FluidModel.b_wetted``) is held to rest
@@ -313,6 +315,22 @@ def error_quanta(relative: float) -> wp.int64:
 
 
 @wp.func
+def divergence_error(prm: SPHParams, past_rest: int, rate_error: float, rho: float) -> float:
+    """The density-rate error the divergence solve removes from particle i (kg/m^3), from ``rate_error`` = dt
+    Drho_i/Dt and the density ``rho`` the solves hold it to. Bender & Koschier (2017) remove every compressing rate,
+    max(rate_error, 0): the velocities are made divergence-free wherever they compress. Where rho < rho0 the density
+    constraint rho <= rho0 (the density solve's, compression only) is not active, and holding the rate at zero
+    there keeps the particle at the density it has: a loose packing never closes. With ``past_rest`` (FluidConfig
+    divergence_constraint 'past_rest_density') only the rate past that slack is removed,
+    max(rate_error - max(rho0 - rho, 0), 0): a particle at or above rest density is treated as before, a rarefied one
+    may close by its shortfall within the step (SPlisHSPlasH skips the divergence solve outright for a particle short
+    of neighbours, fewer than 7 in 2-D and 20 in 3-D; here the density itself measures the deficiency)."""
+    if past_rest != 0:
+        return wp.max(rate_error - wp.max(prm.rest_density - rho, 0.0), 0.0)
+    return wp.max(rate_error, 0.0)
+
+
+@wp.func
 def liquid_density_rate(
     i: int,
     v: wp.array(dtype=wp.vec3),
@@ -395,6 +413,7 @@ def compute_solve_error(
     # Model
     prm: SPHParams,
     mode: int,
+    past_rest: int,
     # State in
     v: wp.array(dtype=wp.vec3),
     rho: wp.array(dtype=float),
@@ -410,8 +429,9 @@ def compute_solve_error(
     increment_per_rho: wp.array(dtype=float),
     solve_stats: wp.array(dtype=wp.int64),
 ):
-    """Each particle's remaining error e_i (``mode`` SOLVE_DIVERGENCE: dt Drho/Dt; SOLVE_DENSITY: rho_i - rho0 +
-    dt Drho/Dt; only compression: e_i >= 0), its next stiffness increment omega e_i alpha_i / dt^2 (omega:
+    """Each particle's remaining error e_i (``mode`` SOLVE_DIVERGENCE: dt Drho/Dt, its compressing part or with
+    ``past_rest`` the part past rest density, :func:`divergence_error`; SOLVE_DENSITY: rho_i - rho0 + dt Drho/Dt,
+    only compression: e_i >= 0), its next stiffness increment omega e_i alpha_i / dt^2 (omega:
     ``prm.jacobi_relaxation``, 1 unless the support holds so many neighbours that plain Jacobi would diverge) and the
     error sum."""
     i = wp.tid()
@@ -423,7 +443,9 @@ def compute_solve_error(
     e = h * liquid_density_rate(i, v, bv, pair_count, pair_index, pair_mass_grad)
     if mode == SOLVE_DENSITY:
         e += rho[i] - prm.rest_density
-    e = wp.max(e, 0.0)
+        e = wp.max(e, 0.0)
+    else:
+        e = divergence_error(prm, past_rest, e, rho[i])
     k_i = prm.jacobi_relaxation * e * alpha[i] / (h * h)
     increment[i] = k_i
     increment_per_rho[i] = k_i / rho[i]

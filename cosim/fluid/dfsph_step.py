@@ -22,7 +22,7 @@ import numpy as np
 import warp as wp
 
 from cosim.fluid import dfsph, wcsph
-from cosim.fluid.config import DensityIteration, InitialState, WallPressure
+from cosim.fluid.config import DensityIteration, DivergenceConstraint, InitialState, WallPressure
 from cosim.fluid.device_layout import pair_table
 from cosim.fluid.free_surface import free_liquid_mode
 from cosim.fluid.lanes import LANE_CHUNK, Lanes, PerLane
@@ -144,7 +144,8 @@ def jacobi_solve(
         apply_stiffness(rec, m, st, sh, sc, v, kappa)
         with rec.together():
             rec.launch(
-                dfsph.compute_solve_error, m.n_particles, prm=m.params, mode=mode, v=v, rho=st.rho, alpha=sc.alpha, active=st.active, dt=sh.dt,
+                dfsph.compute_solve_error, m.n_particles, prm=m.params, mode=mode,
+                past_rest=int(m.config.divergence_constraint is DivergenceConstraint.PAST_REST_DENSITY), v=v, rho=st.rho, alpha=sc.alpha, active=st.active, dt=sh.dt,
                 bv=sh.bv, pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_mass_grad=sc.pair_mass_grad,
                 increment=sc.increment, increment_per_rho=sc.increment_per_rho, solve_stats=sc.lane_stats,
             )
