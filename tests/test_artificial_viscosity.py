@@ -11,7 +11,7 @@ import pytest
 import warp as wp
 
 from cosim.cli.main import main
-from cosim.fluid.config import DEFAULT_ARTIFICIAL_VISCOSITY, GRAVITY, ArtificialViscosityScale, FluidConfig
+from cosim.fluid.config import DEFAULT_ARTIFICIAL_VISCOSITY, GRAVITY, SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY, ArtificialViscosityScale, FluidConfig
 from cosim.fluid.params import SPHParams, make_params
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
@@ -63,7 +63,8 @@ def test_dfsph_signal_velocity_is_the_gravity_wave_speed_plus_twice_the_approach
 
 def test_the_sound_speed_scale_is_c0_and_wcsph_keeps_it_with_either_setting():
     closing_speed = 0.3
-    for cfg in (_config(), _config(pressure_solver="wcsph"), _config(pressure_solver="wcsph", artificial_viscosity_scale="signal_velocity")):
+    for cfg in (_config(artificial_viscosity_scale="sound_speed"), _config(pressure_solver="wcsph"),
+                _config(pressure_solver="wcsph", artificial_viscosity_scale="signal_velocity")):
         a, gw = _pair(cfg, closing_speed)
         np.testing.assert_allclose(a, _monaghan(cfg, closing_speed, cfg.sound_speed, gw), rtol=1e-5, atol=0.0)
 
@@ -74,15 +75,18 @@ def test_a_receding_pair_feels_no_artificial_viscosity():
         assert np.all(a == 0.0)
 
 
-def test_an_unset_free_alpha_is_the_one_alpha():
+def test_an_unset_free_alpha_is_the_one_alpha_under_the_signal_velocity_and_its_own_under_c0():
     assert _config(free_artificial_viscosity=None).free_liquid_alpha == 0.5
     assert make_params(_config(free_artificial_viscosity=None), 0).alpha_free == 0.5
     assert make_params(_config(free_artificial_viscosity=0.25), 0).alpha_free == 0.25
+    for c0_scaled in (_config(artificial_viscosity_scale="sound_speed"), _config(pressure_solver="wcsph")):
+        assert c0_scaled.free_liquid_alpha == SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY
 
 
 def test_an_unset_alpha_is_the_velocity_scales_own():
-    assert FluidConfig().artificial_viscosity == DEFAULT_ARTIFICIAL_VISCOSITY[ArtificialViscosityScale.SOUND_SPEED]
     signal = DEFAULT_ARTIFICIAL_VISCOSITY[ArtificialViscosityScale.SIGNAL_VELOCITY]
+    assert FluidConfig().artificial_viscosity == signal
+    assert FluidConfig(artificial_viscosity_scale="sound_speed").artificial_viscosity == DEFAULT_ARTIFICIAL_VISCOSITY[ArtificialViscosityScale.SOUND_SPEED]
     assert FluidConfig(artificial_viscosity_scale="signal_velocity").artificial_viscosity == signal
     assert FluidConfig(artificial_viscosity_scale="signal_velocity", pressure_solver="wcsph").artificial_viscosity == 0.01  # c0
 
@@ -92,9 +96,9 @@ def _cfl_and_force_step(cfg: FluidConfig, flow_speed: float, max_accel: float) -
     return min(cfg.cfl * h / flow_speed, FORCE_CFL * math.sqrt(h / max_accel))
 
 
-def test_the_viscous_criterion_leaves_the_default_step_alone():
+def test_the_viscous_criterion_leaves_the_c0_scaled_step_alone():
     # alpha 0.25 c0 (c0 = 10 v): dt_visc = 0.4 h / v against the CFL's 0.25 h / v
-    cfg = FluidConfig(dim=2, spacing=SPACING, max_expected_speed=1.0)
+    cfg = FluidConfig(dim=2, spacing=SPACING, max_expected_speed=1.0, artificial_viscosity_scale="sound_speed")
     assert stable_time_step(cfg, 0.0, 1.5, 10.0) == _cfl_and_force_step(cfg, 1.5, 10.0)
 
 
@@ -142,9 +146,9 @@ def test_the_validation_cases_take_the_viscosity_settings(capsys):
     argv = ["validate", "hydrostatic", "--spacing", "0.0125", "--width", "0.1", "--fill", "0.05", "--no-plot", "--json"]
     assert main(argv) == 0
     default = json.loads(capsys.readouterr().out)["cases"][0]
-    assert main([*argv, "--artificial-viscosity-scale", "signal_velocity", "--free-artificial-viscosity", "none"]) == 0
-    signal = json.loads(capsys.readouterr().out)["cases"][0]
-    assert signal["pressure"] != default["pressure"]
+    assert main([*argv, "--artificial-viscosity-scale", "sound_speed", "--free-artificial-viscosity", "0.25"]) == 0
+    sound_speed = json.loads(capsys.readouterr().out)["cases"][0]
+    assert sound_speed["pressure"] != default["pressure"]
 
 
 @pytest.mark.parametrize("flag, value", [("--free-artificial-viscosity", "abc"), ("--free-artificial-viscosity", "2"),

@@ -88,8 +88,8 @@ class DensityIteration(Enum):
 class DivergenceConstraint(Enum):
     """Which density rates DFSPH's divergence solve removes (``cosim.fluid.dfsph.divergence_error``)."""
 
-    EVERY_COMPRESSION = "every_compression"  # every compressing rate (Bender & Koschier 2017)
     PAST_REST_DENSITY = "past_rest_density"  # only the rate that would compress the particle past rho0 within the step
+    EVERY_COMPRESSION = "every_compression"  # every compressing rate (Bender & Koschier 2017)
 
 
 # The density solve's stopping tolerance when none is given, per iteration (see FluidConfig.density_tolerance): the
@@ -105,6 +105,11 @@ APPROACH_WEIGHT = 2.0
 # alpha is a viscosity about c0 / sqrt(g h) (~100) times as large on c0, so each scale has its own, chosen by the
 # validations (docs/artificial_viscosity.md).
 DEFAULT_ARTIFICIAL_VISCOSITY = {ArtificialViscosityScale.SOUND_SPEED: 0.01, ArtificialViscosityScale.SIGNAL_VELOCITY: 1.0}
+# Monaghan's alpha of pairs with free liquid under c0 when none is given (FluidConfig.free_artificial_viscosity): c0
+# does not grow with an impact, so the free liquid's impacts need their own, larger alpha (a value set on the pour,
+# docs/artificial_viscosity.md). The signal velocity's approach term damps impacts wherever they happen, so under it
+# one alpha serves all liquid.
+SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY = 0.25
 
 # The concerns the settings are grouped by, in the order references list them.
 DISCRETISATION = "discretisation"
@@ -174,7 +179,7 @@ class FluidConfig:
                                                                      DEFAULT_ARTIFICIAL_VISCOSITY.items())
                                                  + " (WCSPH, whose scale is c0 either way: the first)")
     artificial_viscosity_scale: ArtificialViscosityScale = setting(
-        ArtificialViscosityScale.SOUND_SPEED, PRESSURE, "The artificial viscosity's velocity scale v_sig (its "
+        ArtificialViscosityScale.SIGNAL_VELOCITY, PRESSURE, "The artificial viscosity's velocity scale v_sig (its "
         "kinematic viscosity is about alpha h v_sig / (2 (dim + 2)), Monaghan 2005): 'sound_speed', c0 (WCSPH: the "
         "equation of state's signal speed; DFSPH, which has no equation of state: the same c0 from "
         "max_expected_speed, a scene estimate) or 'signal_velocity': WCSPH keeps its c0, DFSPH takes Monaghan "
@@ -206,12 +211,15 @@ class FluidConfig:
                                             "the validation cases: below a resting surface's 0.5, which DFSPH's "
                                             "hydrostatic column needs bound; WCSPH's free fall needs 0.75 "
                                             "(docs/free_surface.md).", "", 0.0, 1.0)
-    free_artificial_viscosity: float | None = setting(0.25, PRESSURE, "Monaghan's alpha of every pair with a free "
+    free_artificial_viscosity: float | None = setting(None, PRESSURE, "Monaghan's alpha of every pair with a free "
                                                       "particle (and of a free particle against walls): free liquid "
                                                       "has no tension, so this makes its impacts inelastic; alpha acts "
                                                       "only on approaching pairs, so a separating stream flies free.",
-                                                      "", 0.0, 1.0, kind="float", none_means="artificial_viscosity, "
-                                                      "one alpha for all liquid")
+                                                      "", 0.0, 1.0, kind="float", none_means="the velocity scale's "
+                                                      "own: artificial_viscosity, one alpha for all liquid, with the "
+                                                      "signal velocity (its approach term damps impacts); "
+                                                      f"{SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY:g} with c0 (WCSPH, or "
+                                                      "DFSPH's 'sound_speed')")
     initial_state: InitialState = setting(InitialState.SEEDED, PRESSURE, "How the liquid starts: 'seeded' (from "
                                           "its seeded lattice; DFSPH holds each bound particle to the kernel deficiency "
                                           "it was seeded with, so the surface rows stay at their seeded spacing) or "
@@ -244,7 +252,7 @@ class FluidConfig:
                                               + ", ".join(f"{t:g} for {it.value!r}" for it, t in
                                                           DEFAULT_DENSITY_TOLERANCE.items()))
     divergence_constraint: DivergenceConstraint = setting(
-        DivergenceConstraint.EVERY_COMPRESSION, DFSPH, "Which density rates the divergence solve removes: "
+        DivergenceConstraint.PAST_REST_DENSITY, DFSPH, "Which density rates the divergence solve removes: "
         "'every_compression' (every compressing rate, dt Drho/Dt > 0, Bender & Koschier 2017: liquid below rest "
         "density is held at the density it has, so a loose packing, such as liquid that landed in a splash, is never "
         "closed and stands taller than its volume) or 'past_rest_density' (only the rate that would compress the "
@@ -330,8 +338,11 @@ class FluidConfig:
 
     @property
     def free_liquid_alpha(self) -> float:
-        """Monaghan's alpha of pairs with free liquid: ``free_artificial_viscosity``, or the one alpha where unset."""
-        return self.artificial_viscosity if self.free_artificial_viscosity is None else self.free_artificial_viscosity
+        """Monaghan's alpha of pairs with free liquid: ``free_artificial_viscosity``; where unset, the one alpha under
+        the signal velocity, :data:`SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY` under c0."""
+        if self.free_artificial_viscosity is not None:
+            return self.free_artificial_viscosity
+        return self.artificial_viscosity if self.signal_velocity_viscosity else SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY
 
     @property
     def signal_velocity_viscosity(self) -> bool:
