@@ -38,7 +38,7 @@ from cosim.fluid.runner import SubstepRunner
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
 from cosim.fluid.substep import SubstepScratch
-from cosim.fluid.time_step import split_interval, stable_time_step
+from cosim.fluid.time_step import TimeStepPlanner, split_interval
 from cosim.fluid.wcsph_step import WCSPHStep
 from cosim.frames import Pose, rotation_vector, rotation_y, tilt_about_y, vector_norm
 from cosim.vessel import VesselSpec
@@ -110,6 +110,7 @@ class FluidSolver:
         self._lin_vel = self._ang_vel = np.zeros((len(vessels), 3))
         self._last_max_speed = 0.0
         self._last_max_accel = config.gravity_magnitude
+        self._time_steps = TimeStepPlanner(config)
         self._history: list[tuple[np.ndarray, SubstepRows]] = []
         self._last_report: IntervalReport | None = None
         self._wrench = np.zeros((len(vessels), 6))
@@ -182,7 +183,7 @@ class FluidSolver:
     def plan_time_step(self, duration: float, wall_speed: float) -> tuple[int, float]:
         """(substeps, dt) for an interval of ``duration`` s with walls moving at up to ``wall_speed`` m/s
         (``cosim.fluid.time_step``); raises :class:`FluidInstabilityError` below ``min_time_step``."""
-        dt = stable_time_step(self.config, wall_speed, self._last_max_speed, self._last_max_accel)
+        dt = self._time_steps.stable_time_step(wall_speed, self._last_max_speed, self._last_max_accel)
         if dt < self.config.min_time_step:
             raise FluidInstabilityError(self.step_count, self.time, f"time step collapsed to {dt:.3g} s (< fluid.min_time_step)")
         return split_interval(duration, dt)
