@@ -40,7 +40,7 @@ from cosim.fluid.seeding import ParticleSet
 from cosim.fluid.substep import SubstepScratch
 from cosim.fluid.time_step import TimeStepPlanner, split_interval
 from cosim.fluid.wcsph_step import WCSPHStep
-from cosim.frames import Pose, rotation_vector, rotation_y, tilt_about_y, vector_norm
+from cosim.frames import Pose, rotation_vector, rotation_y, tilt_about_y
 from cosim.vessel import VesselSpec
 
 __all__ = ["FluidInstabilityError", "FluidSolver", "IntervalReport"]
@@ -98,6 +98,7 @@ class FluidSolver:
             raise InputError("fluid.domain_min[1]..domain_max[1]: must contain y = 0 (the pour plane) in 2-D")
         self.config = config
         self.device = resolve_device(device)
+        self._synchronize = self.device.is_cuda  # after the substeps, for their wall time
         dfsph = config.pressure_solver is PressureSolver.DFSPH
         self.layout = layout or layout_for(self.device, dfsph and config.density_iteration is DensityIteration.GAUSS_SEIDEL)
         self.n_particles = len(particles)
@@ -111,7 +112,7 @@ class FluidSolver:
         self._last_max_speed = 0.0
         self._last_max_accel = config.gravity_magnitude
         self._time_steps = TimeStepPlanner(config)
-        self._history: list[tuple[np.ndarray, SubstepRows]] = []
+        self._history: list[tuple[int, float, SubstepRows]] = []  # each interval's substeps, their dt (s), their rows
         self._last_report: IntervalReport | None = None
         self._wrench = np.zeros((len(vessels), 6))
         with allocation_failure_refused(self.device):
@@ -193,9 +194,11 @@ class FluidSolver:
         if not (duration > 0.0 and math.isfinite(duration)):
             raise InputError(f"fluid.advance: duration must be > 0 s, got {duration}")
         m = self.model
-        lin = np.array([(t.position - p.position) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
-        ang = np.array([rotation_vector(t.rotation @ p.rotation.T) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
-        wall_speed = max((vector_norm(lin[k]) + vector_norm(ang[k]) * m.b_reach[k] for k in range(m.n_vessels)), default=0.0)
+        # (V, 3) velocities, divided once for all vessels; each norm sqrt(v . v) on the row itself (the bits of
+        # ``vector_norm``, whose dispatch would cost more than the arithmetic)
+        lin = np.array([t.position - p.position for p, t in zip(self._poses, self._targets)]).reshape(-1, 3) / duration
+        ang = np.array([rotation_vector(t.rotation @ p.rotation.T) for p, t in zip(self._poses, self._targets)]).reshape(-1, 3) / duration
+        wall_speed = max((math.sqrt(v.dot(v)) + math.sqrt(w.dot(w)) * reach for v, w, reach in zip(lin, ang, m.b_reach)), default=0.0)
         n_sub, dt = self.plan_time_step(duration, wall_speed)
         self.scratch.set_motions(self._poses, lin, ang, (lin - self._lin_vel) / duration, (ang - self._ang_vel) / duration)
         self._lin_vel, self._ang_vel = lin, ang
@@ -205,7 +208,7 @@ class FluidSolver:
         self.scratch.begin_interval(dt)
         start = time.perf_counter()
         self.runner.run(n_sub)
-        if self.device.is_cuda:
+        if self._synchronize:
             wp.synchronize_device(self.device)  # the diagnostics copy below waits for the device anyway
         self.substep_wall_time += time.perf_counter() - start
         self.runner.capture_if_due()
@@ -213,7 +216,7 @@ class FluidSolver:
         first, t0 = self.step_count, self.time
         self.step_count += n_sub
         self.time += duration
-        self._history.append((np.full(n_sub, dt), rows))
+        self._history.append((n_sub, dt, rows))
         self._wrench = self.scratch.mean_wrench(m.n_vessels, n_sub)
         self.energy_account.update(
             float(rows.kinetic_energy[-1] + rows.internal_energy[-1]), float(rows.potential_energy[-1]), float(rows.removed_energy.sum()),
@@ -328,8 +331,8 @@ class FluidSolver:
         its solves left, 'divergence_error', 'density_solve_error' (relative; zero under WCSPH)."""
         if not self._history:
             return {}
-        dt = np.concatenate([h[0] for h in self._history])
-        rows = SubstepRows.concatenate([h[1] for h in self._history])
+        dt = np.concatenate([np.full(n_sub, step) for n_sub, step, _ in self._history])
+        rows = SubstepRows.concatenate([h[2] for h in self._history])
         return {
             "dt": dt,
             "time": np.cumsum(dt),
