@@ -130,11 +130,17 @@ class FluidSolver:
 
     # ---- set-up ----------------------------------------------------------------------------------------------
     def _planar(self, pose: Pose) -> Pose:
+        """``pose`` as the solver keeps it: its own copy, projected onto the pour plane in 2-D, its arrays read-only
+        (:meth:`vessel_poses` hands the solver's poses out without copying them)."""
         if self.config.dim == 3:
-            return Pose(pose.position, pose.rotation)
-        pos = pose.position.copy()
-        pos[1] = 0.0
-        return Pose(pos, rotation_y(tilt_about_y(pose.rotation)))
+            planar = Pose(pose.position, pose.rotation)
+        else:
+            pos = pose.position.copy()
+            pos[1] = 0.0
+            planar = Pose(pos, rotation_y(tilt_about_y(pose.rotation)))
+        planar.position.flags.writeable = False
+        planar.rotation.flags.writeable = False
+        return planar
 
     def _seeded_state(self, particles: ParticleSet) -> FluidState:
         state = FluidState.allocate(self.n_particles, self.device)
@@ -302,8 +308,9 @@ class FluidSolver:
         return self._in_id_order(self.scratch.free_surface).astype(np.float64)
 
     def vessel_poses(self) -> list[Pose]:
-        """Current world poses of the vessel frames (as simulated: projected onto the pour plane in 2-D)."""
-        return [Pose(p.position, p.rotation) for p in self._poses]
+        """Current world poses of the vessel frames (as simulated: projected onto the pour plane in 2-D): the solver's
+        own, whose arrays are read-only (a later interval's poses are new objects, so a pose kept stays as it was)."""
+        return list(self._poses)
 
     def wall_particles(self) -> np.ndarray:
         """(Nb, 3) m: world positions of the dummy wall particles at the current poses."""
