@@ -135,9 +135,8 @@ class FluidSolver:
         if self.config.dim == 3:
             planar = Pose(pose.position, pose.rotation)
         else:
-            pos = pose.position.copy()
-            pos[1] = 0.0
-            planar = Pose(pos, rotation_y(tilt_about_y(pose.rotation)))
+            planar = Pose(pose.position, rotation_y(tilt_about_y(pose.rotation)))  # Pose copies the position
+            planar.position[1] = 0.0
         planar.position.flags.writeable = False
         planar.rotation.flags.writeable = False
         return planar
@@ -177,9 +176,10 @@ class FluidSolver:
         if len(poses) != self.model.n_vessels:
             raise InputError(f"fluid: {self.model.n_vessels} vessels but {len(poses)} poses given")
         for k, pose in enumerate(poses):
-            if not (math.isfinite(pose.position.sum()) and math.isfinite(pose.rotation.sum())) and not (
+            if not (math.isfinite(np.add.reduce(pose.position)) and math.isfinite(np.add.reduce(pose.rotation, axis=None))) and not (
                 np.all(np.isfinite(pose.position)) and np.all(np.isfinite(pose.rotation))
-            ):  # a finite sum is the cheap proof (a NaN or inf propagates); an overflowing one is looked at closely
+            ):  # a finite sum (the ufunc's own, without ndarray.sum's wrappers) is the cheap proof (a NaN or inf
+                # propagates); an overflowing one is looked at closely
                 raise InputError(f"fluid: vessel {self.model.vessel_specs[k].name} pose is not finite")
         self._targets = [self._planar(p) for p in poses]
 
@@ -230,8 +230,8 @@ class FluidSolver:
         )
         self._poses = list(self._targets)
         check_interval(self.config, rows, first, t0, dt, self.energy_account.created)
-        self._last_max_speed = float(rows.max_speed.max())
-        self._last_max_accel = float(rows.max_acceleration.max())
+        self._last_max_speed = float(np.maximum.reduce(rows.max_speed))  # ndarray.max's own reduction, unwrapped
+        self._last_max_accel = float(np.maximum.reduce(rows.max_acceleration))
         n, volume = self.n_particles, self.config.particle_volume
         self._last_report = IntervalReport(n_sub, dt, lambda: rows.record(n_sub - 1, first + n_sub - 1, t0 + (n_sub - 1) * dt + dt, dt, n, volume))
         return self._last_report
