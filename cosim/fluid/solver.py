@@ -130,15 +130,11 @@ class FluidSolver:
 
     # ---- set-up ----------------------------------------------------------------------------------------------
     def _planar(self, pose: Pose) -> Pose:
-        """``pose`` as the solver keeps it: its own copy, projected onto the pour plane in 2-D, its arrays read-only
-        (:meth:`vessel_poses` hands the solver's poses out without copying them)."""
+        """``pose`` as the solver keeps it: its own copy, projected onto the pour plane in 2-D."""
         if self.config.dim == 3:
-            planar = Pose(pose.position, pose.rotation)
-        else:
-            planar = Pose(pose.position, rotation_y(tilt_about_y(pose.rotation)))  # Pose copies the position
-            planar.position[1] = 0.0
-        planar.position.flags.writeable = False
-        planar.rotation.flags.writeable = False
+            return Pose(pose.position, pose.rotation)
+        planar = Pose(pose.position, rotation_y(tilt_about_y(pose.rotation)))  # Pose copies the position
+        planar.position[1] = 0.0
         return planar
 
     def _seeded_state(self, particles: ParticleSet) -> FluidState:
@@ -308,9 +304,8 @@ class FluidSolver:
         return self._in_id_order(self.scratch.free_surface).astype(np.float64)
 
     def vessel_poses(self) -> list[Pose]:
-        """Current world poses of the vessel frames (as simulated: projected onto the pour plane in 2-D): the solver's
-        own, whose arrays are read-only (a later interval's poses are new objects, so a pose kept stays as it was)."""
-        return list(self._poses)
+        """Current world poses of the vessel frames (as simulated: projected onto the pour plane in 2-D)."""
+        return [Pose(p.position, p.rotation) for p in self._poses]
 
     def wall_particles(self) -> np.ndarray:
         """(Nb, 3) m: world positions of the dummy wall particles at the current poses."""
