@@ -93,12 +93,13 @@ _IDENTITY.flags.writeable = False
 
 
 def rotation_from_vector(w: np.ndarray) -> np.ndarray:
-    """Rotation matrix of an axis-angle vector (rad): the exp map (Rodrigues), the inverse of
+    """Rotation matrix of an axis-angle vector (3,) (rad): the exp map (Rodrigues), the inverse of
     :func:`rotation_vector`: ``R = I + sin(a) K + (1 - cos(a)) K K`` with ``a = |w|`` and ``K`` the cross-product
-    matrix of ``w / a`` (I below 1e-12 rad). The axis is taken apart as plain floats and the identity is made once
-    (the energy account calls this for every vessel every MuJoCo step): the same double operations, the same bits."""
+    matrix of ``w / a`` (I below 1e-12 rad). The angle is sqrt(w . w) of the vector itself (:func:`vector_norm`'s
+    operations without its dispatch), the axis is taken apart as plain floats and the identity is made once (the
+    energy account calls this for every vessel every MuJoCo step): the same double operations, the same bits."""
     w = np.asarray(w, dtype=float)
-    angle = float(vector_norm(w))
+    angle = math.sqrt(w.dot(w))
     if angle < 1e-12:
         return _IDENTITY.copy()
     k0, k1, k2 = (w / angle).tolist()

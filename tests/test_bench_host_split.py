@@ -2,6 +2,7 @@
 input refused."""
 
 import dataclasses
+import math
 
 import mujoco
 
@@ -40,3 +41,10 @@ def test_the_calls_per_step_are_counted_the_same_on_a_second_pour():
     first, second = host_split.calls_per_step(scene, 0.02), host_split.calls_per_step(scene, 0.02)
     assert first == second  # a pour's Python work is deterministic, whatever the machine's load
     assert 300 < first < 5000  # the step loop's few hundred to thousand calls a step, the substeps' replay one
+
+
+def test_the_host_work_median_pairs_each_interval_with_its_replay():
+    calls = {host_split.ADVANCE: [3.0, 5.0, 4.0], host_split.SUBSTEPS: [1.0, 1.0, 3.0]}
+    assert host_split.host_work_median(calls) == 2.0  # of 2, 4 and 1: not 4 - 1, the medians' difference
+    calls[host_split.SUBSTEPS].pop()  # an interval run without a replay (the one before the capture)
+    assert math.isnan(host_split.host_work_median(calls))

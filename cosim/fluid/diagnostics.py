@@ -199,4 +199,4 @@ class DiagnosticBuffers:
         written)."""
         used = substeps * self.replicas
         diag_f, diag_i = self._views or (read_lane_rows(self.f, used), read_lane_rows(self.i, used))
-        return SubstepRows(*combine_lanes(*(replicas_as_lanes(a, substeps, self.replicas) for a in (diag_f, diag_i))))
+        return SubstepRows(*combine_lanes(replicas_as_lanes(diag_f, substeps, self.replicas), replicas_as_lanes(diag_i, substeps, self.replicas)))

@@ -29,7 +29,7 @@ def check_interval(cfg: FluidConfig, rows: SubstepRows, first: int, t0: float, d
     ``max_density_error``; else for the interval's end where the energy the numerics created, ``energy_created``
     (M g L), exceeds ``max_energy_creation``."""
     if not (
-        rows.i[:, _STOPPING_COUNTS].any() or rows.max_compression.max() > cfg.max_density_error or energy_created > cfg.max_energy_creation
+        rows.i[:, _STOPPING_COUNTS].any() or np.maximum.reduce(rows.max_compression) > cfg.max_density_error or energy_created > cfg.max_energy_creation
     ):  # the usual interval, found in one pass
         return
     checks = [

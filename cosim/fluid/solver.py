@@ -38,9 +38,9 @@ from cosim.fluid.runner import SubstepRunner
 from cosim.fluid.runtime import resolve_device
 from cosim.fluid.seeding import ParticleSet
 from cosim.fluid.substep import SubstepScratch
-from cosim.fluid.time_step import split_interval, stable_time_step
+from cosim.fluid.time_step import TimeStepPlanner, split_interval
 from cosim.fluid.wcsph_step import WCSPHStep
-from cosim.frames import Pose, rotation_vector, rotation_y, tilt_about_y, vector_norm
+from cosim.frames import Pose, rotation_vector, rotation_y, tilt_about_y
 from cosim.vessel import VesselSpec
 
 __all__ = ["FluidInstabilityError", "FluidSolver", "IntervalReport"]
@@ -98,6 +98,7 @@ class FluidSolver:
             raise InputError("fluid.domain_min[1]..domain_max[1]: must contain y = 0 (the pour plane) in 2-D")
         self.config = config
         self.device = resolve_device(device)
+        self._synchronize = self.device.is_cuda  # after the substeps, for their wall time
         dfsph = config.pressure_solver is PressureSolver.DFSPH
         self.layout = layout or layout_for(self.device, dfsph and config.density_iteration is DensityIteration.GAUSS_SEIDEL)
         self.n_particles = len(particles)
@@ -110,7 +111,8 @@ class FluidSolver:
         self._lin_vel = self._ang_vel = np.zeros((len(vessels), 3))
         self._last_max_speed = 0.0
         self._last_max_accel = config.gravity_magnitude
-        self._history: list[tuple[np.ndarray, SubstepRows]] = []
+        self._time_steps = TimeStepPlanner(config)
+        self._history: list[tuple[int, float, SubstepRows]] = []  # each interval's substeps, their dt (s), their rows
         self._last_report: IntervalReport | None = None
         self._wrench = np.zeros((len(vessels), 6))
         with allocation_failure_refused(self.device):
@@ -128,11 +130,12 @@ class FluidSolver:
 
     # ---- set-up ----------------------------------------------------------------------------------------------
     def _planar(self, pose: Pose) -> Pose:
+        """``pose`` as the solver keeps it: its own copy, projected onto the pour plane in 2-D."""
         if self.config.dim == 3:
             return Pose(pose.position, pose.rotation)
-        pos = pose.position.copy()
-        pos[1] = 0.0
-        return Pose(pos, rotation_y(tilt_about_y(pose.rotation)))
+        planar = Pose(pose.position, rotation_y(tilt_about_y(pose.rotation)))  # Pose copies the position
+        planar.position[1] = 0.0
+        return planar
 
     def _seeded_state(self, particles: ParticleSet) -> FluidState:
         state = FluidState.allocate(self.n_particles, self.device)
@@ -169,9 +172,10 @@ class FluidSolver:
         if len(poses) != self.model.n_vessels:
             raise InputError(f"fluid: {self.model.n_vessels} vessels but {len(poses)} poses given")
         for k, pose in enumerate(poses):
-            if not (math.isfinite(pose.position.sum()) and math.isfinite(pose.rotation.sum())) and not (
+            if not (math.isfinite(np.add.reduce(pose.position)) and math.isfinite(np.add.reduce(pose.rotation, axis=None))) and not (
                 np.all(np.isfinite(pose.position)) and np.all(np.isfinite(pose.rotation))
-            ):  # a finite sum is the cheap proof (a NaN or inf propagates); an overflowing one is looked at closely
+            ):  # a finite sum (the ufunc's own, without ndarray.sum's wrappers) is the cheap proof (a NaN or inf
+                # propagates); an overflowing one is looked at closely
                 raise InputError(f"fluid: vessel {self.model.vessel_specs[k].name} pose is not finite")
         self._targets = [self._planar(p) for p in poses]
 
@@ -182,7 +186,7 @@ class FluidSolver:
     def plan_time_step(self, duration: float, wall_speed: float) -> tuple[int, float]:
         """(substeps, dt) for an interval of ``duration`` s with walls moving at up to ``wall_speed`` m/s
         (``cosim.fluid.time_step``); raises :class:`FluidInstabilityError` below ``min_time_step``."""
-        dt = stable_time_step(self.config, wall_speed, self._last_max_speed, self._last_max_accel)
+        dt = self._time_steps.stable_time_step(wall_speed, self._last_max_speed, self._last_max_accel)
         if dt < self.config.min_time_step:
             raise FluidInstabilityError(self.step_count, self.time, f"time step collapsed to {dt:.3g} s (< fluid.min_time_step)")
         return split_interval(duration, dt)
@@ -192,9 +196,11 @@ class FluidSolver:
         if not (duration > 0.0 and math.isfinite(duration)):
             raise InputError(f"fluid.advance: duration must be > 0 s, got {duration}")
         m = self.model
-        lin = np.array([(t.position - p.position) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
-        ang = np.array([rotation_vector(t.rotation @ p.rotation.T) / duration for p, t in zip(self._poses, self._targets)]).reshape(-1, 3)
-        wall_speed = max((vector_norm(lin[k]) + vector_norm(ang[k]) * m.b_reach[k] for k in range(m.n_vessels)), default=0.0)
+        # (V, 3) velocities, divided once for all vessels; each norm sqrt(v . v) on the row itself (the bits of
+        # ``vector_norm``, whose dispatch would cost more than the arithmetic)
+        lin = np.array([t.position - p.position for p, t in zip(self._poses, self._targets)]).reshape(-1, 3) / duration
+        ang = np.array([rotation_vector(t.rotation @ p.rotation.T) for p, t in zip(self._poses, self._targets)]).reshape(-1, 3) / duration
+        wall_speed = max((math.sqrt(v.dot(v)) + math.sqrt(w.dot(w)) * reach for v, w, reach in zip(lin, ang, m.b_reach)), default=0.0)
         n_sub, dt = self.plan_time_step(duration, wall_speed)
         self.scratch.set_motions(self._poses, lin, ang, (lin - self._lin_vel) / duration, (ang - self._ang_vel) / duration)
         self._lin_vel, self._ang_vel = lin, ang
@@ -204,7 +210,7 @@ class FluidSolver:
         self.scratch.begin_interval(dt)
         start = time.perf_counter()
         self.runner.run(n_sub)
-        if self.device.is_cuda:
+        if self._synchronize:
             wp.synchronize_device(self.device)  # the diagnostics copy below waits for the device anyway
         self.substep_wall_time += time.perf_counter() - start
         self.runner.capture_if_due()
@@ -212,7 +218,7 @@ class FluidSolver:
         first, t0 = self.step_count, self.time
         self.step_count += n_sub
         self.time += duration
-        self._history.append((np.full(n_sub, dt), rows))
+        self._history.append((n_sub, dt, rows))
         self._wrench = self.scratch.mean_wrench(m.n_vessels, n_sub)
         self.energy_account.update(
             float(rows.kinetic_energy[-1] + rows.internal_energy[-1]), float(rows.potential_energy[-1]), float(rows.removed_energy.sum()),
@@ -220,8 +226,8 @@ class FluidSolver:
         )
         self._poses = list(self._targets)
         check_interval(self.config, rows, first, t0, dt, self.energy_account.created)
-        self._last_max_speed = float(rows.max_speed.max())
-        self._last_max_accel = float(rows.max_acceleration.max())
+        self._last_max_speed = float(np.maximum.reduce(rows.max_speed))  # ndarray.max's own reduction, unwrapped
+        self._last_max_accel = float(np.maximum.reduce(rows.max_acceleration))
         n, volume = self.n_particles, self.config.particle_volume
         self._last_report = IntervalReport(n_sub, dt, lambda: rows.record(n_sub - 1, first + n_sub - 1, t0 + (n_sub - 1) * dt + dt, dt, n, volume))
         return self._last_report
@@ -327,8 +333,8 @@ class FluidSolver:
         its solves left, 'divergence_error', 'density_solve_error' (relative; zero under WCSPH)."""
         if not self._history:
             return {}
-        dt = np.concatenate([h[0] for h in self._history])
-        rows = SubstepRows.concatenate([h[1] for h in self._history])
+        dt = np.concatenate([np.full(n_sub, step) for n_sub, step, _ in self._history])
+        rows = SubstepRows.concatenate([h[2] for h in self._history])
         return {
             "dt": dt,
             "time": np.cumsum(dt),

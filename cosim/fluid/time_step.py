@@ -16,35 +16,63 @@ def artificial_kinematic_viscosity(cfg: FluidConfig, flow_speed: float, wall_spe
     the largest alpha any pair uses and the largest velocity scale v_sig = c + beta w (``FluidConfig.viscosity_speed``):
     c0, or with the signal velocity the fastest approach w the planned flow allows, two particles head on at
     ``flow_speed`` (m/s) or one at ``flow_speed`` against a wall moving at ``wall_speed`` (m/s)."""
-    alpha = max(cfg.artificial_viscosity, cfg.free_liquid_alpha) if cfg.free_liquid else cfg.artificial_viscosity
-    speed = cfg.viscosity_speed + cfg.viscosity_approach_weight * max(2.0 * flow_speed, flow_speed + wall_speed)
-    return alpha * cfg.smoothing_length * speed / (2.0 * (cfg.dim + 2))
+    return TimeStepPlanner(cfg).artificial_kinematic_viscosity(flow_speed, wall_speed)
 
 
 def stable_time_step(cfg: FluidConfig, wall_speed: float, max_speed: float, max_accel: float) -> float:
     """The largest stable dt (s) for the liquid whose last interval reached ``max_speed`` (m/s) and ``max_accel``
-    (m/s^2) in vessels whose walls move at up to ``wall_speed`` (m/s): the CFL condition dt <= cfl h / signal,
-    with the signal speed acoustic for WCSPH (c0 + the flow's and the wall's speed) and the flow's alone for DFSPH
-    (at least ``max_expected_speed``: a jet forms within an interval), and the force criterion; with
-    ``adaptive_time_step`` off, the fixed step; both bounded by the viscous diffusion criterion
-    dt <= 0.125 h^2 / (nu + nu_art) (:func:`artificial_kinematic_viscosity`, at the flow speed DFSPH's CFL condition
-    plans with: the fixed step's at ``max_expected_speed`` and still walls)."""
-    h = cfg.smoothing_length
-    if not cfg.adaptive_time_step:
-        flow_speed, wall_speed = cfg.max_expected_speed, 0.0  # the fixed step measures nothing
-        dt = cfg.fixed_time_step
-    else:
-        flow_speed = max(cfg.max_expected_speed, max_speed)
-        if cfg.pressure_solver is PressureSolver.WCSPH:
-            signal = cfg.sound_speed + max_speed + wall_speed
+    (m/s^2) in vessels whose walls move at up to ``wall_speed`` (m/s) (:meth:`TimeStepPlanner.stable_time_step`)."""
+    return TimeStepPlanner(cfg).stable_time_step(wall_speed, max_speed, max_accel)
+
+
+class TimeStepPlanner:
+    """The time-step criteria of one configuration, its constants read once (the solver plans every interval, and
+    each of the configuration's derived quantities is a property computed on every read): the same operations in
+    the same order as on the configuration itself, so the same bits."""
+
+    def __init__(self, cfg: FluidConfig):
+        self.h = cfg.smoothing_length
+        self.adaptive = cfg.adaptive_time_step
+        self.max_expected_speed = cfg.max_expected_speed
+        self.fixed_time_step = cfg.fixed_time_step
+        self.acoustic = cfg.pressure_solver is PressureSolver.WCSPH
+        self.sound_speed = cfg.sound_speed
+        self.cfl = cfg.cfl
+        self.kinematic_viscosity = cfg.kinematic_viscosity
+        self.alpha = max(cfg.artificial_viscosity, cfg.free_liquid_alpha) if cfg.free_liquid else cfg.artificial_viscosity
+        self.viscosity_speed = cfg.viscosity_speed
+        self.approach_weight = cfg.viscosity_approach_weight
+        self.dim = cfg.dim
+
+    def artificial_kinematic_viscosity(self, flow_speed: float, wall_speed: float) -> float:
+        """m^2/s, nu_art = alpha h v_sig / (2 (dim + 2)) (:func:`artificial_kinematic_viscosity`)."""
+        speed = self.viscosity_speed + self.approach_weight * max(2.0 * flow_speed, flow_speed + wall_speed)
+        return self.alpha * self.h * speed / (2.0 * (self.dim + 2))
+
+    def stable_time_step(self, wall_speed: float, max_speed: float, max_accel: float) -> float:
+        """The largest stable dt (s) for the liquid whose last interval reached ``max_speed`` (m/s) and ``max_accel``
+        (m/s^2) in vessels whose walls move at up to ``wall_speed`` (m/s): the CFL condition dt <= cfl h / signal,
+        with the signal speed acoustic for WCSPH (c0 + the flow's and the wall's speed) and the flow's alone for DFSPH
+        (at least ``max_expected_speed``: a jet forms within an interval), and the force criterion; with
+        ``adaptive_time_step`` off, the fixed step; both bounded by the viscous diffusion criterion
+        dt <= 0.125 h^2 / (nu + nu_art) (:meth:`artificial_kinematic_viscosity`, at the flow speed DFSPH's CFL
+        condition plans with: the fixed step's at ``max_expected_speed`` and still walls)."""
+        h = self.h
+        if not self.adaptive:
+            flow_speed, wall_speed = self.max_expected_speed, 0.0  # the fixed step measures nothing
+            dt = self.fixed_time_step
         else:
-            signal = flow_speed + wall_speed
-        dt = cfg.cfl * h / max(signal, 1e-9)
-        dt = min(dt, FORCE_CFL * math.sqrt(h / max(max_accel, 1e-9)))
-    diffusivity = cfg.kinematic_viscosity + artificial_kinematic_viscosity(cfg, flow_speed, wall_speed)
-    if diffusivity > 0.0:
-        dt = min(dt, VISCOUS_CFL * h * h / diffusivity)
-    return dt
+            flow_speed = max(self.max_expected_speed, max_speed)
+            if self.acoustic:
+                signal = self.sound_speed + max_speed + wall_speed
+            else:
+                signal = flow_speed + wall_speed
+            dt = self.cfl * h / max(signal, 1e-9)
+            dt = min(dt, FORCE_CFL * math.sqrt(h / max(max_accel, 1e-9)))
+        diffusivity = self.kinematic_viscosity + self.artificial_kinematic_viscosity(flow_speed, wall_speed)
+        if diffusivity > 0.0:
+            dt = min(dt, VISCOUS_CFL * h * h / diffusivity)
+        return dt
 
 
 def split_interval(duration: float, dt: float) -> tuple[int, float]:
