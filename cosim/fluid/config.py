@@ -78,6 +78,13 @@ class FreeLiquidRule(Enum):
     FREE_SURFACE = "free_surface"  # at the free surface (Marrone et al. 2010's indicator), wherever it is
 
 
+class TensionTreatment(Enum):
+    """How WCSPH's pressure gradient treats negative pressure (``cosim.fluid.wcsph.pressure_pair_factor``)."""
+
+    CLAMP = "clamp"  # symmetric sum p_i / rho_i^2 + p_j / rho_j^2 everywhere; tension only limited by max_tension
+    TIC = "tic"  # Sun et al. (2018)'s tensile-instability control: p_j - p_i where p_i < 0 away from the surface
+
+
 class DensityIteration(Enum):
     """How DFSPH's density solve iterates (its divergence solve, about one iteration a substep, is always Jacobi)."""
 
@@ -219,6 +226,15 @@ class FluidConfig:
                                  "p = max(Tait, -max_tension): tension holds the continuity-density liquid together, but "
                                  "a film stretched at a rim can reach tens of kPa and fling its particles; 1 kPa is the "
                                  "hydrostatic pressure of 10 cm of water.", "Pa", 0.0, 1.0e6)
+    tension_treatment: TensionTreatment = setting(TensionTreatment.CLAMP, WCSPH, "How the pressure gradient treats "
+                                                  "negative pressure: 'clamp' (Monaghan's symmetric sum m_j (p_i / "
+                                                  "rho_i^2 + p_j / rho_j^2) grad W for every pair; tension limited "
+                                                  "only by max_tension) or 'tic' (Sun et al. 2018's tensile-"
+                                                  "instability control: (m_j / (rho_i rho_j)) F_ij grad W with F_ij = "
+                                                  "p_j + p_i where p_i >= 0 or particle i is in the free-surface "
+                                                  "region, Marrone et al. 2010's indicator below 0.75, and p_j - p_i "
+                                                  "where p_i < 0 inside the liquid, so tension does not clump "
+                                                  "particles; max_tension still applies). docs/tensile_control.md.")
     density_diffusion: float = setting(0.1, WCSPH, "delta of delta-SPH density diffusion (Antuono et al. 2010, "
                                        "renormalised density gradient).", "", 0.0, 1.0)
     # ---- DFSPH
