@@ -100,3 +100,14 @@ def test_the_symmetric_sum_pushes_the_disordered_interior_of_a_block_in_tension(
     middle = (np.abs(x[:, 0]) < 0.02) & (np.abs(x[:, 2] - 0.04) < 0.02)
     # 2 p / rho sum_j V_j grad W over a jittered support: the tensile term the control removes (m/s after one step)
     assert np.abs(v[middle, 0]).max() > 1e-3
+
+
+@pytest.mark.parametrize("treatment, floor", [("clamp", -1000.0), ("tic", None)])
+def test_only_the_clamp_treatment_clamps_the_tension(treatment, floor):
+    cfg = FluidConfig(dim=2, spacing=DX, pressure_solver="wcsph", max_expected_speed=1.0, tension_treatment=treatment,
+                      max_tension=1000.0, domain_min=(-0.3, -0.3, -0.3), domain_max=(0.3, 0.3, 0.3))
+    block = liquid_block((-0.02, -0.05, 0.0), (0.02, 0.05, 0.02), cfg)
+    stretched = ParticleSet(block.positions, block.velocities, np.full(len(block), 0.98 * cfg.rest_density))
+    tait = cfg.rest_density * cfg.sound_speed**2 / cfg.gamma * (0.98**cfg.gamma - 1.0)  # about -1.9 kPa
+    expected = tait if floor is None else max(tait, floor)
+    assert FluidSolver(cfg, [], [], stretched).pressures() == pytest.approx(expected, rel=1e-4)

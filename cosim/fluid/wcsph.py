@@ -65,7 +65,8 @@ TIC_SURFACE_REGION = wp.constant(0.75)
 @wp.func
 def tait_pressure(prm: SPHParams, rho: float) -> float:
     """Tait equation of state (Camporredondo et al. 2019, Eq. 5) with the artificial sound speed, p = B ((rho/rho0)^gamma - 1), its
-    tension clamped at ``max_tension`` (``FluidConfig.max_tension``)."""
+    tension clamped at ``max_tension`` (``FluidConfig.tension_limit``: ``max_tension`` under the 'clamp' treatment, none
+    under tensile-instability control)."""
     return wp.max(prm.eos_b * (wp.pow(rho / prm.rest_density, prm.gamma) - 1.0), -prm.max_tension)
 
 
