@@ -78,6 +78,13 @@ class FreeLiquidRule(Enum):
     FREE_SURFACE = "free_surface"  # at the free surface (Marrone et al. 2010's indicator), wherever it is
 
 
+class TensionTreatment(Enum):
+    """How WCSPH's pressure gradient treats negative pressure (``cosim.fluid.wcsph.pressure_pair_factor``)."""
+
+    CLAMP = "clamp"  # symmetric sum p_i / rho_i^2 + p_j / rho_j^2 everywhere, tension clamped at max_tension
+    TIC = "tic"  # Sun et al. (2018)'s tensile-instability control (p_j - p_i where p_i < 0 away from the surface), no clamp
+
+
 class DensityIteration(Enum):
     """How DFSPH's density solve iterates (its divergence solve, about one iteration a substep, is always Jacobi)."""
 
@@ -230,10 +237,20 @@ class FluidConfig:
     # ---- WCSPH
     gamma: float = setting(7.0, WCSPH, "Tait exponent of the equation of state p = rho0 c0^2 / gamma ((rho / rho0)^gamma "
                            "- 1) (Camporredondo et al. 2019).", "", 1.0, 10.0)
-    max_tension: float = setting(1000.0, WCSPH, "The most tension (negative pressure) the bound liquid carries, "
-                                 "p = max(Tait, -max_tension): tension holds the continuity-density liquid together, but "
-                                 "a film stretched at a rim can reach tens of kPa and fling its particles; 1 kPa is the "
-                                 "hydrostatic pressure of 10 cm of water.", "Pa", 0.0, 1.0e6)
+    max_tension: float = setting(1000.0, WCSPH, "tension_treatment 'clamp': the most tension (negative pressure) "
+                                 "the bound liquid carries, p = max(Tait, -max_tension): tension holds the "
+                                 "continuity-density liquid together, but a film stretched at a rim can reach tens of "
+                                 "kPa and fling its particles; 1 kPa is the hydrostatic pressure of 10 cm of water. "
+                                 "Not used by 'tic'.", "Pa", 0.0, 1.0e6)
+    tension_treatment: TensionTreatment = setting(TensionTreatment.CLAMP, WCSPH, "How the pressure gradient treats "
+                                                  "negative pressure: 'clamp' (Monaghan's symmetric sum m_j (p_i / "
+                                                  "rho_i^2 + p_j / rho_j^2) grad W for every pair, the tension "
+                                                  "clamped at max_tension) or 'tic' (Sun et al. 2018's tensile-"
+                                                  "instability control, no clamp: (m_j / (rho_i rho_j)) F_ij grad W "
+                                                  "with F_ij = p_j + p_i where p_i >= 0 or particle i is in the "
+                                                  "free-surface region, Marrone et al. 2010's indicator at or below "
+                                                  "0.75, and p_j - p_i where p_i < 0 inside the liquid, so tension "
+                                                  "does not clump particles). docs/tensile_control.md.")
     density_diffusion: float = setting(0.1, WCSPH, "delta of delta-SPH density diffusion (Antuono et al. 2010, "
                                        "renormalised density gradient).", "", 0.0, 1.0)
     # ---- DFSPH
@@ -335,6 +352,12 @@ class FluidConfig:
     def sound_speed(self) -> float:
         """Artificial speed of sound c0 (m/s)."""
         return self.sound_speed_factor * self.max_expected_speed
+
+    @property
+    def tension_limit(self) -> float:
+        """Pa, the most tension WCSPH's equation of state gives: ``max_tension`` under the 'clamp' treatment; none
+        (infinite) under tensile-instability control, whose pressure gradient keeps tension from clumping particles."""
+        return self.max_tension if self.tension_treatment is TensionTreatment.CLAMP else math.inf
 
     @property
     def free_liquid_alpha(self) -> float:

@@ -22,7 +22,7 @@ class SPHParams:
     every particle); ``eos_b`` = rho0 c0^2 / gamma (Pa); ``alpha_free`` the artificial
     viscosity of pairs with free liquid (:attr:`FluidConfig.free_liquid_alpha`); ``viscosity_speed`` (m/s) and
     ``viscosity_approach_weight`` the c and beta of the artificial viscosity's velocity scale
-    (``FluidConfig.viscosity_speed``); ``max_tension`` (Pa) the clamp of WCSPH's negative pressure,
+    (``FluidConfig.viscosity_speed``); ``max_tension`` (Pa) the clamp of WCSPH's negative pressure (``FluidConfig.tension_limit``),
     reached at ``tension_density`` (kg/m^3); ``eta2`` = 0.01 h^2 (m^2); then DFSPH's stopping rule (relative
     tolerances and the iteration cap of each solve) and ``lattice_density``, the summation density of a resting
     lattice over rho0 (DFSPH and WCSPH's free liquid divide their summation density by it, so the liquid as seeded
@@ -81,14 +81,14 @@ def make_params(cfg: FluidConfig, n_vessels: int, atomic_replicas: int = 1, dens
     p.sound_speed = cfg.sound_speed
     p.eos_b = cfg.rest_density * cfg.sound_speed**2 / cfg.gamma
     # the density below which the Tait pressure is clamped at -max_tension (0: the clamp is never reached)
-    p.tension_density = cfg.rest_density * (1.0 - cfg.max_tension / p.eos_b) ** (1.0 / cfg.gamma) if cfg.max_tension < p.eos_b else 0.0
+    p.tension_density = cfg.rest_density * (1.0 - cfg.tension_limit / p.eos_b) ** (1.0 / cfg.gamma) if cfg.tension_limit < p.eos_b else 0.0
     p.gamma = cfg.gamma
     p.nu = cfg.kinematic_viscosity
     p.alpha = cfg.artificial_viscosity
     p.alpha_free = cfg.free_liquid_alpha
     p.viscosity_speed = cfg.viscosity_speed
     p.viscosity_approach_weight = cfg.viscosity_approach_weight
-    p.max_tension = cfg.max_tension
+    p.max_tension = cfg.tension_limit
     p.delta = cfg.density_diffusion
     p.eta2 = 0.01 * h * h
     p.gravity = wp.vec3(*cfg.gravity)

@@ -300,7 +300,8 @@ class FluidSolver:
     def free_surface_indicator(self) -> np.ndarray:
         """(N,) Marrone et al. (2010)'s free-surface indicator of each particle at the last substep's start (about 1
         inside the liquid, 0.5 at a flat surface, 0 alone; ``cosim.fluid.free_surface``). Measured only under
-        ``FluidConfig.free_liquid_rule`` 'free_surface' (with ``free_liquid``); otherwise zeros."""
+        ``FluidConfig.free_liquid_rule`` 'free_surface' (with ``free_liquid``) or WCSPH's ``tension_treatment``
+        'tic'; otherwise zeros."""
         return self._in_id_order(self.scratch.free_surface).astype(np.float64)
 
     def vessel_poses(self) -> list[Pose]:

@@ -8,10 +8,13 @@ update_free_liquid: free liquid (``FluidConfig.free_liquid``): a particle outsid
   below rest density) pulls the falling stream back toward the vessel it left, 16-22 mm short of its parabola in
   ``cosim validate free-fall``; but without tension the continuity density cannot hold caught liquid together,
   because it remembers the loose packing a drop arrived in (its offset from the summation density) and props the
-  caught liquid up. Free liquid pairs use ``free_artificial_viscosity``, so its impacts are inelastic.
+  caught liquid up. Free liquid pairs use ``free_artificial_viscosity``, so its impacts are inelastic. The same
+  neighbour walk measures each particle's free-surface indicator where the 'free_surface' rule or the
+  tensile-instability control needs it.
 compute_forces: per particle, over fluid and wall neighbours,
-  - the acceleration: symmetric pressure gradient, the dummy wall particles entering like liquid particles of
-    mass rho0 V_w with their extrapolated pressure (Adami et al. 2012, see ``cosim.fluid.boundary``); Monaghan
+  - the acceleration: symmetric pressure gradient (or, by ``FluidConfig.tension_treatment`` 'tic', Sun et al.
+    2018's tensile-instability control: :func:`pressure_pair_factor`), the dummy wall particles entering like liquid
+    particles of mass rho0 V_w with their extrapolated pressure (Adami et al. 2012, see ``cosim.fluid.boundary``); Monaghan
     (1992) artificial viscosity and Morris et al. (1997) laminar viscosity (no-slip against the walls); gravity;
   - the reaction on each vessel: -m a_ib summed per particle, and its moment about the vessel's centre of mass,
     stored per particle so they can be reduced in a fixed order (deterministic on every device);
@@ -33,7 +36,7 @@ import warp as wp
 
 from cosim.fluid.boundary import VesselGeometry, VesselMotion
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
-from cosim.fluid.free_surface import FREE_AT_SURFACE, FREE_OUTSIDE_VESSELS, exposed_liquid, renormalisation_term, surface_indicator
+from cosim.fluid.free_surface import FREE_AT_SURFACE, FREE_LIQUID_OFF, FREE_OUTSIDE_VESSELS, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
 from cosim.fluid.neighbors import Neighborhood, first_neighbor, next_neighbor
 from cosim.fluid.params import SPHParams
@@ -56,12 +59,16 @@ from cosim.fluid.sph_kernels import kernel_w
 # near-empty supports (spray, a lone particle) give no meaningful density gradient.
 RENORMALISATION_MIN_DET = wp.constant(0.05)
 MIN_DENSITY_RATIO = wp.constant(0.8)
+# Tensile-instability control's free-surface region: Marrone et al. (2010)'s indicator lambda at or below 0.75, the
+# region their scan test examines (a flat surface's top row 0.5, its second row 0.84, the interior 1).
+TIC_SURFACE_REGION = wp.constant(0.75)
 
 
 @wp.func
 def tait_pressure(prm: SPHParams, rho: float) -> float:
     """Tait equation of state (Camporredondo et al. 2019, Eq. 5) with the artificial sound speed, p = B ((rho/rho0)^gamma - 1), its
-    tension clamped at ``max_tension`` (``FluidConfig.max_tension``)."""
+    tension clamped at ``max_tension`` (``FluidConfig.tension_limit``: ``max_tension`` under the 'clamp' treatment, none
+    under tensile-instability control)."""
     return wp.max(prm.eos_b * (wp.pow(rho / prm.rest_density, prm.gamma) - 1.0), -prm.max_tension)
 
 
@@ -85,6 +92,35 @@ def tait_internal_energy(prm: SPHParams, rho: float) -> float:
     return tait_elastic_energy(prm, rt) + prm.max_tension * (1.0 / rho - 1.0 / rt)
 
 
+@wp.func
+def own_pressure(tic: int, p_i: float, indicator_i: float) -> float:
+    """The pressure p_i of particle i as its pair terms take it (Pa): p_i, but under tensile-instability control
+    (``tic`` 1) -p_i where p_i < 0 inside the liquid (indicator above :data:`TIC_SURFACE_REGION`), so that the pair
+    factor's p_j + (own pressure) is Sun et al. (2018)'s p_j - p_i there (:func:`pressure_pair_factor`)."""
+    if tic != 0 and p_i < 0.0 and indicator_i > TIC_SURFACE_REGION:
+        return -p_i
+    return p_i
+
+
+@wp.func
+def pressure_pair_factor(tic: int, own_i: float, rho_i: float, p_j: float, rho_j: float) -> float:
+    """The factor f_ij of particle i's pressure term a_i -= m_j f_ij grad_i W_ij (Pa m^6/kg^2), for i's own
+    pressure ``own_i`` (:func:`own_pressure`) and density and neighbour j's (a wall particle's: its extrapolated
+    pressure and density, Adami et al. 2012):
+
+    - ``tic`` 0: Monaghan's symmetric sum p_i / rho_i^2 + p_j / rho_j^2;
+    - ``tic`` 1: Sun, Colagrossi, Marrone, Antuono & Zhang (2018), "Multi-resolution Delta-plus-SPH with tensile
+      instability control: towards high Reynolds number flows", Comput. Phys. Commun. 224, Eq. (9):
+      Du_i/Dt = -(1/rho_i) sum_j F_ij grad_i W_ij V_j, V_j = m_j / rho_j, so f_ij = F_ij / (rho_i rho_j), with
+      F_ij = p_j + p_i where p_i >= 0 or i is in the free-surface region, and F_ij = p_j - p_i where p_i < 0
+      inside the liquid. The minus form is the gradient of p - p_i: a particle in uniform tension feels no force
+      from its neighbours' disorder, so tension does not clump particles (the tensile instability). It does not
+      conserve momentum exactly, which Sun et al. show costs little while the particles stay regular."""
+    if tic == 0:
+        return own_i / (rho_i * rho_i) + p_j / (rho_j * rho_j)
+    return (p_j + own_i) / (rho_i * rho_j)
+
+
 @item_kernel
 def update_free_liquid(
     # Model
@@ -93,6 +129,7 @@ def update_free_liquid(
     b_volume: wp.array(dtype=float),
     mode: int,
     threshold: float,
+    measure_surface: int,
     # State in
     motions: wp.array(dtype=VesselMotion),
     nb: Neighborhood,
@@ -108,34 +145,41 @@ def update_free_liquid(
     """Free liquid: a particle where the rule ``mode`` lets liquid be free (outside every vessel's inner volume:
     the falling stream, spray, a splash above a rim; or at the free surface, its indicator below ``threshold``,
     stored in ``indicator``: ``cosim.fluid.free_surface``) is free once it has separated, and stays free until it
-    is packed where the rule no longer holds. Until it has separated (summation density below rho0) the continuity
-    density goes on, so its pressure does not jump when it passes a rim. A free particle's density is the summation
+    is packed where the rule no longer holds (``mode`` :data:`FREE_LIQUID_OFF`: never free). Until it has separated
+    (summation density below rho0) the continuity density goes on, so its pressure does not jump when it passes a rim. A free particle's density is the summation
     density sum_j m_j W_ij + sum_b rho0 V_b W_ib (normalised by a resting lattice's kernel sum), clamped below at
     rho0: memoryless (it sees the packing, whatever the particle went through in flight) and without tension
     (liquid in the air is at ambient pressure; the continuity density's tension would pull the stream back toward
     the vessel it left). It becomes bound when its summation density reaches rho0; the continuity equation then
     continues from that density, so the pressure is continuous and the caught liquid keeps no memory of the loose
-    packing it arrived in."""
+    packing it arrived in. ``measure_surface`` 1 (the tensile-instability control needs it): every particle's
+    indicator is measured and stored, whatever the rule."""
     i = wp.tid()
     if active[i] == 0:
         return
     xi = nb.x[i]
-    if mode == FREE_OUTSIDE_VESSELS and free[i] == 0 and inside_any_vessel(prm, vessels, motions, xi):
-        return  # bound liquid inside a vessel stays bound
+    stays_bound = False
+    if mode == FREE_OUTSIDE_VESSELS and free[i] == 0:
+        stays_bound = inside_any_vessel(prm, vessels, motions, xi)  # bound liquid inside a vessel stays bound
+    if stays_bound and measure_surface == 0:
+        return
+    surface = mode == FREE_AT_SURFACE or measure_surface != 0
     density = mass[i] * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     moment = wp.mat33(0.0)
     walk = first_neighbor(nb, xi, prm.support)
     while walk.index >= 0:
         mj = neighbor_mass(prm, mass, b_volume, walk)
         density += summation_term(prm, mj, walk)
-        if mode == FREE_AT_SURFACE:
+        if surface:
             moment += renormalisation_term(mj / prm.rest_density, walk.r, kernel_gradient(prm, walk.r, walk.r2))
         walk = next_neighbor(nb, walk)
     density = density / prm.lattice_density
     lam = float(0.0)
-    if mode == FREE_AT_SURFACE:
+    if surface:
         lam = surface_indicator(prm.dim, moment)
         indicator[i] = lam
+    if stays_bound or mode == FREE_LIQUID_OFF:
+        return
     state = next_free_state(free[i], exposed_liquid(prm, vessels, motions, mode, xi, lam, threshold), density, prm.rest_density)
     if free[i] == 0 and state == 0:
         # bound liquid leaving over a lip (or at the surface) stays bound while it is packed: its summation density
@@ -169,6 +213,8 @@ def compute_forces(
     b_v_noslip: wp.array(dtype=wp.vec3),
     row: wp.array(dtype=wp.int32),
     capacity: int,
+    tic: int,
+    indicator: wp.array(dtype=float),
     # Out
     acc: wp.array(dtype=wp.vec3),
     rho_grad: wp.array(dtype=wp.vec3),
@@ -185,7 +231,9 @@ def compute_forces(
     (x) grad W (Antuono et al. 2010; liquid neighbours only; zero where L is too ill-conditioned to invert). Also
     the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``:
     grad_i W), in the order of the neighbour loop, which compute_density_rate sums over instead of searching the
-    cells again; more than ``capacity`` neighbours count as an overflow, an instability."""
+    cells again; more than ``capacity`` neighbours count as an overflow, an instability. ``tic`` 1: the pressure
+    terms with Sun et al. (2018)'s tensile-instability control (:func:`pressure_pair_factor`), ``indicator`` each
+    particle's free-surface indicator (read only then)."""
     i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
@@ -199,10 +247,13 @@ def compute_forces(
     xi = nb.x[i]
     vi = v[i]
     rhoi = rho[i]
-    pi_term = p[i] / (rhoi * rhoi)
+    lam = float(1.0)
+    if tic != 0:
+        lam = indicator[i]
+    own = own_pressure(tic, p[i], lam)
     # walls only push: a particle's tension (p < 0) must not pull it onto a wall (it would crawl along overhanging
     # outer faces, an artificial teapot effect); the walls' own pressure is clamped at 0 when extrapolated
-    pi_wall_term = wp.max(p[i], 0.0) / (rhoi * rhoi)
+    own_wall = wp.max(own, 0.0)
     free_i = free[i]
     alpha_wall = wp.where(free_i != 0, prm.alpha_free, prm.alpha)
     a = wp.vec3(0.0)
@@ -225,13 +276,13 @@ def compute_forces(
             vol = mj / rhoj
             moment += renormalisation_term(vol, r, gw)
             gsum += (vol * (rhoj - rhoi)) * gw
-            a -= mj * (pi_term + p[j] / (rhoj * rhoj)) * gw
+            a -= mj * pressure_pair_factor(tic, own, rhoi, p[j], rhoj) * gw
             alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
             a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
         else:
             b = walk.index
             rhob = b_rho[b]
-            ab = -(mj * (pi_wall_term + b_p[b] / (rhob * rhob))) * gw
+            ab = -(mj * pressure_pair_factor(tic, own_wall, rhoi, b_p[b], rhob)) * gw
             ab += viscous_pair(prm, alpha_wall, mj, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
             a += ab
             add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)

@@ -1,7 +1,8 @@
 """The weakly compressible SPH substep (the kernels and their physics: ``cosim.fluid.wcsph``).
 
     start_substep: move_vessels; place_wall_particles; find_neighbors; reorder_particles (``cosim.fluid.substep``)
-    update_free_liquid      free liquid takes its summation density (``FluidConfig.free_liquid``)
+    update_free_liquid      free liquid takes its summation density (``FluidConfig.free_liquid``); each
+                            particle's free-surface indicator where the rule or the tensile-instability control uses it
     extrapolate_wall_state  the wall particles' pressure, density and no-slip velocity from the liquid around them
     compute_forces          pressure, viscous and wall forces; the substep's pair list; the density gradient
     compute_density_rate    continuity with delta-SPH diffusion, over the pair list
@@ -17,6 +18,7 @@ import warp as wp
 from cosim.fluid import boundary as bd
 from cosim.fluid import wcsph
 from cosim.fluid.device_layout import pair_table
+from cosim.fluid.config import FluidConfig, TensionTreatment
 from cosim.fluid.free_surface import free_liquid_mode
 from cosim.fluid.launch import launch_now
 from cosim.fluid.model import FluidModel, FluidState
@@ -42,14 +44,22 @@ class WCSPHScratch:
         self.b_v_noslip = wp.zeros(nb, dtype=wp.vec3, device=d)
 
 
+def tension_control(cfg: FluidConfig) -> int:
+    """1 where the pressure gradient has Sun et al. (2018)'s tensile-instability control
+    (``FluidConfig.tension_treatment`` 'tic'), else 0 (the kernels' int)."""
+    return int(cfg.tension_treatment is TensionTreatment.TIC)
+
+
 def update_free_liquid(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch) -> None:
     """Free liquid (outside every vessel or at the free surface, by ``FluidConfig.free_liquid_rule``, and separated;
-    or not yet packed again) takes the tension-free summation density (``cosim.fluid.wcsph.update_free_liquid``)."""
-    if not m.config.free_liquid:
+    or not yet packed again) takes the tension-free summation density (``cosim.fluid.wcsph.update_free_liquid``);
+    under tensile-instability control every particle's free-surface indicator is measured in the same walk."""
+    tic = tension_control(m.config)
+    if not m.config.free_liquid and not tic:
         return
     rec.launch(
         wcsph.update_free_liquid, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, mode=free_liquid_mode(m.config),
-        threshold=m.config.free_surface_threshold, motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active, mass=st.mass, free=st.free,
+        threshold=m.config.free_surface_threshold, measure_surface=tic, motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active, mass=st.mass, free=st.free,
         rho=st.rho, p=st.p, indicator=sh.free_surface,
     )
 
@@ -71,7 +81,7 @@ def compute_forces(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScra
         wcsph.compute_forces, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, b_vessel=m.b_vessel,
         motions=sh.motions, nb=sh.neighborhood(m, st), v=st.v, rho=st.rho, p=st.p, active=st.active, free=st.free, mass=st.mass,
         bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip, row=sh.row, capacity=sh.pair_capacity,
-        acc=sc.acc, rho_grad=sc.rho_grad, wall_force=sh.wall_force, wall_torque=sh.wall_torque,
+        tic=tension_control(m.config), indicator=sh.free_surface, acc=sc.acc, rho_grad=sc.rho_grad, wall_force=sh.wall_force, wall_torque=sh.wall_torque,
         pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad,
         diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
     )
