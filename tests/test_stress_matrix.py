@@ -11,7 +11,7 @@ from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig, PressureSolver
 from cosim.stress.classify import DENSITY_ERROR_BOUND, ENERGY_EXCESS_BOUND, Outcome, classify
 from cosim.stress.filters import select
-from cosim.stress.matrix import Motion, StressConfig, build_matrix, solver_field
+from cosim.stress.matrix import Motion, StressConfig, build_matrix
 from cosim.validation.scripted import LeakMonitor, WallRegions
 from tests.support.stress import CLEAN
 
@@ -36,7 +36,12 @@ def test_config_id_is_stable_and_fluid_config_follows_the_axes():
     cfg = c.fluid_config()
     assert cfg.cfl == pytest.approx(2.0 * FluidConfig().cfl)
     assert cfg.spacing == pytest.approx(0.191 / 12)
-    assert getattr(cfg, solver_field()) is PressureSolver.WCSPH
+    assert cfg.pressure_solver is PressureSolver.WCSPH
+    # the settings left unset resolve for the configuration's own solver, not for the default solver's
+    for solver in PressureSolver:
+        own = FluidConfig(pressure_solver=solver)
+        cfg = StressConfig(Motion.TILT, 5.0, 0.5, 12, 1.0, 2, solver.value).fluid_config()
+        assert (cfg.artificial_viscosity, cfg.free_liquid_alpha) == (own.artificial_viscosity, own.free_liquid_alpha)
 
 
 def test_shake_runs_at_the_first_sloshing_mode():
