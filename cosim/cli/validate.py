@@ -35,7 +35,8 @@ DEFAULT_OUT = Path("recordings") / "validate"
 # The FluidConfig fields `cosim validate` takes as options (--wall-model for wall_model, ...), each parsed, checked
 # and described from its declaration; not given, the default scene's value (`cosim scene --dump`)
 NUMERICS_OPTIONS = ("density_iteration", "density_tolerance", "wall_model", "wall_pressure", "initial_state", "free_liquid_rule",
-                    "free_surface_threshold", "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity")
+                    "free_surface_threshold", "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity",
+                    "particle_shifting", "shifting_coefficient")
 
 
 def register(subparsers, summary: str) -> None:

@@ -78,6 +78,13 @@ class FreeLiquidRule(Enum):
     FREE_SURFACE = "free_surface"  # at the free surface (Marrone et al. 2010's indicator), wherever it is
 
 
+class ParticleShifting(Enum):
+    """Whether particles are shifted toward uniform spacing each substep (``cosim.fluid.shifting``)."""
+
+    OFF = "off"  # particles move with the flow alone
+    FICKIAN = "fickian"  # down the particle-concentration gradient, tangential at the free surface (Sun et al. 2017)
+
+
 class DensityIteration(Enum):
     """How DFSPH's density solve iterates (its divergence solve, about one iteration a substep, is always Jacobi)."""
 
@@ -205,6 +212,19 @@ class FluidConfig:
                                                       "only on approaching pairs, so a separating stream flies free.",
                                                       "", 0.0, 1.0, kind="float", none_means="artificial_viscosity, "
                                                       "one alpha for all liquid")
+    particle_shifting: ParticleShifting = setting(ParticleShifting.OFF, PRESSURE, "Particle shifting at the start of "
+                                                  "every substep, both solvers: 'fickian' moves each particle down the "
+                                                  "gradient of the particle concentration (walls counted), "
+                                                  "dr = -shifting_coefficient (2h)^2 (max_expected_speed dt / h) grad C "
+                                                  "(Lind et al. 2012; Sun et al. 2017's delta-plus-SPH form), with its "
+                                                  "component normal to the free surface removed near the surface and no "
+                                                  "shift at it (Marrone et al. 2010's indicator). It moves mass without "
+                                                  "momentum and corrects no other field (cosim.fluid.shifting; "
+                                                  "docs/particle_shifting.md).")
+    shifting_coefficient: float = setting(1.0, PRESSURE, "particle_shifting 'fickian': the shift's coefficient A in "
+                                          "dr = -A (2h)^2 (max_expected_speed dt / h) grad C; 1 is Sun et al. "
+                                          "(2017)'s CFL Ma (2h)^2 with Ma = max_expected_speed / c0 "
+                                          "(docs/particle_shifting.md).", "", 0.0, 4.0)
     initial_state: InitialState = setting(InitialState.SEEDED, PRESSURE, "How the liquid starts: 'seeded' (from "
                                           "its seeded lattice; DFSPH holds each bound particle to the kernel deficiency "
                                           "it was seeded with, so the surface rows stay at their seeded spacing) or "
