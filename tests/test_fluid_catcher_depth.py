@@ -77,7 +77,10 @@ def drop_into_deeper_tank(solver: str, across: int, **numerics) -> Caught:
     )
 
 
-@pytest.mark.parametrize(("solver", "numerics"), [("dfsph", {}), ("dfsph", {"density_iteration": "jacobi"}), ("wcsph", {})], ids=["dfsph", "dfsph-jacobi", "wcsph"])
+@pytest.mark.parametrize(
+    ("solver", "numerics"), [("dfsph", {}), ("dfsph", {"density_iteration": "jacobi"}), ("dfsph", {"particle_shifting": "fickian"}), ("wcsph", {})],
+    ids=["dfsph", "dfsph-jacobi", "dfsph-shifting", "wcsph"],
+)
 def test_caught_liquid_stands_at_its_volume_over_the_tank_section(solver, numerics):
     caught = drop_into_deeper_tank(solver, 20, **numerics)
     np.testing.assert_array_equal(caught.masses, np.float32(caught.seeded_mass * SEEDED_DEPTH / TANK_DEPTH))

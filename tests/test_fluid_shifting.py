@@ -58,6 +58,21 @@ def test_particles_shift_into_a_void_and_not_out_of_the_free_surface(solver):
     assert np.abs(shift[far]).max() <= LATTICE_NOISE * largest  # a uniform lattice: no gradient, no shift
 
 
+def test_a_void_in_3d_is_filled_from_its_six_neighbours():
+    cfg = FluidConfig(dim=3, spacing=DX, pressure_solver="dfsph", max_expected_speed=1.0, particle_shifting="fickian",
+                      domain_min=(-0.1, -0.1, -0.1), domain_max=(0.1, 0.1, 0.1))
+    block = liquid_block((-0.025, -0.025, 0.0), (0.025, 0.025, 0.05), cfg)
+    hole = block.positions[np.argmin(np.linalg.norm(block.positions - [0.0, 0.0, 0.025], axis=1))]
+    keep = np.linalg.norm(block.positions - hole, axis=1) > 0.1 * DX
+    x, shift, lam = _one_substep(cfg, ParticleSet(block.positions[keep], block.velocities[keep], block.densities[keep]))
+    to_hole = hole - x
+    ring = np.isclose(np.linalg.norm(to_hole, axis=1), DX, rtol=1e-3)
+    assert ring.sum() == 6
+    inward = np.einsum("ij,ij->i", shift[ring], to_hole[ring]) / DX
+    assert (inward > 0.9 * np.linalg.norm(shift[ring], axis=1)).all() and (inward > 0.0).all()
+    assert (shift[lam < 0.75] == 0.0).all() and (lam < 0.75).sum() > 0
+
+
 def test_liquid_against_a_wall_is_not_shifted_and_the_next_column_moves_along_it():
     # the liquid alone gives the indicator: the column touching a wall has a half support, like a free surface
     tank = VesselSpec(name="tank", inner_width=0.1, inner_height=0.1)
