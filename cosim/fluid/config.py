@@ -217,15 +217,17 @@ class FluidConfig:
                                                   "gradient of the particle concentration (walls counted), "
                                                   "dr = -shifting_coefficient (2h)^2 (max_expected_speed dt / h) grad C "
                                                   "(Lind et al. 2012; Sun et al. 2017's delta-plus-SPH form), with its "
-                                                  "component normal to the free surface removed near the surface and no "
-                                                  "shift at it (Marrone et al. 2010's indicator). It moves mass without "
-                                                  "momentum and corrects no other field (cosim.fluid.shifting; "
+                                                  "component normal to the free surface (or a wall) removed near it and "
+                                                  "no shift at it (Marrone et al. 2010's indicator, over the liquid). It "
+                                                  "moves mass without momentum; WCSPH's density and pressure follow the "
+                                                  "shifted particle to first order (cosim.fluid.shifting; "
                                                   "docs/particle_shifting.md).")
     shifting_coefficient: float = setting(0.1, PRESSURE, "particle_shifting 'fickian': the shift's coefficient A in "
                                           "dr = -A (2h)^2 (max_expected_speed dt / h) grad C (1 is Sun et al. "
                                           "2017's CFL Ma (2h)^2 with Ma = max_expected_speed / c0). 0.1, chosen on "
-                                          "the validation cases: DFSPH's hydrostatic column passes at 0.05 and 0.1 "
-                                          "and fails at 0.25 (docs/particle_shifting.md).", "", 0.0, 1.0)
+                                          "the validation cases: the largest at which DFSPH's hydrostatic column "
+                                          "passes (0.05 and 0.1 pass, 0.25 fails; WCSPH's fails at 0.05 and 0.1; "
+                                          "docs/particle_shifting.md).", "", 0.0, 1.0)
     initial_state: InitialState = setting(InitialState.SEEDED, PRESSURE, "How the liquid starts: 'seeded' (from "
                                           "its seeded lattice; DFSPH holds each bound particle to the kernel deficiency "
                                           "it was seeded with, so the surface rows stay at their seeded spacing) or "
