@@ -27,7 +27,7 @@ As in Sun et al., a particle in the surface region (lambda_i < 0.75) is not shif
 of such a particle is shifted along the surface only, dr_i - (dr_i . n_i) n_i; every other one by dr_i. Here M_i
 and n_i are summed over the liquid alone (not the walls, unlike the free-liquid rule's indicator): the liquid
 touching a wall has half a support, like a free surface, so it is not shifted, and the next rows move along the
-wall (up to the tilt of their own normal): no shift toward or away from a wall (docs/particle_shifting.md).
+wall, up to the tilt of their own normal (docs/particle_shifting.md).
 
 Stability: the shift is an explicit diffusion step of D = 4 A h U dt per substep. DFSPH's CFL step dt <= cfl h / U
 (``cosim.fluid.time_step``) makes D <= 4 A cfl h^2 = A h^2 at cfl 0.25; WCSPH's acoustic step makes it about ten
