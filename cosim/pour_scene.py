@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, DivergenceConstraint, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, PressureSolver, TensionTreatment, WallModel, WallPressure
+from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, DivergenceConstraint, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, ParticleShifting, PressureSolver, TensionTreatment, WallModel, WallPressure
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -82,6 +82,8 @@ class FluidSettings:
     free_surface_threshold: float = like(FluidConfig, "free_surface_threshold")
     free_artificial_viscosity: float | None = like(FluidConfig, "free_artificial_viscosity")
     initial_state: InitialState = like(FluidConfig, "initial_state")
+    particle_shifting: ParticleShifting = like(FluidConfig, "particle_shifting")
+    shifting_coefficient: float = like(FluidConfig, "shifting_coefficient")
     # ---- WCSPH
     gamma: float = like(FluidConfig, "gamma")
     max_tension: float = like(FluidConfig, "max_tension")

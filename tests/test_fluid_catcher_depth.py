@@ -92,9 +92,10 @@ SOUND_SPEED_EVERY_COMPRESSION = {"artificial_viscosity_scale": "sound_speed", "f
         pytest.param("dfsph", {"density_iteration": "jacobi"}, marks=pytest.mark.xfail(
             strict=True, reason="Jacobi iteration: 2 of 288 particles splash over the rim")),
         ("dfsph", SOUND_SPEED_EVERY_COMPRESSION),
+        ("dfsph", {"particle_shifting": "fickian"}),
         ("wcsph", {}),
     ],
-    ids=["dfsph", "dfsph-jacobi", "dfsph-sound-speed-every-compression", "wcsph"],
+    ids=["dfsph", "dfsph-jacobi", "dfsph-sound-speed-every-compression", "dfsph-shifting", "wcsph"],
 )
 def test_caught_liquid_stands_at_its_volume_over_the_tank_section(solver, numerics):
     caught = drop_into_deeper_tank(solver, 20, **numerics)

@@ -85,6 +85,13 @@ class TensionTreatment(Enum):
     TIC = "tic"  # Sun et al. (2018)'s tensile-instability control (p_j - p_i where p_i < 0 away from the surface), no clamp
 
 
+class ParticleShifting(Enum):
+    """Whether particles are shifted toward uniform spacing each substep (``cosim.fluid.shifting``)."""
+
+    OFF = "off"  # particles move with the flow alone
+    FICKIAN = "fickian"  # down the particle-concentration gradient, tangential at the free surface (Sun et al. 2017)
+
+
 class DensityIteration(Enum):
     """How DFSPH's density solve iterates (its divergence solve, about one iteration a substep, is always Jacobi)."""
 
@@ -227,6 +234,22 @@ class FluidConfig:
                                                       "signal velocity (its approach term damps impacts); "
                                                       f"{SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY:g} with c0 (WCSPH, or "
                                                       "DFSPH's 'sound_speed')")
+    particle_shifting: ParticleShifting = setting(ParticleShifting.OFF, PRESSURE, "Particle shifting at the start of "
+                                                  "every substep, both solvers: 'fickian' moves each particle down the "
+                                                  "gradient of the particle concentration (walls counted), "
+                                                  "dr = -shifting_coefficient (2h)^2 (max_expected_speed dt / h) grad C "
+                                                  "(Lind et al. 2012; Sun et al. 2017's delta-plus-SPH form), with its "
+                                                  "component normal to the free surface (or a wall) removed near it and "
+                                                  "no shift at it (Marrone et al. 2010's indicator, over the liquid). It "
+                                                  "moves mass without momentum; WCSPH's density and pressure follow the "
+                                                  "shifted particle to first order (cosim.fluid.shifting; "
+                                                  "docs/particle_shifting.md).")
+    shifting_coefficient: float = setting(0.1, PRESSURE, "particle_shifting 'fickian': the shift's coefficient A in "
+                                          "dr = -A (2h)^2 (max_expected_speed dt / h) grad C (1 is Sun et al. "
+                                          "2017's CFL Ma (2h)^2 with Ma = max_expected_speed / c0). 0.1, chosen on "
+                                          "the validation cases: the largest at which DFSPH's hydrostatic column "
+                                          "passes (0.05 and 0.1 pass, 0.25 fails; WCSPH's fails at 0.05 and 0.1; "
+                                          "docs/particle_shifting.md).", "", 0.0, 1.0)
     initial_state: InitialState = setting(InitialState.SEEDED, PRESSURE, "How the liquid starts: 'seeded' (from "
                                           "its seeded lattice; DFSPH holds each bound particle to the kernel deficiency "
                                           "it was seeded with, so the surface rows stay at their seeded spacing) or "

@@ -7,6 +7,7 @@ A substep of either solver (``cosim.fluid.wcsph_step``, ``cosim.fluid.dfsph_step
       place_wall_particles  the dummy wall particles at the start pose, with the wall's velocity
       find_neighbors        the cell lists of the wall particles (by indirection) and of the liquid (sorted)
       reorder_particles     the liquid's state gathered into cell order, into the other buffer
+      shift_particles       particle shifting, where configured (``cosim.fluid.shifting``)
     ...                     the pressure solver's stages, ending in its integrate (wall guard, diagnostics)
     end_substep
       reduce_wrenches       the particles' forces and torques on each vessel summed in a fixed order
@@ -30,6 +31,7 @@ from cosim.fluid.lanes import Lanes
 from cosim.fluid.model import FluidModel, FluidState
 from cosim.fluid.neighbors import Neighborhood, neighborhood
 from cosim.fluid.program import Recorder
+from cosim.fluid.shifting import ShiftingScratch, shift_particles, shifting_on
 from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, pair_capacity, sum_wall_wrench_chunks
 from cosim.frames import Pose
 
@@ -46,7 +48,8 @@ class SubstepScratch:
     force_sum, torque_sum: (V,) their sums over the interval (reduced in a fixed order through ``partial_wrench``);
     pair_capacity: entries of each particle's pair list; free_surface: (N,) each particle's free-surface indicator
     at its last substep's start, in that substep's particle order (written under ``FluidConfig.free_liquid_rule``
-    'free_surface' only; ``cosim.fluid.free_surface``); diagnostics: the substeps' rows, per lane.
+    'free_surface' only; ``cosim.fluid.free_surface``); shifting: the particle shift's arrays, None where
+    ``FluidConfig.particle_shifting`` is 'off' (``cosim.fluid.shifting``); diagnostics: the substeps' rows, per lane.
     """
 
     def __init__(self, model: FluidModel, lanes: Lanes, layout: DeviceLayout):
@@ -77,6 +80,7 @@ class SubstepScratch:
         self._wrench_views = (self.force_sum.numpy(), self.torque_sum.numpy()) if d.is_cpu else None  # shared memory
         self._counter_views = (self.row.numpy(), *self._wrench_views) if d.is_cpu else None  # cleared every interval
         self.free_surface = wp.zeros(n, dtype=float, device=d)
+        self.shifting = ShiftingScratch(model) if shifting_on(model.config) else None
         self.diagnostics = DiagnosticBuffers(lanes.count, layout.atomic_replicas, nv, d)
 
     def set_motions(self, poses: list[Pose], lin_vel: np.ndarray, ang_vel: np.ndarray, lin_acc: np.ndarray, ang_acc: np.ndarray) -> None:
@@ -195,6 +199,7 @@ def start_substep(rec: Recorder, m: FluidModel, src: FluidState, dst: FluidState
     place_wall_particles(rec, m, sh)
     find_neighbors(rec, m, src, sh)
     reorder_particles(rec, m, src, dst)
+    shift_particles(rec, m, dst, sh)
 
 
 def end_substep(rec: Recorder, m: FluidModel, sh: SubstepScratch) -> None:
