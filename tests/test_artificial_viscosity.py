@@ -5,13 +5,17 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 import warp as wp
 
 from cosim.cli.main import main
-from cosim.fluid.config import DEFAULT_ARTIFICIAL_VISCOSITY, GRAVITY, SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY, ArtificialViscosityScale, FluidConfig
+from cosim.fluid.config import (
+    DEFAULT_ARTIFICIAL_VISCOSITY, DEFAULT_DENSITY_TOLERANCE, GRAVITY, SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY, ArtificialViscosityScale, DensityIteration,
+    FluidConfig,
+)
 from cosim.fluid.params import SPHParams, make_params
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
@@ -49,7 +53,7 @@ def _monaghan(cfg: FluidConfig, closing_speed: float, scale: float, gw: np.ndarr
     """m_j alpha c mu / rho0 grad W, mu = h v_rel . r / (r^2 + 0.01 h^2), with the velocity scale c = ``scale``."""
     h = cfg.smoothing_length
     mu = h * (-closing_speed * DISTANCE) / (DISTANCE**2 + 0.01 * h * h)
-    return cfg.particle_mass * cfg.artificial_viscosity * scale * mu / cfg.rest_density * gw
+    return cfg.particle_mass * cfg.alpha * scale * mu / cfg.rest_density * gw
 
 
 @pytest.mark.parametrize("closing_speed", [0.1, 1.0])
@@ -85,10 +89,13 @@ def test_an_unset_free_alpha_is_the_one_alpha_under_the_signal_velocity_and_its_
 
 def test_an_unset_alpha_is_the_velocity_scales_own():
     signal = DEFAULT_ARTIFICIAL_VISCOSITY[ArtificialViscosityScale.SIGNAL_VELOCITY]
-    assert FluidConfig().artificial_viscosity == signal
-    assert FluidConfig(artificial_viscosity_scale="sound_speed").artificial_viscosity == DEFAULT_ARTIFICIAL_VISCOSITY[ArtificialViscosityScale.SOUND_SPEED]
-    assert FluidConfig(artificial_viscosity_scale="signal_velocity").artificial_viscosity == signal
-    assert FluidConfig(artificial_viscosity_scale="signal_velocity", pressure_solver="wcsph").artificial_viscosity == 0.01  # c0
+    assert FluidConfig().alpha == signal
+    assert FluidConfig(artificial_viscosity_scale="sound_speed").alpha == DEFAULT_ARTIFICIAL_VISCOSITY[ArtificialViscosityScale.SOUND_SPEED]
+    assert FluidConfig(artificial_viscosity_scale="signal_velocity").alpha == signal
+    assert FluidConfig(artificial_viscosity_scale="signal_velocity", pressure_solver="wcsph").alpha == 0.01  # c0
+    # unset stays unset, so a replaced solver or iteration resolves for itself
+    assert replace(FluidConfig(), pressure_solver="wcsph").alpha == 0.01
+    assert replace(FluidConfig(), density_iteration="jacobi").density_solve_tolerance == DEFAULT_DENSITY_TOLERANCE[DensityIteration.JACOBI]
 
 
 def _cfl_and_force_step(cfg: FluidConfig, flow_speed: float, max_accel: float) -> float:

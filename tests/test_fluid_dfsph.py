@@ -54,7 +54,7 @@ def test_resting_column_stays_at_rest_and_weighs_its_weight():
     assert fluid.last_report.last.volume_in_vessel[0] == pytest.approx(fluid.n_particles * cfg.particle_volume)
     hist = fluid.history()
     assert hist["density_iterations"].min() >= 1 and hist["density_iterations"].max() <= cfg.max_solver_iterations
-    assert hist["density_solve_error"][-1] <= cfg.density_tolerance or hist["density_iterations"][-1] == cfg.max_solver_iterations
+    assert hist["density_solve_error"][-1] <= cfg.density_solve_tolerance or hist["density_iterations"][-1] == cfg.max_solver_iterations
 
 
 def test_time_step_follows_the_flow_not_the_sound_speed():

@@ -41,7 +41,7 @@ def test_config_id_is_stable_and_fluid_config_follows_the_axes():
     for solver in PressureSolver:
         own = FluidConfig(pressure_solver=solver)
         cfg = StressConfig(Motion.TILT, 5.0, 0.5, 12, 1.0, 2, solver.value).fluid_config()
-        assert (cfg.artificial_viscosity, cfg.free_liquid_alpha) == (own.artificial_viscosity, own.free_liquid_alpha)
+        assert (cfg.alpha, cfg.free_liquid_alpha) == (own.alpha, own.free_liquid_alpha)
 
 
 def test_shake_runs_at_the_first_sloshing_mode():

@@ -348,11 +348,6 @@ class FluidConfig:
 
     def __post_init__(self) -> None:
         check_settings(self, "fluid")
-        if self.density_tolerance is None:
-            object.__setattr__(self, "density_tolerance", DEFAULT_DENSITY_TOLERANCE[self.density_iteration])
-        if self.artificial_viscosity is None:
-            scale = ArtificialViscosityScale.SIGNAL_VELOCITY if self.signal_velocity_viscosity else ArtificialViscosityScale.SOUND_SPEED
-            object.__setattr__(self, "artificial_viscosity", DEFAULT_ARTIFICIAL_VISCOSITY[scale])
         for axis in range(3):
             if self.domain_max[axis] - self.domain_min[axis] < 4.0 * self.support_radius:
                 raise InputError(
@@ -382,13 +377,30 @@ class FluidConfig:
         (infinite) under tensile-instability control, whose pressure gradient keeps tension from clumping particles."""
         return self.max_tension if self.tension_treatment is TensionTreatment.CLAMP else math.inf
 
+    # The settings left unset (None) stay unset in the fields and resolve here, for the solver and iteration in
+    # effect, so that dataclasses.replace with another solver or iteration resolves them for that one.
+    @property
+    def alpha(self) -> float:
+        """Monaghan's alpha of the bound liquid: ``artificial_viscosity``, or where unset the velocity scale's own
+        (:data:`DEFAULT_ARTIFICIAL_VISCOSITY`; WCSPH's scale is c0 either way)."""
+        if self.artificial_viscosity is not None:
+            return self.artificial_viscosity
+        scale = ArtificialViscosityScale.SIGNAL_VELOCITY if self.signal_velocity_viscosity else ArtificialViscosityScale.SOUND_SPEED
+        return DEFAULT_ARTIFICIAL_VISCOSITY[scale]
+
+    @property
+    def density_solve_tolerance(self) -> float:
+        """The density solve's stopping tolerance (fraction of rho0): ``density_tolerance``, or where unset the
+        iteration's own (:data:`DEFAULT_DENSITY_TOLERANCE`)."""
+        return DEFAULT_DENSITY_TOLERANCE[self.density_iteration] if self.density_tolerance is None else self.density_tolerance
+
     @property
     def free_liquid_alpha(self) -> float:
         """Monaghan's alpha of pairs with free liquid: ``free_artificial_viscosity``; where unset, the one alpha under
         the signal velocity, :data:`SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY` under c0."""
         if self.free_artificial_viscosity is not None:
             return self.free_artificial_viscosity
-        return self.artificial_viscosity if self.signal_velocity_viscosity else SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY
+        return self.alpha if self.signal_velocity_viscosity else SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY
 
     @property
     def signal_velocity_viscosity(self) -> bool:

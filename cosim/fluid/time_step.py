@@ -39,7 +39,7 @@ class TimeStepPlanner:
         self.sound_speed = cfg.sound_speed
         self.cfl = cfg.cfl
         self.kinematic_viscosity = cfg.kinematic_viscosity
-        self.alpha = max(cfg.artificial_viscosity, cfg.free_liquid_alpha) if cfg.free_liquid else cfg.artificial_viscosity
+        self.alpha = max(cfg.alpha, cfg.free_liquid_alpha) if cfg.free_liquid else cfg.alpha
         self.viscosity_speed = cfg.viscosity_speed
         self.approach_weight = cfg.viscosity_approach_weight
         self.dim = cfg.dim
