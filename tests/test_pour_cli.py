@@ -321,3 +321,12 @@ def test_coarsest_resolution_pours_with_the_head_floor_capped_at_the_cfs_limit(t
     # would stop with an error about cfs.h_q_ref, a key the scene did not set)
     summary = _tiny_pour(tmp_path, "coarse", "")
     assert summary["cfs_head_reference"] == CFS_MAX_HEAD < 2.5 * summary["particle_spacing"]
+
+
+def test_the_one_thread_share_prints_in_plain_percent():
+    from cosim.cli.pour import _one_thread_note
+
+    assert _one_thread_note({"fluid_substeps_one_thread": 0, "sph_steps": 100}) == ""
+    assert _one_thread_note({"fluid_substeps_one_thread": 9962, "sph_steps": 10000}).startswith(", 99.6 % of the substeps")
+    assert _one_thread_note({"fluid_substeps_one_thread": 10000, "sph_steps": 10000}).startswith(", 100 % of the substeps")
+    assert _one_thread_note({"fluid_substeps_one_thread": 3, "sph_steps": 10000}).startswith(", 0.03 % of the substeps")

@@ -100,4 +100,4 @@ def _one_thread_note(summary: dict) -> str:
     if summary["fluid_substeps_one_thread"] == 0:
         return ""
     share = summary["fluid_substeps_one_thread"] / summary["sph_steps"]
-    return f", {100 * share:.2g} % of the substeps on one thread, where it was the faster (busy cores) or was timed"
+    return f", {100 * share:.3g} % of the substeps on one thread, where it was the faster (busy cores) or was timed"
