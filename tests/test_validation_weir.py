@@ -9,7 +9,7 @@ from cosim.errors import InputError
 from cosim.validation import weir
 
 # The coarse run: 5 particles across the 40 mm head (dx = 8 mm), about 1000 particles. The resolution study in
-# docs/outflow_validation.md measured C_d / Rehbock = 1.005 at this resolution, 1.009 at 7 and 1.021 at 10 across
+# docs/outflow_validation.md gives C_d / Rehbock = 1.005 at this resolution, 1.009 at 7 and 1.021 at 10 across
 # (the default) with DFSPH's default numerics. The coarse ratio is checked within half the change that halving dx
 # made (|1.021 - 1.005| / 2): a change of the liquid's numerics that moves the coarse coefficient by that much moves
 # it as much as a resolution step does, and is caught.

@@ -248,8 +248,7 @@ class FluidConfig:
                                           "dr = -A (2h)^2 (max_expected_speed dt / h) grad C (1 is Sun et al. "
                                           "2017's CFL Ma (2h)^2 with Ma = max_expected_speed / c0). 0.1, chosen on "
                                           "the validation cases: the largest at which DFSPH's hydrostatic column "
-                                          "passes (0.05 and 0.1 pass, 0.25 fails; WCSPH's fails at 0.05 and 0.1; "
-                                          "docs/particle_shifting.md).", "", 0.0, 1.0)
+                                          "passes (docs/particle_shifting.md).", "", 0.0, 1.0)
     initial_state: InitialState = setting(InitialState.SEEDED, PRESSURE, "How the liquid starts: 'seeded' (from "
                                           "its seeded lattice; DFSPH holds each bound particle to the kernel deficiency "
                                           "it was seeded with, so the surface rows stay at their seeded spacing) or "
