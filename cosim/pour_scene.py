@@ -78,7 +78,7 @@ class FluidSettings:
     artificial_viscosity: float = like(FluidConfig, "artificial_viscosity")
     artificial_viscosity_scale: ArtificialViscosityScale = like(FluidConfig, "artificial_viscosity_scale")
     free_liquid: bool = like(FluidConfig, "free_liquid")
-    free_liquid_rule: FreeLiquidRule = like(FluidConfig, "free_liquid_rule")
+    free_liquid_rule: FreeLiquidRule | None = like(FluidConfig, "free_liquid_rule")
     free_surface_threshold: float = like(FluidConfig, "free_surface_threshold")
     free_artificial_viscosity: float | None = like(FluidConfig, "free_artificial_viscosity")
     initial_state: InitialState = like(FluidConfig, "initial_state")

@@ -133,21 +133,23 @@ def _empty(value: Any) -> bool:
 def setting(
     default: Any, group: str, meaning: str, unit: str = "", lo: Bound = None, hi: Bound = None,
     lo_open: bool = False, hi_open: bool = False, kind: str | None = None, none_means: str = "",
+    choices: type[Enum] | None = None,
 ) -> Any:
     """A dataclass field with ``default`` declared as a :class:`Setting` (``kind`` from the default where not given:
     a bool, an Enum member, a tuple (vector, of the tuple's length), an int or a float; a None default, or an empty tuple for a list kind,
     makes it optional, ``none_means`` saying what not setting it stands for; ``none_means`` with another default
     makes it optional too, with that default, for code that passes None; :data:`REQUIRED`: no default, a float
     unless ``kind`` says otherwise). A bound given as a name is that attribute of the object the setting belongs to
-    (:meth:`Bounds.of`)."""
+    (:meth:`Bounds.of`). ``choices``: the Enum of a 'choice' whose default is None (otherwise the default's)."""
     if kind is None:
         kind = ("bool" if isinstance(default, bool) else "choice" if isinstance(default, Enum)
                 else "vector" if isinstance(default, tuple) else "int" if isinstance(default, int) else "float")
     bounds = None if lo is None and hi is None else Bounds(lo, hi, lo_open, hi_open)
     optional = default is None or (kind in LISTS and default == ()) or bool(none_means)
     length = len(default) if isinstance(default, tuple) and default else 3
-    spec = Setting(group, meaning, unit, kind, bounds, type(default) if kind == "choice" else None, optional, none_means,
-                   length)
+    if kind == "choice" and choices is None:
+        choices = type(default)
+    spec = Setting(group, meaning, unit, kind, bounds, choices, optional, none_means, length)
     return dataclasses.field(default=default, metadata={SETTING: spec})
 
 

@@ -158,18 +158,34 @@ def test_the_free_surface_rule_changes_state_at_the_surface_and_when_packed(free
     assert int(out.numpy()[0]) == expected
 
 
-@pytest.mark.parametrize("rule, drop_is_free", [("free_surface", True), ("outside_vessels", False)])
-def test_the_free_surface_rule_needs_no_vessel(rule, drop_is_free):
-    # a drop falling inside a tall tank, above its liquid and below its rim: free at the surface by the local rule,
-    # bound by the geometric one (it is inside a vessel); the resting pool is bound either way, its surface row too
-    # (lambda 0.5, above the default threshold)
+def _drop_over_a_pool(solver: str, rule: str | None) -> tuple[FluidConfig, np.ndarray]:
+    """A drop inside a tall tank, above its resting pool and below its rim, after one substep: (config, free mask;
+    the drop last)."""
     tank = VesselSpec(name="tank", inner_width=0.191, inner_height=0.4)
-    cfg = FluidConfig(dim=2, spacing=0.191 / 16, pressure_solver="wcsph", max_expected_speed=2.0, free_liquid_rule=rule,
+    cfg = FluidConfig(dim=2, spacing=0.191 / 16, pressure_solver=solver, max_expected_speed=2.0, free_liquid_rule=rule,
                       domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.5))
     pool = fill_vessel(tank, 0.06, cfg)
     drop = ParticleSet(np.array([[0.0, 0.0, 0.3]]), np.zeros((1, 3)), np.full(1, cfg.rest_density))
-    solver = _indicator_after_one_step(cfg, ParticleSet.concatenate([pool, drop]), [tank], [Pose()])
-    free = solver.free_mask()
+    return cfg, _indicator_after_one_step(cfg, ParticleSet.concatenate([pool, drop]), [tank], [Pose()]).free_mask()
+
+
+@pytest.mark.parametrize("rule, drop_is_free", [("free_surface", True), ("outside_vessels", False)])
+def test_the_free_surface_rule_needs_no_vessel(rule, drop_is_free):
+    # the drop is free at the surface by the local rule, bound by the geometric one (it is inside a vessel); the
+    # resting pool is bound either way, its surface row too (lambda 0.5, above the default threshold)
+    cfg, free = _drop_over_a_pool("wcsph", rule)
     assert free[-1] == drop_is_free
     assert cfg.free_surface_threshold < lattice_indicator(2, 0)
     assert not free[:-1].any()
+
+
+@pytest.mark.parametrize("solver, rule", [("dfsph", "free_surface"), ("wcsph", "outside_vessels")])
+def test_an_unset_rule_is_the_pressure_solvers_own(solver, rule):
+    # DFSPH's default is the local rule, WCSPH's the geometric one: the drop inside the tank is free under DFSPH's
+    # and bound under WCSPH's, the pool bound under both; a rule that is set is the one in effect under either solver
+    cfg, free = _drop_over_a_pool(solver, None)
+    assert cfg.free_liquid_rule is None and cfg.free_liquid_rule_in_effect.value == rule
+    assert free[-1] == (rule == "free_surface")
+    assert not free[:-1].any()
+    other = "outside_vessels" if rule == "free_surface" else "free_surface"
+    assert FluidConfig(spacing=0.01, pressure_solver=solver, free_liquid_rule=other).free_liquid_rule_in_effect.value == other

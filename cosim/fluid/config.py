@@ -119,6 +119,11 @@ APPROACH_WEIGHT = 2.0
 # alpha is a viscosity about c0 / sqrt(g h) (~100) times as large on c0, so each scale has its own, chosen by the
 # validations (docs/artificial_viscosity.md).
 DEFAULT_ARTIFICIAL_VISCOSITY = {ArtificialViscosityScale.SOUND_SPEED: 0.01, ArtificialViscosityScale.SIGNAL_VELOCITY: 1.0}
+# The free-liquid rule when none is given (FluidConfig.free_liquid_rule), per pressure solver: every DFSPH validation
+# passes with the local free-surface indicator, which needs no knowledge of the scene; WCSPH's free fall needs a
+# threshold above a resting surface's indicator under it, so WCSPH keeps the vessels' inner volumes
+# (docs/free_surface.md).
+DEFAULT_FREE_LIQUID_RULE = {PressureSolver.DFSPH: FreeLiquidRule.FREE_SURFACE, PressureSolver.WCSPH: FreeLiquidRule.OUTSIDE_VESSELS}
 # Monaghan's alpha of pairs with free liquid under c0 when none is given (FluidConfig.free_artificial_viscosity): c0
 # does not grow with an impact, so the free liquid's impacts need their own, larger alpha (a value set on the pour,
 # docs/artificial_viscosity.md). The signal velocity's approach term damps impacts wherever they happen, so under it
@@ -200,24 +205,25 @@ class FluidConfig:
         "(1997)'s signal velocity of each pair, v_sig = sqrt(|g| h) + 2 max(0, -v_ij . r_ij / |r_ij|), with the "
         "speed of gravity waves at the kernel scale, sqrt(|g| h), for the sound speed the incompressible liquid does "
         "not have: the same for every scene, larger where particles collide (docs/artificial_viscosity.md).")
-    free_liquid: bool = setting(True, PRESSURE, "Treat liquid outside every vessel (the stream, spray) as free once it "
-                                "has separated (summation density below rho0): WCSPH gives it a memoryless summation "
-                                "density clamped at rho0, so no tension pulls the stream back to the vessel it left "
+    free_liquid: bool = setting(True, PRESSURE, "Treat exposed liquid (the stream, spray: where free_liquid_rule lets "
+                                "liquid be free) as free once it has separated (summation density below rho0): WCSPH "
+                                "gives it a memoryless summation density clamped at rho0, so no tension pulls the "
+                                "stream back to the vessel it left "
                                 "(cosim.fluid.wcsph.update_free_liquid; false: the continuity density everywhere, whose "
                                 "tension lands the stream short of its free-fall parabola, `cosim validate free-fall`); "
                                 "DFSPH holds it to its plain summation density (cosim.fluid.dfsph.bound_or_free_density). "
                                 "Either way its pairs use free_artificial_viscosity. Where liquid may become free: "
                                 "free_liquid_rule.")
-    free_liquid_rule: FreeLiquidRule = setting(FreeLiquidRule.OUTSIDE_VESSELS, PRESSURE, "Where liquid may become free "
-                                               "(with free_liquid): 'outside_vessels', outside every vessel's inner "
-                                               "volume (so the liquid over a weir's or a tilted pourer's crest is free "
-                                               "as well as the stream), or 'free_surface', at the free surface wherever "
-                                               "it is: Marrone et al. (2010)'s indicator, the smallest eigenvalue of "
-                                               "the renormalisation matrix, below free_surface_threshold "
-                                               "(cosim.fluid.free_surface; docs/free_surface.md). Either way the "
-                                               "liquid must also have separated (summation density below rho0) and "
-                                               "is bound again once packed (summation density >= rho0) where the "
-                                               "rule no longer holds.")
+    free_liquid_rule: FreeLiquidRule | None = setting(
+        None, PRESSURE, "Where liquid may become free (with free_liquid): 'outside_vessels', outside every vessel's "
+        "inner volume (so the liquid over a weir's or a tilted pourer's crest is free as well as the stream), or "
+        "'free_surface', at the free surface wherever it is: Marrone et al. (2010)'s indicator, the smallest "
+        "eigenvalue of the renormalisation matrix, below free_surface_threshold (cosim.fluid.free_surface; "
+        "docs/free_surface.md). Either way the liquid must also have separated (summation density below rho0) and is "
+        "bound again once packed (summation density >= rho0) where the rule no longer holds.", kind="choice",
+        choices=FreeLiquidRule, none_means="the pressure solver's own, " + ", ".join(
+            f"{r.value!r} for {s.value!r}" for s, r in DEFAULT_FREE_LIQUID_RULE.items()) + " (chosen on the validation "
+        "cases: WCSPH's free fall needs a threshold above a resting surface's indicator under 'free_surface')")
     free_surface_threshold: float = setting(0.4, PRESSURE, "free_liquid_rule 'free_surface': liquid whose indicator "
                                             "lambda is below this is at the free surface (about 1 inside the liquid, "
                                             "0.5 at a flat surface's top row, 0 for a lone particle; Marrone et al. "
@@ -386,6 +392,12 @@ class FluidConfig:
             return self.artificial_viscosity
         scale = ArtificialViscosityScale.SIGNAL_VELOCITY if self.signal_velocity_viscosity else ArtificialViscosityScale.SOUND_SPEED
         return DEFAULT_ARTIFICIAL_VISCOSITY[scale]
+
+    @property
+    def free_liquid_rule_in_effect(self) -> FreeLiquidRule:
+        """Where liquid may become free: ``free_liquid_rule``, or where unset the pressure solver's own
+        (:data:`DEFAULT_FREE_LIQUID_RULE`)."""
+        return DEFAULT_FREE_LIQUID_RULE[self.pressure_solver] if self.free_liquid_rule is None else self.free_liquid_rule
 
     @property
     def density_solve_tolerance(self) -> float:

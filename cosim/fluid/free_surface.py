@@ -48,7 +48,7 @@ def free_liquid_mode(cfg: FluidConfig) -> int:
     """The rule of ``cfg`` as the kernels' int: off, outside every vessel, or at the free surface."""
     if not cfg.free_liquid:
         return int(FREE_LIQUID_OFF)
-    if cfg.free_liquid_rule is FreeLiquidRule.FREE_SURFACE:
+    if cfg.free_liquid_rule_in_effect is FreeLiquidRule.FREE_SURFACE:
         return int(FREE_AT_SURFACE)
     return int(FREE_OUTSIDE_VESSELS)
 
