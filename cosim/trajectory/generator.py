@@ -617,8 +617,10 @@ class TrajectoryGenerator:
 
     @property
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(q, qd, qdd)`` (n,) at :attr:`time` (copies)."""
-        return tuple(a.copy() for a in self._state)  # type: ignore[return-value]
+        """``(q, qd, qdd)`` (n,) at :attr:`time` (copies; the tuple written out: a generator expression costs a call
+        per element, and the step loop reads this state twice a MuJoCo step per arm)."""
+        q, qd, qdd = self._state
+        return q.copy(), qd.copy(), qdd.copy()
 
     @property
     def at_rest(self) -> bool:
