@@ -178,6 +178,10 @@ class LiquidProbe:
         self._sums = wp.zeros((CHUNKS, STREAM_SUM_COLUMNS), dtype=float, device=device)
         self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
         self._crossing_x = wp.zeros(max(n_particles, 1), dtype=float, device=device)
+        # on the CPU, the read-back arrays' numpy views, made once (they share the arrays' memory: each is read
+        # before the next launch writes it); on other devices each read is a copy to the host
+        read_back = (self._column_levels, self._column_volumes, self._head_sums, self._sums, self._crossing_count, self._crossing_x)
+        self._views = {id(a): a.numpy() for a in read_back} if wp.get_device(device).is_cpu else None
         self._commands: dict[tuple, tuple[wp.Launch, list]] = {}  # the launch and its scalar arguments as packed
         self._layouts: dict[str, tuple[tuple[int, ...], tuple[int, ...]]] = {}  # each kernel's argument_layout
         spec = geo.pourer
@@ -213,6 +217,11 @@ class LiquidProbe:
                     packed[k] = scalar
         command.launch()
 
+    def _host(self, array: wp.array) -> np.ndarray:
+        """``array``'s values on the host: its numpy view on the CPU (valid until the next launch writes it), a copy
+        from other devices."""
+        return array.numpy() if self._views is None else self._views[id(array)]
+
     def _frame(self, pose: Pose) -> PourerFrame:
         """The pourer's frame at ``pose`` (the one struct, updated: launches copy their arguments)."""
         f = self._pourer_frame
@@ -242,12 +251,12 @@ class LiquidProbe:
             self._launch(add_column_chunks, geo.columns, [sums, CHUNKS, scale], [self._column_volumes])
         window = wp.vec3(*head_window(crest, dx))
         self._launch(sum_crest_head, CHUNKS, [window, dx, WINDOW_WIDTH * dx, geo.dim, self.n, chunk, x, active], [self._head_sums])
-        levels = self._column_levels.numpy().astype(np.float64)[: geo.columns]
-        heights = surface_heights(levels, self._column_volumes.numpy().astype(np.float64)[: geo.columns], dx)
+        levels = self._host(self._column_levels).astype(np.float64)[: geo.columns]
+        heights = surface_heights(levels, self._host(self._column_volumes).astype(np.float64)[: geo.columns], dx)
         c, slope, columns = surface_line(heights, dx)
         theta1 = math.atan(slope) if columns >= MIN_FIT_COLUMNS else tilt
 
-        volume = volume_over_crest(self._head_sums.numpy(), dx, geo.dim)
+        volume = volume_over_crest(self._host(self._head_sums), dx, geo.dim)
         if volume > 0.0:
             h_q = head_from_volume(volume, dx)
         elif columns >= MIN_FIT_COLUMNS:
@@ -258,7 +267,7 @@ class LiquidProbe:
         lip = pourer_pose.transform(geo.lip_local[None, :])[0]
         top = lip[2] + dx + max(h_q, 0.0)
         self._launch(sum_leaving_stream, CHUNKS, [frame, wp.vec3(*lip), dx, top, self.n, chunk, x, v, active], [self._sums])
-        count, svx, svz, sx, sz = self._sums.numpy().astype(np.float64).sum(axis=0)
+        count, svx, svz, sx, sz = self._host(self._sums).astype(np.float64).sum(axis=0)
         if count > 0:
             v_q, v_q_z = svx / count, svz / count
             jet_dx, jet_dz = sx / count - lip[0], sz / count - lip[2]
@@ -287,10 +296,13 @@ class LiquidProbe:
         none is (:mod:`cosim.coupling.landing`)."""
         drop = max(lip_z - rim_z, 0.0)
         min_speed = MIN_FALL_SPEED_FRACTION * math.sqrt(2.0 * gravity * drop)
-        self._crossing_count.zero_()
+        if self._views is None:
+            self._crossing_count.zero_()
+        else:
+            self._host(self._crossing_count).fill(0)
         if self.n:
             self._launch(collect_rim_crossing, self.n, [rim_z, BAND_SPACINGS * self.geo.spacing, min_speed, x, v, active], [self._crossing_count, self._crossing_x])
-        count = int(self._crossing_count.numpy()[0])
+        count = int(self._host(self._crossing_count)[0])
         if count == 0:
             return math.nan
-        return float(np.median(self._crossing_x[:count].numpy().astype(np.float64)))
+        return float(np.median(self._host(self._crossing_x)[:count].astype(np.float64)))
