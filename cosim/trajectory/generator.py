@@ -331,7 +331,7 @@ class TrajectoryGenerator:
             interval = self.settings.control_period
         clamped = (q < self._lo) | (q > self._hi)
         self._clamped += clamped
-        q = np.clip(q, self._lo, self._hi)
+        q = q.clip(self._lo, self._hi)  # the array's own clip (np.clip's, without its dispatch)
         self._history_steps = (self._history_steps + [self._steps])[-3:]
         self._history_q = (self._history_q + [q])[-3:]
         if explicit:
@@ -343,7 +343,7 @@ class TrajectoryGenerator:
                 self._check_trackable(qd, clamped)
             self._points, self._segment = [], None
             self._sync_input()
-            error = float(np.max(np.abs(np.array(self._input.current_position) - q)))
+            error = float(np.abs(np.array(self._input.current_position) - q).max())
             self._follow_with_ruckig(q, qd, qdd, clamped, interval, 0.0, error)
             return
         period = self.settings.control_period
@@ -406,8 +406,8 @@ class TrajectoryGenerator:
         (:meth:`_intercept_horizon`); ``error`` (rad) is the arm's distance to the path now."""
         self._sync_input()
         self._max_target_error = max(self._max_target_error, error)
-        qd = np.where(clamped, 0.0, np.clip(qd, -self._vmax, self._vmax))
-        qdd = np.where(clamped, 0.0, np.clip(qdd, -self._amax, self._amax))
+        qd = np.where(clamped, 0.0, qd.clip(-self._vmax, self._vmax))
+        qdd = np.where(clamped, 0.0, qdd.clip(-self._amax, self._amax))
         self._path = self._stop_at_range(q, qd, qdd, interval)
         self._path_floats = tuple(a.tolist() for a in self._path)
         self._path_lead = lead
@@ -607,7 +607,7 @@ class TrajectoryGenerator:
     def _in_range(self, q: list[float]) -> np.ndarray:
         """ruckig's positions (rad) clipped onto the joint range: its braking onto a boundary lands on it up to
         round-off (of order 1e-12 rad beyond it), which the range check must not see."""
-        return np.clip(np.array(q), self._lo, self._hi)
+        return np.array(q).clip(self._lo, self._hi)
 
     # ---- state -----------------------------------------------------------------------------------------------------
     @property
