@@ -553,7 +553,8 @@ class TrajectoryGenerator:
             self.hold()  # the last target was reached and no new one came: do not extrapolate its motion
         if self._segment is not None:
             row = 1 + self._steps + 1 - self._segment[1]  # after the start's and the end's rows
-            state = tuple(a[row] for a in self._segment_states)
+            q, qd, qdd = self._segment_states
+            state = (q[row], qd[row], qdd[row])
             self._unsent_state = state
             self._on_segment = True
             self._finished = self._segment_u(self._steps + 1) >= 1.0 - TIME_EPSILON
