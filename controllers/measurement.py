@@ -75,10 +75,10 @@ class LiquidMeasurement:
     jet_dz: float = 0.0
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
+        for name in _MEASUREMENT_FIELDS:
+            value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise MeasurementError(f"measurement.{f.name}: must be a finite number, got {value!r}")
+                raise MeasurementError(f"measurement.{name}: must be a finite number, got {value!r}")
         for name in ("volume_in_pourer", "poured_volume"):
             if getattr(self, name) < 0.0:
                 raise MeasurementError(f"measurement.{name}: must be >= 0 m^3, got {getattr(self, name):g}")
@@ -87,6 +87,9 @@ class LiquidMeasurement:
     def slosh_angle(self) -> float:
         """sigma = theta1 - tilt (rad): the free surface's angle to the world horizontal, + when higher toward +x."""
         return self.theta1 - self.tilt
+
+
+_MEASUREMENT_FIELDS = tuple(f.name for f in fields(LiquidMeasurement))  # read once: each control step checks them all
 
 
 class Phase(Enum):

@@ -27,7 +27,8 @@ def quat_wxyz_to_matrix(q: np.ndarray) -> np.ndarray:
     """Rotation matrix (3, 3) of a unit quaternion [w, x, y, z] (normalised here). The entries are computed on plain
     floats (the exchange converts both vessels' quaternions every MuJoCo step, and on numpy scalars each operation
     costs a dispatch): the same double operations, so the same bits."""
-    w, x, y, z = (np.asarray(q, dtype=float) / vector_norm(q)).tolist()
+    q = np.asarray(q, dtype=float).ravel(order="K")
+    w, x, y, z = (q / np.sqrt(q.dot(q))).tolist()  # |q|: vector_norm's operations, without its call
     return np.array(
         [
             [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -126,7 +127,10 @@ class Pose:
 
     @classmethod
     def from_quat_wxyz(cls, position, quat) -> "Pose":
-        return cls(position, quat_wxyz_to_matrix(quat))
+        pose = cls.__new__(cls)  # the new rotation matrix kept as it is (the constructor would copy it again)
+        pose.position = np.array(position, dtype=float).reshape(3)
+        pose.rotation = quat_wxyz_to_matrix(quat)
+        return pose
 
     def transform(self, points_local: np.ndarray) -> np.ndarray:
         """World coordinates of points (n, 3) given in this frame."""

@@ -2,7 +2,8 @@
 
 The host exchanges only a few hundred numbers with the liquid's arrays per control period, whatever the liquid's
 size: the controller's probe reduces the particles on the fluid's device (cosim/coupling/measure.py) and the
-solver reads back its per-substep diagnostics and the wrench. Spied here: every read-back (``wp.array.numpy``)
+solver reads back its per-substep diagnostics and the wrench. Spied here: every read-back (``wp.array.numpy``, and
+the probe's own read-back point ``LiquidProbe.read_back``, which on the CPU reads through numpy views made once)
 and upload (``wp.array.assign``, ``wp.copy``) in the same stretch of the default pour, with the stream falling
 (3.0 to 3.2 s), at two resolutions."""
 
@@ -12,7 +13,7 @@ import pytest
 import warp as wp
 
 from cosim.bench.host_overhead import POUR_WARM_UP, time_steps, warm_pour
-from cosim.coupling.measure import CHUNKS, STREAM_SUM_COLUMNS
+from cosim.coupling.measure import CHUNKS, STREAM_SUM_COLUMNS, LiquidProbe
 
 STREAM_SUMS = CHUNKS * STREAM_SUM_COLUMNS  # the probe's partial sums of the leaving stream, per chunk: a fixed size
 
@@ -24,7 +25,7 @@ COARSE, FINE = 16, 24  # particles across the pourer: 208 and 480 particles
 def _spied(monkeypatch, pour) -> Counter:
     """(operation, element count) -> calls, over SPIED_SECONDS of ``pour``."""
     seen: Counter = Counter()
-    numpy, assign, copy = wp.array.numpy, wp.array.assign, wp.copy
+    numpy, assign, copy, read_back = wp.array.numpy, wp.array.assign, wp.copy, LiquidProbe.read_back
 
     def spy_numpy(self):
         seen["read", self.size] += 1
@@ -38,10 +39,16 @@ def _spied(monkeypatch, pour) -> Counter:
         seen["copy", src.size] += 1
         return copy(dest, src, *args, **kwargs)
 
+    def spy_read_back(self, array, size=None):
+        values = read_back(self, array, size)
+        seen["probe read", values.size] += 1
+        return values
+
     with monkeypatch.context() as m:
         m.setattr(wp.array, "numpy", spy_numpy)
         m.setattr(wp.array, "assign", spy_assign)
         m.setattr(wp, "copy", spy_copy)
+        m.setattr(LiquidProbe, "read_back", spy_read_back)
         time_steps(pour, SPIED_SECONDS)
     return seen
 

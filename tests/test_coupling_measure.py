@@ -222,6 +222,6 @@ def test_probe_equals_the_numpy_contract_on_a_pouring_sph_liquid(dim, across, cr
 def test_a_launch_s_key_reads_the_array_arguments_its_signature_names():
     from cosim.coupling.measure import argument_layout, collect_rim_crossing, sum_leaving_stream
 
-    # frame, lip, dx, top, n, chunk, then x, v, active, sums
-    assert argument_layout(sum_leaving_stream) == ((6, 7, 8, 9), (0, 1, 2, 3, 4, 5))
+    # frames (an array of one), lip, dx, top, n, chunk, then x, v, active, sums
+    assert argument_layout(sum_leaving_stream) == ((0, 6, 7, 8, 9), (1, 2, 3, 4, 5))
     assert argument_layout(collect_rim_crossing) == ((3, 4, 5, 6, 7), (0, 1, 2))

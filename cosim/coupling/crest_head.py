@@ -78,7 +78,7 @@ def bspline_share_above(s: float) -> float:
 @wp.kernel
 def sum_crest_head(
     # Model
-    window: wp.vec3,
+    windows: wp.array(dtype=wp.vec3),
     dx: float,
     width: float,
     dim: int,
@@ -91,8 +91,10 @@ def sum_crest_head(
     sums: wp.array(dtype=float),
 ):
     """Per chunk of ``chunk`` consecutive particles, in order: sum of B(sx) [B(sy)] C(sz) (module docstring; window
-    = world (x_w, y_w, z_c), its width w = ``width``; m = dx (dx / w)^(dim - 1) times the total)."""
+    = world (x_w, y_w, z_c) = ``windows[0]``, an array of one, written before each measurement, so that a captured
+    graph of the launch reads the current one; its width w = ``width``; m = dx (dx / w)^(dim - 1) times the total)."""
     k = wp.tid()
+    window = windows[0]
     total = float(0.0)
     for i in range(k * chunk, wp.min((k + 1) * chunk, n)):
         if active[i] == 0:

@@ -21,8 +21,8 @@ ROLES = (ArmRole.POUR, ArmRole.CATCH)  # fluid vessel index k <-> ROLES[k]
 def vessel_poses(scene: RobotScene) -> list[Pose]:
     """World poses of the pourer and the catcher frames, in the fluid's vessel order (valid after mj_forward or
     mj_kinematics; read from the bodies' rows as they are: the Pose copies them)."""
-    xpos, xquat = scene.data.xpos, scene.data.xquat
-    return [Pose.from_quat_wxyz(xpos[body], xquat[body]) for body in (scene.arms[role].vessel_body for role in ROLES)]
+    xpos, xquat, arms = scene.data.xpos, scene.data.xquat, scene.arms
+    return [Pose.from_quat_wxyz(xpos[arms[role].vessel_body], xquat[arms[role].vessel_body]) for role in ROLES]
 
 
 def wrench_at_body_com(scene: RobotScene, role: ArmRole, pose: Pose, wrench: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

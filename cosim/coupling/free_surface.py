@@ -85,7 +85,7 @@ def section_extent(f: PourerFrame, qx: float) -> float:
 @wp.kernel
 def sum_columns(
     # Model
-    f: PourerFrame,
+    frames: wp.array(dtype=PourerFrame),
     width: float,
     dx: float,
     columns: int,
@@ -101,8 +101,10 @@ def sum_columns(
 ):
     """Per chunk of ``chunk`` consecutive particles, in order, and per column: sum over the chunk's liquid in the
     inner box of B((x_i - x_k) / w) / D(x_i)^(dim - 2) (``layer`` 0: M_k), times C((z_i - z_k) / dx) with z_k =
-    ``levels[k]`` (``layer`` 1: m_k) (module docstring; w = ``width``)."""
+    ``levels[k]`` (``layer`` 1: m_k) (module docstring; w = ``width``). The pourer's frame is ``frames[0]`` (an
+    array of one, written before each measurement, so that a captured graph of the launches reads the current one)."""
     k = wp.tid()
+    f = frames[0]
     half = (columns - 1) // 2
     for c in range(columns):
         sums[k, c] = 0.0

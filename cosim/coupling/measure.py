@@ -74,7 +74,7 @@ class MeasurementGeometry:
 @wp.kernel
 def sum_leaving_stream(
     # Model
-    f: PourerFrame,
+    frames: wp.array(dtype=PourerFrame),
     lip: wp.vec3,
     dx: float,
     top: float,
@@ -89,8 +89,9 @@ def sum_leaving_stream(
 ):
     """Per chunk of ``chunk`` consecutive particles, in order: count, sum vx, sum vz, sum x, sum z of the particles
     that have just left over the lip (outside the inner box, x in [x_lip + dx, x_lip + 4 dx], z in
-    [z_lip - 6 dx, top])."""
+    [z_lip - 6 dx, top]); the pourer's frame is ``frames[0]``."""
     k = wp.tid()
+    f = frames[0]
     count = float(0.0)
     svx = float(0.0)
     svz = float(0.0)
@@ -178,15 +179,24 @@ class LiquidProbe:
         self._sums = wp.zeros((CHUNKS, STREAM_SUM_COLUMNS), dtype=float, device=device)
         self._crossing_count = wp.zeros(1, dtype=wp.int32, device=device)
         self._crossing_x = wp.zeros(max(n_particles, 1), dtype=float, device=device)
+        # on the CPU, the read-back arrays' numpy views, made once (they share the arrays' memory: each is read
+        # before the next launch writes it); on other devices each read is a copy to the host
+        results = (self._column_levels, self._column_volumes, self._head_sums, self._sums, self._crossing_count, self._crossing_x)
+        self._views = {id(a): a.numpy() for a in results} if wp.get_device(device).is_cpu else None
         self._commands: dict[tuple, tuple[wp.Launch, list]] = {}  # the launch and its scalar arguments as packed
         self._layouts: dict[str, tuple[tuple[int, ...], tuple[int, ...]]] = {}  # each kernel's argument_layout
         spec = geo.pourer
-        self._pourer_frame = PourerFrame()  # the fixed fields once; :meth:`_frame` sets the pose (warp struct fields are costly to set)
-        self._pourer_frame.half_width = 0.5 * spec.inner_width
-        self._pourer_frame.half_depth = 0.5 * spec.section_depth
-        self._pourer_frame.height = spec.inner_height
-        self._pourer_frame.dim = geo.dim
-        self._pourer_frame.round_section = int(geo.dim == 3 and spec.shape is VesselShape.CYLINDER)
+        frame = PourerFrame()  # the fixed fields once; :meth:`_set_pose` writes the pose before each measurement
+        frame.half_width = 0.5 * spec.inner_width
+        frame.half_depth = 0.5 * spec.section_depth
+        frame.height = spec.inner_height
+        frame.dim = geo.dim
+        frame.round_section = int(geo.dim == 3 and spec.shape is VesselShape.CYLINDER)
+        self._frame = wp.array([frame], dtype=PourerFrame, device=device)  # one entry: the kernels read it there
+        self._window = wp.zeros(1, dtype=wp.vec3, device=device)  # the crest head's window centre (m)
+        # what :meth:`_set_pose` writes: the arrays' own memory on the CPU, host copies uploaded elsewhere
+        self._frame_host, self._window_host = self._frame.numpy(), self._window.numpy()
+        self._graphs: dict[tuple[int, int], object] = {}  # the surface launches captured, per particle array set
 
     def _launch(self, kernel, dim: int, inputs: list, outputs: list) -> None:
         """``wp.launch(kernel, dim, inputs, outputs)`` through a recorded launch kept per kernel and array set (the
@@ -213,12 +223,49 @@ class LiquidProbe:
                     packed[k] = scalar
         command.launch()
 
-    def _frame(self, pose: Pose) -> PourerFrame:
-        """The pourer's frame at ``pose`` (the one struct, updated: launches copy their arguments)."""
-        f = self._pourer_frame
-        f.origin = wp.vec3(*pose.position)
-        f.rotation = wp.mat33(*pose.rotation.ravel())
-        return f
+    def read_back(self, array: wp.array, size: int | None = None) -> np.ndarray:
+        """The first ``size`` values (None: all) of one of the probe's result arrays on the host: every value the
+        probe reads from the device comes through here. On the CPU the array's numpy view (valid until the next
+        launch writes it), elsewhere a copy of just those values."""
+        if self._views is None:
+            return (array if size is None else array[:size]).numpy()
+        return self._views[id(array)][:size]
+
+    def _set_pose(self, pose: Pose, window: np.ndarray) -> None:
+        """The pourer's frame at ``pose`` and the crest head's window centre (m) into the arrays the kernels read
+        (float32, rounded as a launch's own vectors are)."""
+        self._frame_host["origin"][0] = pose.position
+        self._frame_host["rotation"][0] = pose.rotation
+        self._window_host[0] = window
+        if self._views is None:  # not the arrays' own memory: uploaded
+            self._frame.assign(self._frame_host)
+            self._window.assign(self._window_host)
+
+    def _surface_launches(self, x: wp.array, active: wp.array) -> None:
+        """The launches that need nothing from the host but the pose: the free-surface columns' heights, levels and
+        volumes over them, and the liquid over the crest (their scalars are the geometry's, fixed)."""
+        geo, dx, device = self.geo, self.geo.spacing, self.device
+        chunk = max(math.ceil(self.n / CHUNKS), 1)
+        if geo.columns:
+            scale, sums = column_scale(dx, geo.dim), self._column_sums
+            columns = [self._frame, WINDOW_WIDTH * dx, dx, geo.columns, self.n, chunk, x, active, self._column_levels]
+            wp.launch(sum_columns, CHUNKS, [*columns, 0], [sums], device=device)
+            wp.launch(add_column_chunks, geo.columns, [sums, CHUNKS, scale], [self._column_heights], device=device)
+            wp.launch(layer_levels, geo.columns, [self._column_heights, LAYER_SPACINGS * dx, float(REACH) * dx], [self._column_levels], device=device)
+            wp.launch(sum_columns, CHUNKS, [*columns, 1], [sums], device=device)
+            wp.launch(add_column_chunks, geo.columns, [sums, CHUNKS, scale], [self._column_volumes], device=device)
+        wp.launch(sum_crest_head, CHUNKS, [self._window, dx, WINDOW_WIDTH * dx, geo.dim, self.n, chunk, x, active], [self._head_sums], device=device)
+
+    def _measure_surface(self, x: wp.array, active: wp.array) -> None:
+        """:meth:`_surface_launches` as one graph, captured at the first call with these particle arrays (the solver's
+        alternate between two) and replayed: the launches' argument handling once instead of at every measurement."""
+        key = (x.ptr, active.ptr)
+        graph = self._graphs.get(key)
+        if graph is None:
+            with wp.ScopedCapture(device=self.device) as capture:
+                self._surface_launches(x, active)
+            graph = self._graphs[key] = capture.graph
+        wp.capture_launch(graph)
 
     def measure(
         self, t: float, pourer_pose: Pose, catcher_pose: Pose, x: wp.array, v: wp.array, active: wp.array,
@@ -228,26 +275,17 @@ class LiquidProbe:
         solver's count-based volume in the pourer (m^3)."""
         geo, dx = self.geo, self.geo.spacing
         height = geo.pourer.inner_height
-        frame = self._frame(pourer_pose)
         tilt = tilt_about_y(pourer_pose.rotation)
         crest = pourer_pose.transform(geo.crest_local[None, :])[0]
         chunk = max(math.ceil(self.n / CHUNKS), 1)
-        if geo.columns:
-            scale, sums = column_scale(dx, geo.dim), self._column_sums
-            columns = [frame, WINDOW_WIDTH * dx, dx, geo.columns, self.n, chunk, x, active, self._column_levels]
-            self._launch(sum_columns, CHUNKS, [*columns, 0], [sums])
-            self._launch(add_column_chunks, geo.columns, [sums, CHUNKS, scale], [self._column_heights])
-            self._launch(layer_levels, geo.columns, [self._column_heights, LAYER_SPACINGS * dx, float(REACH) * dx], [self._column_levels])
-            self._launch(sum_columns, CHUNKS, [*columns, 1], [sums])
-            self._launch(add_column_chunks, geo.columns, [sums, CHUNKS, scale], [self._column_volumes])
-        window = wp.vec3(*head_window(crest, dx))
-        self._launch(sum_crest_head, CHUNKS, [window, dx, WINDOW_WIDTH * dx, geo.dim, self.n, chunk, x, active], [self._head_sums])
-        levels = self._column_levels.numpy().astype(np.float64)[: geo.columns]
-        heights = surface_heights(levels, self._column_volumes.numpy().astype(np.float64)[: geo.columns], dx)
+        self._set_pose(pourer_pose, head_window(crest, dx))
+        self._measure_surface(x, active)
+        levels = self.read_back(self._column_levels, geo.columns).astype(np.float64)
+        heights = surface_heights(levels, self.read_back(self._column_volumes, geo.columns).astype(np.float64), dx)
         c, slope, columns = surface_line(heights, dx)
         theta1 = math.atan(slope) if columns >= MIN_FIT_COLUMNS else tilt
 
-        volume = volume_over_crest(self._head_sums.numpy(), dx, geo.dim)
+        volume = volume_over_crest(self.read_back(self._head_sums), dx, geo.dim)
         if volume > 0.0:
             h_q = head_from_volume(volume, dx)
         elif columns >= MIN_FIT_COLUMNS:
@@ -257,8 +295,8 @@ class LiquidProbe:
 
         lip = pourer_pose.transform(geo.lip_local[None, :])[0]
         top = lip[2] + dx + max(h_q, 0.0)
-        self._launch(sum_leaving_stream, CHUNKS, [frame, wp.vec3(*lip), dx, top, self.n, chunk, x, v, active], [self._sums])
-        count, svx, svz, sx, sz = self._sums.numpy().astype(np.float64).sum(axis=0)
+        self._launch(sum_leaving_stream, CHUNKS, [self._frame, wp.vec3(*lip), dx, top, self.n, chunk, x, v, active], [self._sums])
+        count, svx, svz, sx, sz = self.read_back(self._sums).astype(np.float64).sum(axis=0)
         if count > 0:
             v_q, v_q_z = svx / count, svz / count
             jet_dx, jet_dz = sx / count - lip[0], sz / count - lip[2]
@@ -287,10 +325,13 @@ class LiquidProbe:
         none is (:mod:`cosim.coupling.landing`)."""
         drop = max(lip_z - rim_z, 0.0)
         min_speed = MIN_FALL_SPEED_FRACTION * math.sqrt(2.0 * gravity * drop)
-        self._crossing_count.zero_()
+        if self._views is None:
+            self._crossing_count.zero_()
+        else:
+            self._views[id(self._crossing_count)].fill(0)
         if self.n:
             self._launch(collect_rim_crossing, self.n, [rim_z, BAND_SPACINGS * self.geo.spacing, min_speed, x, v, active], [self._crossing_count, self._crossing_x])
-        count = int(self._crossing_count.numpy()[0])
+        count = int(self.read_back(self._crossing_count)[0])
         if count == 0:
             return math.nan
-        return float(np.median(self._crossing_x[:count].numpy().astype(np.float64)))
+        return float(np.median(self.read_back(self._crossing_x, count).astype(np.float64)))

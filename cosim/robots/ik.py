@@ -155,8 +155,9 @@ class ArmIK:
                     break
             mujoco.mj_comPos(model, data)
             mujoco.mj_jacSite(model, data, self._jacp, self._jacr, self.site_id)
-            np.take(self._jacp, self.dof_adr, axis=1, out=jac[:3])
-            np.multiply(s.rotation_length, np.take(self._jacr, self.dof_adr, axis=1), out=jac[3:])
+            # the arrays' own methods (what numpy's functions of the same names call, without their dispatch)
+            self._jacp.take(self.dof_adr, axis=1, out=jac[:3])
+            np.multiply(s.rotation_length, self._jacr.take(self.dof_adr, axis=1), out=jac[3:])
             err[:3] = e_pos
             np.multiply(s.rotation_length, e_rot, out=err[3:])
             dq = np.linalg.solve(jac @ jac.T + damping2, jac).T @ err  # J^T (J J^T + l^2 I)^-1 e
@@ -166,10 +167,10 @@ class ArmIK:
                 if task_ok and float(np.max(np.abs(pull))) <= s.posture_tolerance:
                     return IKResult(q, err_p, err_r, iteration, True)
                 dq += s.posture_gain * pull
-            largest = float(np.max(np.abs(dq)))
+            largest = float(np.abs(dq).max())
             if largest > s.max_step:
                 dq *= s.max_step / largest
-            q = np.clip(q + dq, self.lower, self.upper)
+            q = (q + dq).clip(self.lower, self.upper)
         return IKResult(q, err_p, err_r, iteration, task_ok)
 
     def solve_or_raise(

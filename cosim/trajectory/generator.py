@@ -331,7 +331,7 @@ class TrajectoryGenerator:
             interval = self.settings.control_period
         clamped = (q < self._lo) | (q > self._hi)
         self._clamped += clamped
-        q = np.clip(q, self._lo, self._hi)
+        q = q.clip(self._lo, self._hi)  # the array's own clip (np.clip's, without its dispatch)
         self._history_steps = (self._history_steps + [self._steps])[-3:]
         self._history_q = (self._history_q + [q])[-3:]
         if explicit:
@@ -343,7 +343,7 @@ class TrajectoryGenerator:
                 self._check_trackable(qd, clamped)
             self._points, self._segment = [], None
             self._sync_input()
-            error = float(np.max(np.abs(np.array(self._input.current_position) - q)))
+            error = float(np.abs(np.array(self._input.current_position) - q).max())
             self._follow_with_ruckig(q, qd, qdd, clamped, interval, 0.0, error)
             return
         period = self.settings.control_period
@@ -406,8 +406,8 @@ class TrajectoryGenerator:
         (:meth:`_intercept_horizon`); ``error`` (rad) is the arm's distance to the path now."""
         self._sync_input()
         self._max_target_error = max(self._max_target_error, error)
-        qd = np.where(clamped, 0.0, np.clip(qd, -self._vmax, self._vmax))
-        qdd = np.where(clamped, 0.0, np.clip(qdd, -self._amax, self._amax))
+        qd = np.where(clamped, 0.0, qd.clip(-self._vmax, self._vmax))
+        qdd = np.where(clamped, 0.0, qdd.clip(-self._amax, self._amax))
         self._path = self._stop_at_range(q, qd, qdd, interval)
         self._path_floats = tuple(a.tolist() for a in self._path)
         self._path_lead = lead
@@ -553,7 +553,8 @@ class TrajectoryGenerator:
             self.hold()  # the last target was reached and no new one came: do not extrapolate its motion
         if self._segment is not None:
             row = 1 + self._steps + 1 - self._segment[1]  # after the start's and the end's rows
-            state = tuple(a[row] for a in self._segment_states)
+            q, qd, qdd = self._segment_states
+            state = (q[row], qd[row], qdd[row])
             self._unsent_state = state
             self._on_segment = True
             self._finished = self._segment_u(self._steps + 1) >= 1.0 - TIME_EPSILON
@@ -607,7 +608,7 @@ class TrajectoryGenerator:
     def _in_range(self, q: list[float]) -> np.ndarray:
         """ruckig's positions (rad) clipped onto the joint range: its braking onto a boundary lands on it up to
         round-off (of order 1e-12 rad beyond it), which the range check must not see."""
-        return np.clip(np.array(q), self._lo, self._hi)
+        return np.array(q).clip(self._lo, self._hi)
 
     # ---- state -----------------------------------------------------------------------------------------------------
     @property
@@ -617,8 +618,10 @@ class TrajectoryGenerator:
 
     @property
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(q, qd, qdd)`` (n,) at :attr:`time` (copies)."""
-        return tuple(a.copy() for a in self._state)  # type: ignore[return-value]
+        """``(q, qd, qdd)`` (n,) at :attr:`time` (copies; the tuple written out: a generator expression costs a call
+        per element, and the step loop reads this state twice a MuJoCo step per arm)."""
+        q, qd, qdd = self._state
+        return q.copy(), qd.copy(), qdd.copy()
 
     @property
     def at_rest(self) -> bool:

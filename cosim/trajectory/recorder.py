@@ -51,14 +51,16 @@ class TrajectoryRecorder:
 
     def record(self) -> None:
         """Take every sample due up to the generators' current time (inside their last step)."""
-        now = self.generators[0].time
-        if any(g.time != now for g in self.generators):
+        times = {g.time for g in self.generators}
+        if len(times) > 1:
             raise ValueError("TrajectoryRecorder.record: the generators are at different times; step them all first")
-        while self._sample_time(len(self._times)) <= now + TIME_EPSILON:
-            t = self._sample_time(len(self._times))
-            states = [g.state_at(t) for g in self.generators]
-            self._rows.append(tuple(np.concatenate([s[i] for s in states]) for i in range(3)))  # type: ignore[arg-type]
+        now = times.pop()
+        t = self._sample_time(len(self._times))
+        while t <= now + TIME_EPSILON:
+            # per quantity (q, qd, qdd) the generators' arrays joined, in generator order
+            self._rows.append(tuple([np.concatenate(column) for column in zip(*[g.state_at(t) for g in self.generators])]))  # type: ignore[arg-type]
             self._times.append(t)
+            t = self._sample_time(len(self._times))
 
     def trajectory(self) -> JointTrajectory:
         """The samples so far (at least two are needed)."""
