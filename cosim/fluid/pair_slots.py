@@ -6,9 +6,9 @@ gradient, that times its mass). Three layouts, the same entries in the same orde
 - packed (the CPU's): the particles of each block of :data:`PAIR_BLOCK` consecutive particles store their entries
   one after the other, from the block's first slot (block * PAIR_BLOCK * capacity) on, so a pass over the pair list
   reads one contiguous stream per block instead of a row per particle that is mostly empty (a 3-D support holds
-  about 110 neighbours in rows of 283 slots: each row read starts a new stream the hardware prefetcher has to
-  find again; the pair passes of a 3-D substep took about 0.6 x their time with rows three quarters full). The
-  builder keeps each block's next free slot while it walks; the particles of a block must be built one after the
+  about 110 neighbours, a row 2.5 times the lattice's 113: each row read would start a new stream that the
+  hardware prefetcher has to find again; docs/performance.md has the measurements). The builder keeps each
+  block's next free slot while it walks; the particles of a block must be built one after the
   other, in order, by one thread, which holds on the CPU (a launch runs its threads in order, and the lanes deal
   out chunks of ``cosim.fluid.lanes.LANE_CHUNK`` = PAIR_BLOCK particles, ``cosim.fluid.lanes.lane_item``);
 - rows: particle i's entries at i * capacity, one after the other (CUDA's Gauss-Seidel solve);
@@ -26,13 +26,18 @@ import warp as wp
 from cosim.fluid.lanes import LANE_CHUNK
 
 PAIR_BLOCK = LANE_CHUNK
+# A block's next free slot sits this many int32 after the previous block's (64 bytes, a cache line): neighbouring
+# blocks belong to different lanes, and two lanes' cursors in one line would pass it between the cores on every
+# particle (false sharing)
+BLOCK_NEXT_STRIDE = 16
 
 
 @wp.struct
 class PairSlots:
     """``start`` (N,): each particle's first slot; ``step``: the slots between its consecutive entries; ``stride``:
     a fixed layout's slots between consecutive particles' first entries (0: packed by blocks); ``capacity``: entries
-    a particle may have; ``block_next`` (blocks,): a packed build's next free slot of each block."""
+    a particle may have; ``block_next`` (blocks x :data:`BLOCK_NEXT_STRIDE`,): a packed build's next free slot of each
+    block, at its first entry."""
 
     start: wp.array(dtype=wp.int32)
     step: int
@@ -49,8 +54,8 @@ def open_pair_row(slots: PairSlots, i: int) -> int:
     if slots.stride == 0:
         block = i // PAIR_BLOCK
         if i % PAIR_BLOCK == 0:
-            slots.block_next[block] = block * PAIR_BLOCK * slots.capacity
-        first = slots.block_next[block]
+            slots.block_next[block * BLOCK_NEXT_STRIDE] = block * PAIR_BLOCK * slots.capacity
+        first = slots.block_next[block * BLOCK_NEXT_STRIDE]
     slots.start[i] = first
     return first
 
@@ -59,7 +64,7 @@ def open_pair_row(slots: PairSlots, i: int) -> int:
 def close_pair_row(slots: PairSlots, i: int, first: int, count: int):
     """Particle i's list built with ``count`` entries: a packed block's next particle starts after them."""
     if slots.stride == 0:
-        slots.block_next[i // PAIR_BLOCK] = first + count * slots.step
+        slots.block_next[(i // PAIR_BLOCK) * BLOCK_NEXT_STRIDE] = first + count * slots.step
 
 
 def pair_slots(rows: int, capacity: int, device, by_column: bool, packed: bool) -> PairSlots:
@@ -71,7 +76,7 @@ def pair_slots(rows: int, capacity: int, device, by_column: bool, packed: bool) 
     slots = PairSlots()
     slots.start = wp.zeros(max(rows, 1), dtype=wp.int32, device=device)
     slots.capacity = capacity
-    slots.block_next = wp.zeros(max(-(-rows // PAIR_BLOCK), 1), dtype=wp.int32, device=device)
+    slots.block_next = wp.zeros(max(-(-rows // PAIR_BLOCK), 1) * BLOCK_NEXT_STRIDE, dtype=wp.int32, device=device)
     if by_column:
         slots.step, slots.stride = max(rows, 1), 1
     elif packed:
