@@ -43,9 +43,9 @@ def test_each_pair_layout_asked_for_is_profiled_with_the_rest_of_the_devices_lay
     from cosim.bench.kernel_profile import main
     from cosim.fluid.device_layout import CPU_LAYOUT
 
-    assert main(["--device", "cpu", "--cases", "2:400:dfsph:jacobi", "--steps", "4", "--pair-layouts", "rows", "columns", "--out", str(tmp_path)]) == 0
+    assert main(["--device", "cpu", "--cases", "2:400:dfsph:jacobi", "--steps", "4", "--pair-layouts", "rows", "columns", "packed", "--out", str(tmp_path)]) == 0
     headings = [line for line in (tmp_path / "kernel_profile.md").read_text().splitlines() if line.startswith("## ")]
-    assert [h.rsplit(", ", 1)[1] for h in headings] == ["pair tables in rows", "pair tables in columns"]
+    assert [h.rsplit(", ", 1)[1] for h in headings] == ["pair tables in rows", "pair tables in columns", "pair tables in packed"]
 
     # the solver is built with the layout asked for (slot-major tables on the CPU, the CPU's reductions kept)
     columns = replace(CPU_LAYOUT, pairs_by_column=True)

@@ -33,19 +33,6 @@ def record_walk(nb: Neighborhood, radius: float, liquid_only: int, points: wp.ar
     found[i, 0] = n
 
 
-def sorted_cloud(rng, n: int, dim: int, device) -> tuple[CellGrid, wp.array]:
-    """n random points sorted into a cell grid of one radius per cell (the liquid's layout: cell order)."""
-    x = rng.uniform(*DOMAIN, (n, 3))
-    if dim == 2:
-        x[:, 1] = 0.0
-    grid = CellGrid([DOMAIN[0]] * 3, [DOMAIN[1]] * 3, RADIUS, dim, n, device)
-    ones = wp.ones(n, dtype=wp.int32, device=device)
-    grid.build(wp.array(x, dtype=wp.vec3, device=device), ones, n)
-    x_sorted = wp.array(x[grid.order.numpy()[:n]], dtype=wp.vec3, device=device)
-    grid.build(x_sorted, ones, n)
-    return grid, x_sorted
-
-
 def expected_walk(points, x, bx, b_order, cell_of, b_cell_of, walls: bool, min_r2: float):
     """Brute force: every point within RADIUS (and at least sqrt(min_r2) away), ordered by (cell, liquid before
     wall, position in its cell list): (kind, index) pairs, kind 1 for a wall particle."""
@@ -73,25 +60,30 @@ def cell_index(grid: CellGrid, x: np.ndarray) -> np.ndarray:
     return (c[:, 2] * spec.ny + c[:, 1]) * spec.nx + c[:, 0]
 
 
-@pytest.mark.parametrize("dim", [2, 3])
-@pytest.mark.parametrize("liquid_only", [False, True])
-def test_walk_visits_the_points_within_the_radius_in_cell_order(dim, liquid_only):
+def sorted_points(x: np.ndarray, dim: int, device) -> tuple[CellGrid, wp.array]:
+    """The points ``x`` sorted into a cell grid of one radius per cell (the liquid's layout: cell order)."""
+    n = len(x)
+    grid = CellGrid([DOMAIN[0]] * 3, [DOMAIN[1]] * 3, RADIUS, dim, n, device)
+    ones = wp.ones(n, dtype=wp.int32, device=device)
+    grid.build(wp.array(x, dtype=wp.vec3, device=device), ones, n)
+    x_sorted = wp.array(x[grid.order.numpy()[:n]], dtype=wp.vec3, device=device)
+    grid.build(x_sorted, ones, n)
+    return grid, x_sorted
+
+
+def check_walks(x_np: np.ndarray, bx_np: np.ndarray, dim: int, liquid_only: bool, walkers: int) -> None:
+    """The walk from the first ``walkers`` liquid particles (each leaves itself out) and from every wall particle
+    (a wall particle's liquid walk counts a liquid particle put exactly on it) against the brute force."""
     device = "cpu"
-    rng = np.random.default_rng(7 + dim)
-    n = 400 if dim == 2 else 1500
-    grid, x = sorted_cloud(rng, n, dim, device)
-    bx_np = rng.uniform(*DOMAIN, (n // 3, 3))
-    if dim == 2:
-        bx_np[:, 1] = 0.0
+    n = len(x_np)
+    grid, x = sorted_points(x_np, dim, device)
     bx = wp.array(bx_np, dtype=wp.vec3, device=device)
     wall_grid = CellGrid([DOMAIN[0]] * 3, [DOMAIN[1]] * 3, RADIUS, dim, len(bx_np), device)
     wall_grid.build(bx, wp.ones(len(bx_np), dtype=wp.int32, device=device), len(bx_np))
     nb = neighborhood(grid, x, wall_grid, bx)
 
     x_np = x.numpy().astype(float)
-    # the walk from the liquid particles themselves (each leaves itself out) and from the wall particles
-    # (a wall particle's liquid walk counts a liquid particle put exactly on it)
-    points_np = np.concatenate([x_np[: n // 4], bx_np.astype(np.float32).astype(float)])
+    points_np = np.concatenate([x_np[:walkers], bx_np.astype(np.float32).astype(float)])
     points_np[-1] = x_np[-1]
     points = wp.array(points_np, dtype=wp.vec3, device=device)
     m = len(points_np)
@@ -113,3 +105,34 @@ def test_walk_visits_the_points_within_the_radius_in_cell_order(dim, liquid_only
     for k in range(m):
         codes = found[k, 1 : 1 + count[k]]
         assert [(1, -1 - c) if c < 0 else (0, c) for c in codes.tolist()] == expected[k], f"point {k}"
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("liquid_only", [False, True])
+def test_walk_visits_the_points_within_the_radius_in_cell_order(dim, liquid_only):
+    rng = np.random.default_rng(7 + dim)
+    n = 400 if dim == 2 else 1500
+    x = rng.uniform(*DOMAIN, (n, 3))
+    bx = rng.uniform(*DOMAIN, (n // 3, 3))
+    if dim == 2:
+        x[:, 1] = bx[:, 1] = 0.0
+    check_walks(x, bx, dim, liquid_only, walkers=n // 4)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_walk_finds_the_points_on_cell_faces_and_beyond_the_grid(dim):
+    """The walk leaves out the cells of its block that lie beyond the radius (``cell_within_reach``): points on
+    the cells' faces and corners, a float32 ulp either side of them, and outside the grid (filed in its end cells)
+    are found all the same."""
+    rng = np.random.default_rng(11 + dim)
+    count = 120 if dim == 2 else 600  # a 2-D grid's faces hold fewer distinct points
+    faces = RADIUS * rng.integers(0, 11, (count, 3)).astype(float)
+    ulp = np.spacing(np.float32(1.0)) * rng.choice([-2.0, -1.0, 0.0, 1.0, 2.0], faces.shape)
+    on_faces = (faces.astype(np.float32) * (1.0 + ulp.astype(np.float32))).astype(float)
+    near_faces = faces + rng.choice([-1.0, 1.0], faces.shape) * rng.uniform(0.0, 0.02, faces.shape)
+    outside = rng.uniform(DOMAIN[0] - 0.15, DOMAIN[1] + 0.15, (count // 2, 3))
+    x = np.concatenate([on_faces, near_faces, outside])
+    bx = np.concatenate([near_faces[::3], outside[::3]])
+    if dim == 2:
+        x[:, 1] = bx[:, 1] = 0.0
+    check_walks(x, bx, dim, liquid_only=False, walkers=len(x))

@@ -2,16 +2,18 @@
 timed by warp's CUDA activity timing (a profile, not a benchmark: launches run one by one so each is timed).
 
     python -m cosim.bench.kernel_profile [--device cuda] [--cases 3:1000000:wcsph 2:10000:dfsph:jacobi] [--steps 20]
-                                         [--top 12] [--pair-layouts rows columns] [--out DIR]
+                                         [--top 12] [--pair-layouts rows columns packed] [--out DIR]
 
 For each case (dim:particles:solver, for DFSPH optionally :gauss_seidel or :jacobi, its density iteration) the
 block of ``cosim.bench.fluid_throughput`` settles for one interval of ``steps`` WCSPH substeps, then one more is timed: the wall time, the sum of the device activities (their
 difference is the host's launch and synchronisation cost), and the ``top`` activities by total time, with their
 count and milliseconds per substep. On the CPU, where warp times nothing per kernel, each operation of the substeps is
-timed on the host's clock instead (:class:`OperationTimer`, the solver's ``operation_hook``; a CPU launch returns
-when it is done), the lanes' shares one after the other.
-``--pair-layouts`` profiles each case once per layout of the neighbour-pair tables (``rows``: a row per particle,
-the CPU's; ``columns``: slot-major, CUDA's; :mod:`cosim.fluid.device_layout`), the rest of the device's layout kept:
+timed on the host instead (:class:`OperationTimer`, the solver's ``operation_hook``; a CPU launch returns
+when it is done), the lanes' shares one after the other, by the thread's CPU time, which leaves out the moments
+the OS gave the core to another process (on a shared machine a profile's wall times swing with the load).
+``--pair-layouts`` profiles each case once per layout of the neighbour-pair tables (``rows``: a row per particle;
+``columns``: slot-major, CUDA's; ``packed``: DFSPH's lists of each block of particles one after the other, the
+CPU's, the CPU only; :mod:`cosim.fluid.device_layout`, :mod:`cosim.fluid.pair_slots`), the rest of the device's layout kept:
 the particles are the same under either, so the kernels' times compare the layouts alone.
 Writes DIR/kernel_profile.md (atomically) besides printing it.
 """
@@ -34,7 +36,12 @@ from cosim.fluid.runtime import resolve_device
 
 # the speed targets' sizes (3-D 1M, 2-D 10k), each solver, DFSPH with either density iteration
 DEFAULT_CASES = [f"{size}:{solver}" for size in ("3:1000000", "2:10000") for solver in ("wcsph", "dfsph:jacobi", "dfsph:gauss_seidel")]
-PAIR_LAYOUTS = {"rows": False, "columns": True}  # --pair-layouts: name -> DeviceLayout.pairs_by_column
+# --pair-layouts: name -> the DeviceLayout fields of the pair tables
+PAIR_LAYOUTS = {
+    "rows": dict(pairs_by_column=False, pairs_packed=False),
+    "columns": dict(pairs_by_column=True, pairs_packed=False),
+    "packed": dict(pairs_by_column=False, pairs_packed=True),
+}
 
 
 def parse_case(text: str) -> tuple[int, int, PressureSolver, DensityIteration]:
@@ -50,18 +57,18 @@ def operation_name(op) -> str:
 
 
 class OperationTimer:
-    """A :attr:`FluidSolver.operation_hook` that times each operation on the host's clock (ms, by
-    :func:`operation_name`): on the CPU a launch runs to completion before it returns."""
+    """A :attr:`FluidSolver.operation_hook` that times each operation by the calling thread's CPU time (ms, by
+    :func:`operation_name`): on the CPU a launch runs to completion on that thread before it returns."""
 
     def __init__(self) -> None:
         self.total: dict[str, float] = defaultdict(float)
         self.count: dict[str, int] = defaultdict(int)
 
     def __call__(self, op) -> None:
-        start = time.perf_counter()
+        start = time.thread_time()
         op()
         name = operation_name(op)
-        self.total[name] += 1e3 * (time.perf_counter() - start)
+        self.total[name] += 1e3 * (time.thread_time() - start)
         self.count[name] += 1
 
 
@@ -69,9 +76,9 @@ def profile_case(
     dim: int, n: int, solver: PressureSolver, iteration: DensityIteration, device: str, steps: int, top: int, pair_layout: str | None = None,
 ) -> list[str]:
     """The case's lines of the report: a heading, the wall and the timed totals, the table of the top activities
-    (on CUDA the device's activities, timed by warp; on the CPU each operation, timed on the host's clock).
+    (on CUDA the device's activities, timed by warp; on the CPU each operation, timed by the thread's CPU time).
     ``pair_layout``: a key of :data:`PAIR_LAYOUTS` (None: the device's own layout)."""
-    layout = None if pair_layout is None else replace(layout_for(wp.get_device(device)), pairs_by_column=PAIR_LAYOUTS[pair_layout])
+    layout = None if pair_layout is None else replace(layout_for(wp.get_device(device)), **PAIR_LAYOUTS[pair_layout])
     fluid, interval = resting_block(n, dim, device, steps, solver, graphs=False, iteration=iteration, layout=layout)
     fluid.advance(interval)  # compiles, settles
     cuda = fluid.device.is_cuda
@@ -90,7 +97,7 @@ def profile_case(
         timer.count[r.name] += 1
     total, count = timer.total, timer.count
     timed_ms, timed_count = sum(total.values()), sum(count.values())
-    what = "device activities" if cuda else "operations (each timed on the host's clock)"
+    what = "device activities" if cuda else "operations (each timed by the thread's CPU time)"
     sub = report.substeps
     layout_name = "" if pair_layout is None else f", pair tables in {pair_layout}"
     lines = [

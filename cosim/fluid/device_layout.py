@@ -12,7 +12,10 @@ sequential chunks and integrate's atomics on one diagnostics row.
   kernels are the same: a warp array's strides carry the layout. Slot-major helps the kernels that read the tables
   in lock step and slows the ones that write them and DFSPH's Gauss-Seidel sweeps (a colour runs a 27th of the
   cells), so a solver that sweeps keeps a row per particle on CUDA too (``python -m cosim.bench.kernel_profile
-  --pair-layouts rows columns`` compares the two; the figures are in docs/performance.md).
+  --pair-layouts rows columns`` compares the two; the figures are in docs/performance.md). DFSPH's tables are flat
+  and read through each particle's first slot (``cosim.fluid.pair_slots``): on the CPU packed, the lists of each
+  block of 16 particles one after the other, so a pass reads one stream per block rather than a mostly empty row
+  per particle.
 - The wall wrench (a sum over every particle per vessel, in a fixed order): on the CPU :data:`WRENCH_CHUNKS`
   contiguous chunks; on CUDA levels of chunks of :data:`REDUCTION_ITEMS` interleaved items (chunk c sums items c,
   c + chunks, ...: consecutive threads read consecutive addresses), until few enough partial sums remain.
@@ -39,17 +42,20 @@ CUDA_ATOMIC_REPLICAS = 64  # CUDA: replicas of each accumulator (atomics per add
 
 @dataclass(frozen=True)
 class DeviceLayout:
-    """pairs_by_column: pair tables slot-major (CUDA) instead of particle-major. interleaved_reduction: the
+    """pairs_by_column: pair tables slot-major (CUDA) instead of particle-major. pairs_packed: DFSPH's
+    particle-major tables packed by blocks of particles (the CPU's; each block built in order by one thread, which a
+    CUDA launch does not do) instead of a row per particle. interleaved_reduction: the
     wrench reduced in interleaved levels (CUDA) instead of contiguous chunks. atomic_replicas: copies of each
     accumulator (diagnostics row, solve statistics) the particles spread their atomics over."""
 
     pairs_by_column: bool
+    pairs_packed: bool
     interleaved_reduction: bool
     atomic_replicas: int
 
 
-CPU_LAYOUT = DeviceLayout(pairs_by_column=False, interleaved_reduction=False, atomic_replicas=1)
-CUDA_LAYOUT = DeviceLayout(pairs_by_column=True, interleaved_reduction=True, atomic_replicas=CUDA_ATOMIC_REPLICAS)
+CPU_LAYOUT = DeviceLayout(pairs_by_column=False, pairs_packed=True, interleaved_reduction=False, atomic_replicas=1)
+CUDA_LAYOUT = DeviceLayout(pairs_by_column=True, pairs_packed=False, interleaved_reduction=True, atomic_replicas=CUDA_ATOMIC_REPLICAS)
 CUDA_SWEEP_LAYOUT = replace(CUDA_LAYOUT, pairs_by_column=False)  # CUDA's, the pair tables a row per particle
 
 

@@ -95,6 +95,7 @@ from cosim.fluid.diagnostics import (
 from cosim.fluid.free_surface import FREE_AT_SURFACE, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
 from cosim.fluid.neighbors import GridSpec, Neighborhood, first_neighbor, next_neighbor
+from cosim.fluid.pair_slots import PairSlots, close_pair_row, open_pair_row
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
     add_wall_reaction,
@@ -233,9 +234,10 @@ def compute_density_factor(
     increment: wp.array(dtype=float),
     increment_per_rho: wp.array(dtype=float),
     pair_count: wp.array(dtype=wp.int32),
-    pair_index: wp.array2d(dtype=wp.int32),
-    pair_grad: wp.array2d(dtype=wp.vec3),
-    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    pair_slots: PairSlots,
+    pair_index: wp.array(dtype=wp.int32),
+    pair_grad: wp.array(dtype=wp.vec3),
+    pair_mass_grad: wp.array(dtype=wp.vec3),
     indicator: wp.array(dtype=float),
     solve_stats: wp.array(dtype=wp.int64),
     keep_going: wp.array(dtype=wp.int32),
@@ -244,8 +246,8 @@ def compute_density_factor(
 ):
     """Summation density, DFSPH factor (for particles of different masses, alpha_i = rho_i / (|sum_j m_j grad W_ij|^2
     + sum_j m_i m_j |grad W_ij|^2): neighbour j moves by m_i (k_i / rho_i) grad W_ij under i's stiffness) and the
-    substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall
-    code :func:`wall_pair`; ``pair_grad[i, k]``: grad_i W, 1/m^(dim+1); ``pair_mass_grad[i, k]``: the same times the
+    substep's pair list (entry k at slot s of particle i's ``pair_slots``, ``cosim.fluid.pair_slots``; ``pair_index[s]``:
+    neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad[s]``: grad_i W, 1/m^(dim+1); ``pair_mass_grad[s]``: the same times the
     pair's mass, m_j or rho0 V_b, as the solves use it), which the later stages loop over instead of the cell grid;
     the divergence solve's warm start (increment = a fraction of the last substep's stiffness, applied by the first
     iteration; ``increment_per_rho`` = increment / rho, as the neighbours read it) and its counters. More than
@@ -259,6 +261,7 @@ def compute_density_factor(
     warm = WARM_START_DIVERGENCE * kappa_divergence[i]
     kappa_divergence[i] = 0.0
     pair_count[i] = 0
+    first = open_pair_row(pair_slots, i)
     if active[i] == 0:
         rho[i] = prm.rest_density
         alpha[i] = 0.0
@@ -285,14 +288,15 @@ def compute_density_factor(
         if walk.wall == 0:
             grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
         if count < capacity:
-            pair_index[i, count] = pair_code(walk)
-            pair_grad[i, count] = gw
-            pair_mass_grad[i, count] = gm
+            pair_index[first + count * pair_slots.step] = pair_code(walk)
+            pair_grad[first + count * pair_slots.step] = gw
+            pair_mass_grad[first + count * pair_slots.step] = gm
         count += 1
         walk = next_neighbor(nb, walk)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
+    close_pair_row(pair_slots, i, first, pair_count[i])
     lam = float(0.0)
     if free_liquid == FREE_AT_SURFACE:
         lam = surface_indicator(prm.dim, moment)
@@ -336,21 +340,24 @@ def liquid_density_rate(
     v: wp.array(dtype=wp.vec3),
     bv: wp.array(dtype=wp.vec3),
     pair_count: wp.array(dtype=wp.int32),
-    pair_index: wp.array2d(dtype=wp.int32),
-    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    pair_slots: PairSlots,
+    pair_index: wp.array(dtype=wp.int32),
+    pair_mass_grad: wp.array(dtype=wp.vec3),
 ) -> float:
     """Drho_i/Dt = sum_j m_j (v_i - v_j) . grad W_ij + sum_b rho0 V_b (v_i - v_b) . grad W_ib over liquid particle i's
     pair list, from the velocities as they are (kg/m^3/s)."""
     vi = v[i]
     rate = float(0.0)
+    first = pair_slots.start[i]
     for k in range(pair_count[i]):
-        j = pair_index[i, k]
+        s = first + k * pair_slots.step
+        j = pair_index[s]
         vj = wp.vec3(0.0)
         if j >= 0:
             vj = v[j]
         else:
             vj = bv[pair_wall(j)]
-        rate += wp.dot(vi - vj, pair_mass_grad[i, k])
+        rate += wp.dot(vi - vj, pair_mass_grad[s])
     return rate
 
 
@@ -360,14 +367,17 @@ def wall_density_rate(
     v: wp.array(dtype=wp.vec3),
     bv: wp.array(dtype=wp.vec3),
     b_pair_count: wp.array(dtype=wp.int32),
-    b_pair_index: wp.array2d(dtype=wp.int32),
-    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    b_pair_slots: PairSlots,
+    b_pair_index: wp.array(dtype=wp.int32),
+    b_pair_mass_grad: wp.array(dtype=wp.vec3),
 ) -> float:
     """Drho_b/Dt = sum_j m_j (v_b - v_j) . grad W_bj over wall-layer particle b's liquid neighbours (kg/m^3/s)."""
     vb = bv[b]
     rate = float(0.0)
+    first = b_pair_slots.start[b]
     for k in range(b_pair_count[b]):
-        rate += wp.dot(vb - v[b_pair_index[b, k]], b_pair_mass_grad[b, k])
+        s = first + k * b_pair_slots.step
+        rate += wp.dot(vb - v[b_pair_index[s]], b_pair_mass_grad[s])
     return rate
 
 
@@ -379,8 +389,9 @@ def apply_stiffness(
     active: wp.array(dtype=wp.int32),
     dt: wp.array(dtype=float),
     pair_count: wp.array(dtype=wp.int32),
-    pair_index: wp.array2d(dtype=wp.int32),
-    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    pair_slots: PairSlots,
+    pair_index: wp.array(dtype=wp.int32),
+    pair_mass_grad: wp.array(dtype=wp.vec3),
     b_increment_per_rho: wp.array(dtype=float),
     # State in/out
     v: wp.array(dtype=wp.vec3),
@@ -396,14 +407,16 @@ def apply_stiffness(
         return
     ki = increment_per_rho[i]
     dv = wp.vec3(0.0)
+    first = pair_slots.start[i]
     for k in range(pair_count[i]):
-        j = pair_index[i, k]
+        s = first + k * pair_slots.step
+        j = pair_index[s]
         kj = float(0.0)
         if j >= 0:
             kj = increment_per_rho[j]
         else:
             kj = b_increment_per_rho[pair_wall(j)]
-        dv += (ki + kj) * pair_mass_grad[i, k]
+        dv += (ki + kj) * pair_mass_grad[s]
     v[i] = v[i] - dt[0] * dv
     kappa[i] = kappa[i] + increment[i]
 
@@ -422,8 +435,9 @@ def compute_solve_error(
     dt: wp.array(dtype=float),
     bv: wp.array(dtype=wp.vec3),
     pair_count: wp.array(dtype=wp.int32),
-    pair_index: wp.array2d(dtype=wp.int32),
-    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    pair_slots: PairSlots,
+    pair_index: wp.array(dtype=wp.int32),
+    pair_mass_grad: wp.array(dtype=wp.vec3),
     # Out
     increment: wp.array(dtype=float),
     increment_per_rho: wp.array(dtype=float),
@@ -440,7 +454,7 @@ def compute_solve_error(
         increment_per_rho[i] = 0.0
         return
     h = dt[0]
-    e = h * liquid_density_rate(i, v, bv, pair_count, pair_index, pair_mass_grad)
+    e = h * liquid_density_rate(i, v, bv, pair_count, pair_slots, pair_index, pair_mass_grad)
     if mode == SOLVE_DENSITY:
         e += rho[i] - prm.rest_density
         e = wp.max(e, 0.0)
@@ -513,8 +527,9 @@ def compute_wall_density_factor(
     b_rho: wp.array(dtype=float),
     b_alpha: wp.array(dtype=float),
     b_pair_count: wp.array(dtype=wp.int32),
-    b_pair_index: wp.array2d(dtype=wp.int32),
-    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    b_pair_slots: PairSlots,
+    b_pair_index: wp.array(dtype=wp.int32),
+    b_pair_mass_grad: wp.array(dtype=wp.vec3),
     solve_stats: wp.array(dtype=wp.int64),
     diag_i: wp.array2d(dtype=wp.int32),
 ):
@@ -526,6 +541,7 @@ def compute_wall_density_factor(
     neighbours with m grad_b W. Other wall particles carry no stiffness (rho_b = rho0, no pairs)."""
     b = wp.tid()
     b_pair_count[b] = 0
+    first = open_pair_row(b_pair_slots, b)
     b_rho[b] = prm.rest_density
     b_alpha[b] = 0.0
     if b_wetted[b] == 0:
@@ -542,8 +558,8 @@ def compute_wall_density_factor(
             gw = kernel_gradient(prm, walk.r, walk.r2)
             grad_sq += mj * mb * wp.dot(gw, gw)
             if count < capacity:
-                b_pair_index[b, count] = walk.index
-                b_pair_mass_grad[b, count] = mj * gw
+                b_pair_index[first + count * b_pair_slots.step] = walk.index
+                b_pair_mass_grad[first + count * b_pair_slots.step] = mj * gw
             count += 1
         walk = next_neighbor(nb, walk)
     if count == 0:
@@ -551,6 +567,7 @@ def compute_wall_density_factor(
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], b), DIAG_PAIR_OVERFLOW, 1)
     b_pair_count[b] = wp.min(count, capacity)
+    close_pair_row(b_pair_slots, b, first, b_pair_count[b])
     density = density / prm.lattice_density + b_rest_offset[b]
     b_rho[b] = density
     b_alpha[b] = density / wp.max(grad_sq, MIN_FACTOR_DENOMINATOR * prm.lattice_factor_denominator)
@@ -593,8 +610,9 @@ def compute_wall_solve_error(
     b_rho: wp.array(dtype=float),
     b_alpha: wp.array(dtype=float),
     b_pair_count: wp.array(dtype=wp.int32),
-    b_pair_index: wp.array2d(dtype=wp.int32),
-    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    b_pair_slots: PairSlots,
+    b_pair_index: wp.array(dtype=wp.int32),
+    b_pair_mass_grad: wp.array(dtype=wp.vec3),
     # State in/out
     b_kappa: wp.array(dtype=float),
     b_increment: wp.array(dtype=float),
@@ -612,7 +630,7 @@ def compute_wall_solve_error(
         b_increment_per_rho[b] = 0.0
         return
     h = dt[0]
-    e = h * wall_density_rate(b, v, bv, b_pair_count, b_pair_index, b_pair_mass_grad)
+    e = h * wall_density_rate(b, v, bv, b_pair_count, b_pair_slots, b_pair_index, b_pair_mass_grad)
     if mode == SOLVE_DENSITY:
         e += b_rho[b] - prm.rest_density
     e = wp.max(e, 0.0)
@@ -644,8 +662,9 @@ def relax_liquid_density(
     alpha: wp.array(dtype=float),
     bv: wp.array(dtype=wp.vec3),
     pair_count: wp.array(dtype=wp.int32),
-    pair_index: wp.array2d(dtype=wp.int32),
-    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    pair_slots: PairSlots,
+    pair_index: wp.array(dtype=wp.int32),
+    pair_mass_grad: wp.array(dtype=wp.vec3),
     mass: wp.array(dtype=float),
     v: wp.array(dtype=wp.vec3),
     kappa: wp.array(dtype=float),
@@ -655,7 +674,7 @@ def relax_liquid_density(
     increment k_i = e_i alpha_i / dt^2 that removes it, added to kappa_i, and applied at once to i and to its liquid
     neighbours (v_i -= dt (k_i / rho_i) sum_j m_j grad W_ij, v_j += dt (k_i / rho_i) m_i grad W_ij: the k_i part of
     the Jacobi step's pair force, so the momentum exchanged is the same). Returns e_i / rho0."""
-    e = wp.max(h * liquid_density_rate(i, v, bv, pair_count, pair_index, pair_mass_grad) + rho[i] - prm.rest_density, 0.0)
+    e = wp.max(h * liquid_density_rate(i, v, bv, pair_count, pair_slots, pair_index, pair_mass_grad) + rho[i] - prm.rest_density, 0.0)
     if e == 0.0:
         return 0.0
     k_i = e * alpha[i] / (h * h)
@@ -663,9 +682,11 @@ def relax_liquid_density(
     push = h * k_i / rho[i]
     mi = mass[i]
     dv = wp.vec3(0.0)
+    first = pair_slots.start[i]
     for k in range(pair_count[i]):
-        j = pair_index[i, k]
-        gm = pair_mass_grad[i, k]
+        s = first + k * pair_slots.step
+        j = pair_index[s]
+        gm = pair_mass_grad[s]
         dv += gm
         if j >= 0:
             v[j] = v[j] + (push * (mi / mass[j])) * gm  # gm carries m_j
@@ -683,8 +704,9 @@ def relax_wall_density(
     b_rho: wp.array(dtype=float),
     b_alpha: wp.array(dtype=float),
     b_pair_count: wp.array(dtype=wp.int32),
-    b_pair_index: wp.array2d(dtype=wp.int32),
-    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    b_pair_slots: PairSlots,
+    b_pair_index: wp.array(dtype=wp.int32),
+    b_pair_mass_grad: wp.array(dtype=wp.vec3),
     mass: wp.array(dtype=float),
     v: wp.array(dtype=wp.vec3),
     b_kappa: wp.array(dtype=float),
@@ -697,15 +719,17 @@ def relax_wall_density(
     n = b_pair_count[b]
     if n == 0:
         return 0.0
-    e = wp.max(h * wall_density_rate(b, v, bv, b_pair_count, b_pair_index, b_pair_mass_grad) + b_rho[b] - prm.rest_density, 0.0)
+    e = wp.max(h * wall_density_rate(b, v, bv, b_pair_count, b_pair_slots, b_pair_index, b_pair_mass_grad) + b_rho[b] - prm.rest_density, 0.0)
     if e == 0.0:
         return 0.0
     k_b = e * b_alpha[b] / (h * h)
     b_kappa[b] = b_kappa[b] + k_b
     push = h * k_b / b_rho[b] * prm.rest_density * b_volume[b]
+    first = b_pair_slots.start[b]
     for k in range(n):
-        j = b_pair_index[b, k]
-        v[j] = v[j] + (push / mass[j]) * b_pair_mass_grad[b, k]  # b_pair_mass_grad carries the liquid's m_j
+        s = first + k * b_pair_slots.step
+        j = b_pair_index[s]
+        v[j] = v[j] + (push / mass[j]) * b_pair_mass_grad[s]  # b_pair_mass_grad carries the liquid's m_j
     return e / prm.rest_density
 
 
@@ -779,13 +803,15 @@ def gauss_seidel_density_sweep(
     dt: wp.array(dtype=float),
     bv: wp.array(dtype=wp.vec3),
     pair_count: wp.array(dtype=wp.int32),
-    pair_index: wp.array2d(dtype=wp.int32),
-    pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    pair_slots: PairSlots,
+    pair_index: wp.array(dtype=wp.int32),
+    pair_mass_grad: wp.array(dtype=wp.vec3),
     b_rho: wp.array(dtype=float),
     b_alpha: wp.array(dtype=float),
     b_pair_count: wp.array(dtype=wp.int32),
-    b_pair_index: wp.array2d(dtype=wp.int32),
-    b_pair_mass_grad: wp.array2d(dtype=wp.vec3),
+    b_pair_slots: PairSlots,
+    b_pair_index: wp.array(dtype=wp.int32),
+    b_pair_mass_grad: wp.array(dtype=wp.vec3),
     mass: wp.array(dtype=float),
     # State in/out
     v: wp.array(dtype=wp.vec3),
@@ -808,11 +834,11 @@ def gauss_seidel_density_sweep(
             continue
         cell = sweep_cell[thread, k]
         for i in range(cell_start[cell], cell_end[cell]):
-            q = error_quanta(relax_liquid_density(prm, i, h, rho, alpha, bv, pair_count, pair_index, pair_mass_grad, mass, v, kappa))
+            q = error_quanta(relax_liquid_density(prm, i, h, rho, alpha, bv, pair_count, pair_slots, pair_index, pair_mass_grad, mass, v, kappa))
             total += q
             worst = wp.max(worst, q)
         for kk in range(b_cell_start[cell], b_cell_end[cell]):
-            q = error_quanta(relax_wall_density(prm, b_order[kk], h, b_volume, bv, b_rho, b_alpha, b_pair_count, b_pair_index, b_pair_mass_grad, mass, v, b_kappa))
+            q = error_quanta(relax_wall_density(prm, b_order[kk], h, b_volume, bv, b_rho, b_alpha, b_pair_count, b_pair_slots, b_pair_index, b_pair_mass_grad, mass, v, b_kappa))
             total += q
             worst = wp.max(worst, q)
     if total > wp.int64(0):
@@ -842,8 +868,9 @@ def compute_nonpressure(
     bx: wp.array(dtype=wp.vec3),
     bv: wp.array(dtype=wp.vec3),
     pair_count: wp.array(dtype=wp.int32),
-    pair_index: wp.array2d(dtype=wp.int32),
-    pair_grad: wp.array2d(dtype=wp.vec3),
+    pair_slots: PairSlots,
+    pair_index: wp.array(dtype=wp.int32),
+    pair_grad: wp.array(dtype=wp.vec3),
     row: wp.array(dtype=wp.int32),
     free: wp.array(dtype=wp.int32),
     mass: wp.array(dtype=float),
@@ -875,17 +902,19 @@ def compute_nonpressure(
     rhoi = rho[i]
     a = wp.vec3(0.0)
     free_i = free[i]
+    first = pair_slots.start[i]
     for k in range(pair_count[i]):
-        j = pair_index[i, k]
+        s = first + k * pair_slots.step
+        j = pair_index[s]
         if j >= 0:
             r = xi - x[j]
             vij = vi - v[j]
             alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
-            a += viscous_pair(prm, alpha, mass[j], r, wp.dot(r, r), pair_grad[i, k], vij, vij, rhoi, rho[j])
+            a += viscous_pair(prm, alpha, mass[j], r, wp.dot(r, r), pair_grad[s], vij, vij, rhoi, rho[j])
         else:
             b = pair_wall(j)
             r = xi - bx[b]
-            a += wall_pair_viscosity(prm, wp.where(free_i != 0, prm.alpha_free, prm.alpha), b_volume[b], r, wp.dot(r, r), pair_grad[i, k], vi - bv[b], rhoi)
+            a += wall_pair_viscosity(prm, wp.where(free_i != 0, prm.alpha_free, prm.alpha), b_volume[b], r, wp.dot(r, r), pair_grad[s], vi - bv[b], rhoi)
     a += prm.gravity
     v_star[i] = vi + dt[0] * a
     increment[i] = warm
@@ -911,8 +940,9 @@ def compute_wall_reaction(
     bx: wp.array(dtype=wp.vec3),
     bv: wp.array(dtype=wp.vec3),
     pair_count: wp.array(dtype=wp.int32),
-    pair_index: wp.array2d(dtype=wp.int32),
-    pair_grad: wp.array2d(dtype=wp.vec3),
+    pair_slots: PairSlots,
+    pair_index: wp.array(dtype=wp.int32),
+    pair_grad: wp.array(dtype=wp.vec3),
     b_rho: wp.array(dtype=float),
     b_kappa_density: wp.array(dtype=float),
     b_kappa_divergence: wp.array(dtype=float),
@@ -943,14 +973,16 @@ def compute_wall_reaction(
     xi = x[i]
     vi = v[i]
     ki = kappa / rhoi
+    first = pair_slots.start[i]
     for k in range(pair_count[i]):
-        j = pair_index[i, k]
+        s = first + k * pair_slots.step
+        j = pair_index[s]
         if j >= 0:
             continue
         b = pair_wall(j)
         xb = bx[b]
         r = xi - xb
-        gw = pair_grad[i, k]
+        gw = pair_grad[s]
         ab = wall_pair_viscosity(prm, wp.where(free[i] != 0, prm.alpha_free, prm.alpha), b_volume[b], r, wp.dot(r, r), gw, vi - bv[b], rhoi)
         kb = (b_kappa_density[b] + b_kappa_divergence[b]) / b_rho[b]
         ab -= (prm.rest_density * b_volume[b] * (ki + kb)) * gw

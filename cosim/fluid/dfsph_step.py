@@ -23,11 +23,11 @@ import warp as wp
 
 from cosim.fluid import dfsph, wcsph
 from cosim.fluid.config import DensityIteration, DivergenceConstraint, InitialState, WallPressure
-from cosim.fluid.device_layout import pair_table
 from cosim.fluid.free_surface import free_liquid_mode
 from cosim.fluid.lanes import LANE_CHUNK, Lanes, PerLane
 from cosim.fluid.launch import launch_now
 from cosim.fluid.model import FluidModel, FluidState
+from cosim.fluid.pair_slots import flat_pair_table, pair_slots
 from cosim.fluid.program import Recorder
 from cosim.fluid.substep import PairList, SubstepScratch, end_substep, start_substep
 
@@ -45,21 +45,23 @@ class DFSPHScratch:
 
     Liquid (N,): alpha, the DFSPH factor (``cosim.fluid.dfsph.compute_density_factor``); increment, increment_per_rho, the
     stiffness increments a solve applies next (m^2/s^2, and over rho); v_star, the predicted velocity (m/s);
-    pairs and pair_mass_grad (the pair list, and its gradients times the neighbour's mass). Wall layer (Nb,): b_rho,
-    b_alpha, b_increment, b_increment_per_rho, b_kappa_density, b_kappa_divergence and its list of liquid
-    neighbours (b_pair_count, b_pair_index, b_pair_mass_grad). Solves: solve_stats (int64, a padded row per lane and
+    pairs and pair_mass_grad (the pair list, and its gradients times the neighbour's mass: flat tables, each particle's
+    entries at the slots of pair_slots, ``cosim.fluid.pair_slots``). Wall layer (Nb,): b_rho, b_alpha, b_increment,
+    b_increment_per_rho, b_kappa_density, b_kappa_divergence and its list of liquid neighbours (b_pair_count,
+    b_pair_slots, b_pair_index, b_pair_mass_grad). Solves: solve_stats (int64, a padded row per lane and
     replica), keep_going (the loop flag), substep_weight (1 / substeps of the interval). Gauss-Seidel: each sweep
     thread's cells and their colours (sweep_count, sweep_cell, sweep_color).
     """
 
     def __init__(self, m: FluidModel, sh: SubstepScratch, lanes: Lanes, gauss_seidel: bool):
-        d, n, nb, cap, by_column = m.device, m.n_particles, m.n_boundary, sh.pair_capacity, sh.layout.pairs_by_column
+        d, n, nb, cap, by_column, packed = m.device, m.n_particles, m.n_boundary, sh.pair_capacity, sh.layout.pairs_by_column, sh.layout.pairs_packed
         self.alpha = wp.zeros(n, dtype=float, device=d)
         self.increment = wp.zeros(n, dtype=float, device=d)
         self.increment_per_rho = wp.zeros(n, dtype=float, device=d)
         self.v_star = wp.zeros(n, dtype=wp.vec3, device=d)
-        self.pairs = PairList(wp.zeros(n, dtype=wp.int32, device=d), pair_table(n, cap, wp.int32, d, by_column), pair_table(n, cap, wp.vec3, d, by_column))
-        self.pair_mass_grad = pair_table(n, cap, wp.vec3, d, by_column)
+        self.pairs = PairList(wp.zeros(n, dtype=wp.int32, device=d), flat_pair_table(n, cap, wp.int32, d), flat_pair_table(n, cap, wp.vec3, d))
+        self.pair_slots = pair_slots(n, cap, d, by_column, packed)
+        self.pair_mass_grad = flat_pair_table(n, cap, wp.vec3, d)
         self.b_rho = wp.zeros(nb, dtype=float, device=d)
         if not solved_wall_layer(m):
             self.b_rho.fill_(m.config.rest_density)  # never computed: the mirrored walls' k_b / rho_b = 0 / rho0
@@ -69,8 +71,9 @@ class DFSPHScratch:
         self.b_kappa_density = wp.zeros(nb, dtype=float, device=d)
         self.b_kappa_divergence = wp.zeros(nb, dtype=float, device=d)
         self.b_pair_count = wp.zeros(nb, dtype=wp.int32, device=d)
-        self.b_pair_index = pair_table(nb, cap, wp.int32, d, by_column)
-        self.b_pair_mass_grad = pair_table(nb, cap, wp.vec3, d, by_column)
+        self.b_pair_slots = pair_slots(nb, cap, d, by_column, packed)
+        self.b_pair_index = flat_pair_table(nb, cap, wp.int32, d)
+        self.b_pair_mass_grad = flat_pair_table(nb, cap, wp.vec3, d)
         replicas = sh.layout.atomic_replicas  # rows per lane (check_convergence sums every row)
         self.solve_stats = wp.zeros((lanes.count * replicas, dfsph.STATS_ROW_STRIDE), dtype=wp.int64, device=d)
         self.lane_stats = PerLane(self.solve_stats[k * replicas : (k + 1) * replicas].flatten() for k in range(lanes.count))
@@ -93,7 +96,7 @@ def compute_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
         capacity=sh.pair_capacity, free_liquid=free_liquid_mode(m.config), threshold=m.config.free_surface_threshold, motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active,
         mass=st.mass, row=sh.row, kappa_divergence=st.kappa_divergence, free=st.free, rest_offset=st.rest_offset,
         rho=st.rho, alpha=sc.alpha, increment=sc.increment, increment_per_rho=sc.increment_per_rho,
-        pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, pair_mass_grad=sc.pair_mass_grad,
+        pair_count=sc.pairs.count, pair_slots=sc.pair_slots, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, pair_mass_grad=sc.pair_mass_grad,
         indicator=sh.free_surface, solve_stats=sc.lane_stats, keep_going=sc.keep_going, diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
     )
 
@@ -103,7 +106,7 @@ def compute_wall_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh
     rec.launch(
         dfsph.compute_wall_density_factor, m.n_boundary, prm=m.params, b_volume=m.b_volume, b_wetted=m.b_wetted, b_rest_offset=m.b_rest_offset,
         capacity=sh.pair_capacity, nb=sh.neighborhood(m, st), mass=st.mass, row=sh.row, b_rho=sc.b_rho, b_alpha=sc.b_alpha,
-        b_pair_count=sc.b_pair_count, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
+        b_pair_count=sc.b_pair_count, b_pair_slots=sc.b_pair_slots, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
         solve_stats=sc.lane_stats, diag_i=sh.diagnostics.lane_i,
     )
 
@@ -121,7 +124,7 @@ def apply_stiffness(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScr
     ``kappa``."""
     rec.launch(
         dfsph.apply_stiffness, m.n_particles, increment=sc.increment, increment_per_rho=sc.increment_per_rho, active=st.active, dt=sh.dt,
-        pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_mass_grad=sc.pair_mass_grad, b_increment_per_rho=sc.b_increment_per_rho,
+        pair_count=sc.pairs.count, pair_slots=sc.pair_slots, pair_index=sc.pairs.index, pair_mass_grad=sc.pair_mass_grad, b_increment_per_rho=sc.b_increment_per_rho,
         v=v, kappa=kappa,
     )
 
@@ -146,13 +149,13 @@ def jacobi_solve(
             rec.launch(
                 dfsph.compute_solve_error, m.n_particles, prm=m.params, mode=mode,
                 past_rest=int(m.config.divergence_constraint is DivergenceConstraint.PAST_REST_DENSITY), v=v, rho=st.rho, alpha=sc.alpha, active=st.active, dt=sh.dt,
-                bv=sh.bv, pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_mass_grad=sc.pair_mass_grad,
+                bv=sh.bv, pair_count=sc.pairs.count, pair_slots=sc.pair_slots, pair_index=sc.pairs.index, pair_mass_grad=sc.pair_mass_grad,
                 increment=sc.increment, increment_per_rho=sc.increment_per_rho, solve_stats=sc.lane_stats,
             )
             if solved_wall_layer(m):
                 rec.launch(
                     dfsph.compute_wall_solve_error, m.n_boundary, prm=m.params, mode=mode, v=v, dt=sh.dt, bv=sh.bv, b_rho=sc.b_rho,
-                    b_alpha=sc.b_alpha, b_pair_count=sc.b_pair_count, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
+                    b_alpha=sc.b_alpha, b_pair_count=sc.b_pair_count, b_pair_slots=sc.b_pair_slots, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
                     b_kappa=b_kappa, b_increment=sc.b_increment, b_increment_per_rho=sc.b_increment_per_rho, solve_stats=sc.lane_stats,
                 )
         check_convergence(rec, m, sh, sc, mode)
@@ -167,7 +170,7 @@ def compute_nonpressure(rec: Recorder, m: FluidModel, st: FluidState, sh: Subste
     """v* = v + dt (g + viscosity); the density solve's warm start and counters."""
     rec.launch(
         dfsph.compute_nonpressure, m.n_particles, prm=m.params, b_volume=m.b_volume, x=st.x, v=st.v, rho=st.rho, active=st.active, dt=sh.dt,
-        bx=sh.bx, bv=sh.bv, pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, row=sh.row, free=st.free, mass=st.mass,
+        bx=sh.bx, bv=sh.bv, pair_count=sc.pairs.count, pair_slots=sc.pair_slots, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, row=sh.row, free=st.free, mass=st.mass,
         kappa_density=st.kappa_density, v_star=sc.v_star, increment=sc.increment, increment_per_rho=sc.increment_per_rho,
         solve_stats=sc.lane_stats, keep_going=sc.keep_going, diag_f=sh.diagnostics.lane_f,
     )
@@ -193,8 +196,8 @@ def gauss_seidel_density_solve(rec: Recorder, m: FluidModel, st: FluidState, sh:
                 dfsph.gauss_seidel_density_sweep, sc.sweep_threads, prm=m.params, color=color, b_volume=m.b_volume,
                 sweep_count=sc.sweep_count, sweep_cell=sc.sweep_cell, sweep_color=sc.sweep_color, cell_start=m.grid.cell_start,
                 cell_end=m.grid.cell_end, b_order=m.b_grid.order, b_cell_start=m.b_grid.cell_start, b_cell_end=m.b_grid.cell_end,
-                rho=st.rho, alpha=sc.alpha, dt=sh.dt, bv=sh.bv, pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_mass_grad=sc.pair_mass_grad,
-                b_rho=sc.b_rho, b_alpha=sc.b_alpha, b_pair_count=sc.b_pair_count, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
+                rho=st.rho, alpha=sc.alpha, dt=sh.dt, bv=sh.bv, pair_count=sc.pairs.count, pair_slots=sc.pair_slots, pair_index=sc.pairs.index, pair_mass_grad=sc.pair_mass_grad,
+                b_rho=sc.b_rho, b_alpha=sc.b_alpha, b_pair_count=sc.b_pair_count, b_pair_slots=sc.b_pair_slots, b_pair_index=sc.b_pair_index, b_pair_mass_grad=sc.b_pair_mass_grad,
                 mass=st.mass, v=sc.v_star, kappa=st.kappa_density, b_kappa=sc.b_kappa_density, solve_stats=sc.lane_stats,
             )
         check_convergence(rec, m, sh, sc, dfsph.SOLVE_DENSITY)
@@ -214,7 +217,7 @@ def compute_wall_reaction(rec: Recorder, m: FluidModel, st: FluidState, sh: Subs
     rec.launch(
         dfsph.compute_wall_reaction, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, b_vessel=m.b_vessel, motions=sh.motions,
         x=st.x, v=st.v, rho=st.rho, kappa_density=st.kappa_density, kappa_divergence=st.kappa_divergence, active=st.active, bx=sh.bx, bv=sh.bv,
-        pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, b_rho=sc.b_rho, b_kappa_density=sc.b_kappa_density,
+        pair_count=sc.pairs.count, pair_slots=sc.pair_slots, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, b_rho=sc.b_rho, b_kappa_density=sc.b_kappa_density,
         b_kappa_divergence=sc.b_kappa_divergence, substep_weight=sc.substep_weight, free=st.free,
         wall_force=sh.wall_force, wall_torque=sh.wall_torque, p=st.p,
     )

@@ -15,7 +15,11 @@ leave the same ranges, so the neighbour lists, and every result, are identical.
 Every SPH sum over neighbours is one walk (:func:`first_neighbor`, :func:`next_neighbor`, in the manner of warp's
 ``hash_grid_query``/``hash_grid_query_next``) over a :class:`Neighborhood`, the liquid and the wall particles in one
 grid: the walk owns the order of the cells, the liquid before the walls in each cell, and the support test, so
-every kernel adds its terms in the same order and only says what a neighbour contributes.
+every kernel adds its terms in the same order and only says what a neighbour contributes. It opens only the cells
+of the block whose box lies within the radius (:func:`cell_within_reach`): a support sphere reaches 20.6 of the
+27 cells on average in 3-D (1 + 6 + 12 pi/4 + 8 pi/6 for a point uniformly placed in its cell; 8.1 of 9 in 2-D),
+so in a uniform liquid 4.9 points are tested per neighbour instead of 6.5, and the neighbours and their order stay
+the same.
 """
 
 from __future__ import annotations
@@ -80,15 +84,48 @@ def neighbor_cells(g: GridSpec, x: wp.vec3) -> CellBlock:
 
 
 @wp.func
-def block_cell(g: GridSpec, block: CellBlock, k: int) -> int:
-    """Grid index of the k-th cell of ``block`` (0 <= k < ``block.count``), x fastest, then y, then z: the
+def block_cell_coords(block: CellBlock, k: int) -> wp.vec3i:
+    """Cell coordinates of the k-th cell of ``block`` (0 <= k < ``block.count``), x fastest, then y, then z: the
     neighbour walk (:func:`first_neighbor`) visits the cells, and so sums the neighbours, in this one order."""
     sx = block.size[0]
     sy = block.size[1]
-    cx = block.first[0] + k % sx
-    cy = block.first[1] + (k // sx) % sy
-    cz = block.first[2] + k // (sx * sy)
-    return grid_index(g, cx, cy, cz)
+    return wp.vec3i(block.first[0] + k % sx, block.first[1] + (k // sx) % sy, block.first[2] + k // (sx * sy))
+
+
+# Slack (in cells) by which a cell's box is widened before it is found out of reach: a point is filed by the floor
+# of its rounded cell coordinate, so it may lie a few ulps outside its cell's exact box, and the walk's own
+# distance test rounds too; 1e-3 of a cell is far above both and keeps every cell the walk could find a
+# neighbour in.
+CELL_REACH_SLACK = wp.constant(1.0e-3)
+
+
+@wp.func
+def axis_gap(g: GridSpec, c: int, last: int, origin: float, x: float) -> float:
+    """Distance (m) along one axis from ``x`` to the slab of cell ``c`` of a grid axis with cells 0..``last``,
+    the slab widened by :data:`CELL_REACH_SLACK` and unbounded outward at the grid's end cells, which hold every
+    point beyond them (:func:`grid_cell` clamps)."""
+    size = 1.0 / g.inv_cell
+    lo = origin + (float(c) - CELL_REACH_SLACK) * size
+    hi = origin + (float(c + 1) + CELL_REACH_SLACK) * size
+    gap = float(0.0)
+    if c > 0 and x < lo:
+        gap = lo - x
+    if c < last and x > hi:
+        gap = x - hi
+    return gap
+
+
+@wp.func
+def cell_within_reach(g: GridSpec, c: wp.vec3i, x: wp.vec3, radius2: float) -> bool:
+    """Whether any point filed in cell ``c`` can lie within sqrt(``radius2``) (m) of ``x``: the squared distance
+    from x to the cell's box (:func:`axis_gap`) below radius2. The corner and edge cells of a 3 x 3 x 3 block
+    around a point reach its support sphere only where the point lies near them (about 6 of the 27 cells are out
+    of reach on average in 3-D, about 1 of 9 in 2-D); skipping them leaves the neighbours and their order as
+    they are."""
+    gx = axis_gap(g, c[0], g.nx - 1, g.origin[0], x[0])
+    gy = axis_gap(g, c[1], g.ny - 1, g.origin[1], x[1])
+    gz = axis_gap(g, c[2], g.nz - 1, g.origin[2], x[2])
+    return gx * gx + gy * gy + gz * gz < radius2
 
 
 @wp.struct
@@ -111,7 +148,7 @@ class Neighborhood:
 @wp.struct
 class NeighborWalk:
     """A walk over the neighbours of the point ``x``: every liquid particle, and with ``walls`` every wall
-    particle, at a squared distance r2 with ``min_r2`` <= r2 < ``radius2``, cell by cell in :func:`block_cell`'s
+    particle, at a squared distance r2 with ``min_r2`` <= r2 < ``radius2``, cell by cell in :func:`block_cell_coords`'s
     order, in each cell the liquid first (in cell order), then the wall particles (in cell order). Where it stands:
     the neighbour ``index`` (a liquid particle, or with ``wall`` 1 a wall particle; -1 once the walk is done), its
     offset ``r`` = x - x_neighbour (m) and ``r2`` = r . r; and, for the next step, the block of cells, the open
@@ -165,10 +202,16 @@ def next_neighbor(nb: Neighborhood, walk: NeighborWalk) -> NeighborWalk:
             w.end = nb.b_cell_end[w.cell]
         elif w.k + 1 < w.cells.count:
             w.k = w.k + 1
-            w.cell = block_cell(nb.spec, w.cells, w.k)
-            w.wall = 0
-            w.item = nb.cell_start[w.cell]
-            w.end = nb.cell_end[w.cell]
+            c = block_cell_coords(w.cells, w.k)
+            w.cell = grid_index(nb.spec, c[0], c[1], c[2])
+            if cell_within_reach(nb.spec, c, w.x, w.radius2):
+                w.wall = 0
+                w.item = nb.cell_start[w.cell]
+                w.end = nb.cell_end[w.cell]
+            else:  # no point of this cell is a neighbour: neither its liquid nor its walls are opened
+                w.wall = 1
+                w.item = 0
+                w.end = 0
         else:
             w.index = -1
             return w
