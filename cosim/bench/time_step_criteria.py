@@ -12,7 +12,9 @@ and with each ``fluid.viscous_time_step``. Every ``--approach-every``-th interva
 largest pairwise approach speed at the interval's start, max over pairs within the support 2h of
 -min(0, v_ij . r_ij / |r_ij|) (m/s; liquid pairs, by brute force over all pairs: the 2-D pour has about a thousand
 particles), against the two bounds the criterion can plan with: 2 x the last interval's largest speed (measured) and
-2 x the CFL condition's flow speed (planned).
+2 x the CFL condition's flow speed (planned). And the DFSPH solves' iterations (divergence, density) of each interval's
+last substep, a sample of one substep in three or four: a longer substep leaves its solves more to correct, so the
+substeps a criterion saves are not all wall time saved.
 """
 
 from __future__ import annotations
@@ -74,13 +76,23 @@ def max_approach_speed(positions: np.ndarray, velocities: np.ndarray, support: f
     return float(max(closing.max(initial=0.0), 0.0))
 
 
+@dataclass
+class Recording:
+    """What :func:`recorded_plans` collects: every interval's plan, the approach samples, and each interval's last
+    substep's (divergence, density) solve iterations."""
+
+    plans: list[PlannedInterval] = dataclasses.field(default_factory=list)
+    samples: list[ApproachSample] = dataclasses.field(default_factory=list)
+    iterations: list[tuple[int, int]] = dataclasses.field(default_factory=list)
+
+
 @contextlib.contextmanager
-def recorded_plans(fluid: FluidSolver, approach_every: int) -> Iterator[tuple[list[PlannedInterval], list[ApproachSample]]]:
-    """Within the block, every plan of ``fluid``'s intervals is appended to the first list and every
-    ``approach_every``-th interval's approach sample to the second; the planner is put back on exit."""
-    plans: list[PlannedInterval] = []
-    samples: list[ApproachSample] = []
-    original_limits, original_plan = TimeStepPlanner.limits, fluid.plan_time_step
+def recorded_plans(fluid: FluidSolver, approach_every: int) -> Iterator[Recording]:
+    """Within the block, every plan of ``fluid``'s intervals, every ``approach_every``-th interval's approach sample
+    and each interval's last substep's solve iterations are recorded; the planner is put back on exit."""
+    recording = Recording()
+    plans, samples = recording.plans, recording.samples
+    original_limits, original_plan, original_advance = TimeStepPlanner.limits, fluid.plan_time_step, fluid.advance
     last: list[tuple] = []
     cfg = fluid.config
 
@@ -101,13 +113,19 @@ def recorded_plans(fluid: FluidSolver, approach_every: int) -> Iterator[tuple[li
         plans.append(PlannedInterval(duration, wall, speed, accel, result, n_sub))
         return n_sub, dt
 
+    def advance(duration: float):
+        interval = original_advance(duration)
+        recording.iterations.append(interval.last.solver_iterations)
+        return interval
+
     TimeStepPlanner.limits = limits
     fluid.plan_time_step = plan
+    fluid.advance = advance
     try:
-        yield plans, samples
+        yield recording
     finally:
         TimeStepPlanner.limits = original_limits
-        del fluid.plan_time_step
+        del fluid.plan_time_step, fluid.advance
 
 
 def substeps_with(plans: list[PlannedInterval], step: Callable[[PlannedInterval], float]) -> int:
@@ -115,8 +133,10 @@ def substeps_with(plans: list[PlannedInterval], step: Callable[[PlannedInterval]
     return sum(split_interval(p.duration, step(p))[0] for p in plans)
 
 
-def report(plans: list[PlannedInterval], samples: list[ApproachSample], cfg: FluidConfig, substep_wall: float) -> dict:
+def report(recording: Recording, cfg: FluidConfig, substep_wall: float) -> dict:
     """The run's numbers (see the module docstring), JSON-ready."""
+    plans, samples = recording.plans, recording.samples
+    iterations = np.array(recording.iterations, dtype=float).reshape(-1, 2)
     simulated = sum(p.duration for p in plans)
     substeps = sum(p.substeps for p in plans)
     intervals, by_substeps = Counter(), Counter()
@@ -140,6 +160,8 @@ def report(plans: list[PlannedInterval], samples: list[ApproachSample], cfg: Flu
         "substeps": substeps,
         "substeps_per_simulated_s": substeps / simulated if simulated else math.nan,
         "substep_wall_ms": 1e3 * substep_wall / substeps if substeps else math.nan,
+        "solve_iterations_per_substep": {"divergence": float(iterations[:, 0].mean()), "density": float(iterations[:, 1].mean())}
+        if len(iterations) else {},
         "binding_intervals": dict(intervals),
         "binding_substeps": dict(by_substeps),
         "substeps_on_the_same_inputs": alternatives,
@@ -153,7 +175,11 @@ def print_report(out: dict, command: str) -> None:
     print(f"Machine: {machine_description()}, 1-minute load average {os.getloadavg()[0]:.1f} at the end. Command: `{command}`.")
     print(f"{out['simulated_s']:.2f} s simulated in {out['intervals']} intervals, {out['substeps']} substeps "
           f"({out['substeps_per_simulated_s']:.0f} per simulated s, {out['substep_wall_ms']:.3f} ms of wall time each); "
-          f"viscous_time_step = {out['config']['viscous_time_step']}.\n")
+          f"viscous_time_step = {out['config']['viscous_time_step']}.")
+    if out["solve_iterations_per_substep"]:
+        its = out["solve_iterations_per_substep"]
+        print(f"DFSPH solve iterations per substep (each interval's last): divergence {its['divergence']:.2f}, density {its['density']:.2f}.")
+    print()
     print("| criterion | intervals it set | substeps it set |")
     print("|---|---|---|")
     for name in TimeStepLimits._fields:
@@ -194,9 +220,9 @@ def main(argv: list[str] | None = None) -> int:
         scene = dataclasses.replace(scene, coupling=dataclasses.replace(scene.coupling, max_duration=args.duration))
     pour = prepare(scene)
     relaxation_wall = pour.fluid.substep_wall_time
-    with recorded_plans(pour.fluid, args.approach_every) as (plans, samples):
+    with recorded_plans(pour.fluid, args.approach_every) as recording:
         pour.run()
-    out = report(plans, samples, pour.fluid.config, pour.fluid.substep_wall_time - relaxation_wall)
+    out = report(recording, pour.fluid.config, pour.fluid.substep_wall_time - relaxation_wall)
     if args.json:
         print(json.dumps(out, indent=2))
     else:
