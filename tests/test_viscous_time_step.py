@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from cosim.bench import time_step_criteria
 from cosim.bench.time_step_criteria import max_approach_speed
 from cosim.fluid.config import GRAVITY, FluidConfig
 from cosim.fluid.time_step import VISCOUS_CFL, TimeStepPlanner, split_interval
@@ -76,3 +77,11 @@ def test_the_pairwise_approach_speed_counts_approaching_pairs_within_the_support
     assert max_approach_speed(x, -head_on, 0.02) == 0.0  # receding
     sideways = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 0.0, 0.0]])  # shearing past: no approach
     assert max_approach_speed(x, sideways, 0.02) == 0.0
+
+
+@pytest.mark.parametrize("argv, field", [(["--approach-every", "0"], "--approach-every"), (["--duration", "-1"], "--duration"),
+                                         (["--threads", "-1"], "--threads")])
+def test_the_bench_refuses_bad_input_in_one_line(argv, field, capsys):
+    assert time_step_criteria.main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and field in err
