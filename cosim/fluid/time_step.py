@@ -81,14 +81,14 @@ class TimeStepPlanner:
         (m/s^2) in vessels whose walls move at up to ``wall_speed`` (m/s): the CFL condition dt <= cfl h / signal,
         with the signal speed acoustic for WCSPH (c0 + the flow's and the wall's speed) and the flow's alone for DFSPH
         (at least ``max_expected_speed``: a jet forms within an interval), and the force criterion; with
-        ``adaptive_time_step`` off, the fixed step alone; either way the viscous diffusion criterion
-        dt <= 0.125 h^2 / (nu + nu_art) (Morris et al. 1997, "Modeling low Reynolds number incompressible flows using
-        SPH", J. Comput. Phys. 136), with nu_art (:meth:`artificial_kinematic_viscosity`) at the approach speed of
-        ``viscous_time_step``: 'planned_approach', the flow speed DFSPH's CFL condition plans with; 'measured_approach',
-        ``max_speed`` itself (the fixed step, which measures nothing, takes ``max_expected_speed`` and still walls either
-        way), so that, nu_art being
-        alpha h v_sig / (2 (dim + 2)), the criterion is Monaghan (1997)'s dt <= C h / max v_sig,ij with
-        C = 0.125 (2 (dim + 2)) / alpha at the largest approach the last interval's speeds allow."""
+        ``adaptive_time_step`` off, the fixed step alone. Either way the viscous diffusion criterion
+        dt <= 0.125 h^2 / (nu + nu_art) (Morris, Fox and Zhu 1997, "Modeling low Reynolds number incompressible flows
+        using SPH", J. Comput. Phys. 136), nu_art (:meth:`artificial_kinematic_viscosity`) at the approach speed
+        ``viscous_time_step`` takes: 'planned_approach', the flow speed DFSPH's CFL condition plans with;
+        'measured_approach', ``max_speed`` itself (the fixed step, which measures nothing, takes
+        ``max_expected_speed`` and still walls either way). nu_art being alpha h v_sig / (2 (dim + 2)), the criterion
+        is Monaghan's dt <= C h / max v_sig,ij (1997, "SPH and Riemann solvers", J. Comput. Phys. 136) with
+        C = 0.125 x 2 (dim + 2) / alpha, at the planned or at the measured approach."""
         h = self.h
         force = math.inf
         if not self.adaptive:
