@@ -85,3 +85,14 @@ def test_the_bench_refuses_bad_input_in_one_line(argv, field, capsys):
     assert time_step_criteria.main(argv) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and field in err
+
+
+def test_scenes_and_the_validation_cases_take_the_setting():
+    from cosim.fluid.config import ViscousTimeStep
+    from cosim.pour_scene import FluidSettings
+    from cosim.validation.common import NUMERICS_FIELDS
+
+    assert FluidSettings().fluid_config(0.191).viscous_time_step is ViscousTimeStep.PLANNED_APPROACH
+    measured = FluidSettings(viscous_time_step=ViscousTimeStep.MEASURED_APPROACH)
+    assert measured.fluid_config(0.191).viscous_time_step is ViscousTimeStep.MEASURED_APPROACH
+    assert "viscous_time_step" in NUMERICS_FIELDS
