@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, DivergenceConstraint, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, ParticleShifting, PressureSolver, TensionTreatment, WallModel, WallPressure
+from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, DivergenceConstraint, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, ParticleShifting, PressureSolver, TensionTreatment, ViscousTimeStep, WallModel, WallPressure
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -98,6 +98,7 @@ class FluidSettings:
     max_solver_iterations: int = like(FluidConfig, "max_solver_iterations")
     # ---- time stepping
     cfl: float = like(FluidConfig, "cfl")
+    viscous_time_step: ViscousTimeStep = like(FluidConfig, "viscous_time_step")
     adaptive_time_step: bool = like(FluidConfig, "adaptive_time_step")
     # ---- guards
     max_density_error: float = like(FluidConfig, "max_density_error")
