@@ -117,6 +117,11 @@ def test_outflow_falls_on_its_parabola_as_free_liquid():
     assert r.raw["failure"] == "" and len(r.raw["landing_error"]) >= free_fall.MIN_FOLLOWED
     assert r.raw["median_abs_error"] <= free_fall.LANDING_TOLERANCE
     assert r.passed
+    # each landed particle's launch state: taken when it first sampled beyond the lip, moving out over it (+x, v_x > 0)
+    launch = np.asarray(r.raw["launch_state"])
+    assert launch.shape == (len(r.raw["landing_error"]), 5)
+    assert np.array_equal(launch[:, 0], r.raw["launch_time"])
+    assert (launch[:, 3] > 0.0).all()
 
 
 @pytest.mark.slow

@@ -9,8 +9,9 @@ vessel; it lands where it first crosses the plane ``drop`` below the lip (linear
 Its landing error is the landed x minus the x its own launch state predicts for free fall (z = z0 + v_z t -
 g t^2 / 2, x = x0 + v_x t; the ballistic jet of Camporredondo et al. 2019, Eqs. 6-7).
 
-Each landed particle's share of its flight samples in which it was free liquid is reported too (``free_in_flight``,
-and ``free_after_launch``, s from its launch to the first such sample, NaN for never):
+Each landed particle's launch state (``launch_state``: t, x, z, v_x, v_z) and its share of its flight samples in
+which it was free liquid are reported too (``free_in_flight``, and ``free_after_launch``, s from its launch to the
+first such sample, NaN for never):
 under ``fluid.free_liquid_rule`` 'outside_vessels' the stream is free, and so without tension, by construction;
 under 'free_surface' only where the free-surface indicator finds it at the surface (docs/free_surface.md).
 
@@ -107,6 +108,10 @@ class ParticleFollower:
         self.first_free[free & np.isnan(self.first_free)] = solver.time
         self.previous = x
 
+    def launch_states(self) -> np.ndarray:
+        """(n, 5): each landed particle's launch state t, x, z, v_x, v_z (s, m, m, m/s, m/s; world frame)."""
+        return self.launch[np.isfinite(self.landed_x)]
+
     def errors(self) -> tuple[np.ndarray, np.ndarray]:
         """(launch times s, landing errors m: landed x minus the free-fall prediction) of the landed particles."""
         done = np.isfinite(self.landed_x)
@@ -144,6 +149,7 @@ def run(p: Params) -> CaseResult:
         "failure": run_.failure,
         "launch_time": t_launch.tolist(),
         "landing_error": errors.tolist(),
+        "launch_state": follower.launch_states().tolist(),
         "median_abs_error": median,
         "free_in_flight": free_share.tolist(),
         "free_after_launch": free_after.tolist(),
