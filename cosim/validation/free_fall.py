@@ -14,6 +14,13 @@ and ``free_after_launch``, s from its launch to the first such sample, NaN for n
 under ``fluid.free_liquid_rule`` 'outside_vessels' the stream is free, and so without tension, by construction;
 under 'free_surface' only where the free-surface indicator finds it at the surface (docs/free_surface.md).
 
+Where the stream leaves the vessel (:mod:`cosim.validation.launch_point`): the height over the real lip (the wall's
+own outer top edge, ``VesselSpec.lip_local``) at which the stream's lower surface passes the plane of the wall's outer
+face, along each launched particle's free-fall path and from the particles' own crossings, per 50 ms of launch times;
+the same at the outer face of the wall the liquid sees (thicker when its dummy layers reach past the real wall).
+Checked: the free path passes no more than 1 mm below the real lip (below it the stream left from a crest the real
+vessel does not have).
+
 This isolates the liquid's physics from the controller's measurement of the jet (``cosim pour``'s landing
 prediction from the mean outflow velocity at the lip): a stream that the liquid's own forces pull back while it
 falls (continuity WCSPH's tension; docs/physics-and-validation.md, The falling stream) lands short of every

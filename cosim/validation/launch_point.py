@@ -1,24 +1,26 @@
-"""Where a poured stream leaves its vessel: the crossing of the stream's lower surface with the plane of the wall's
-outer face, measured from the wall's outer top edge.
+"""Where a poured stream leaves its vessel: the height over the wall's outer top edge (the lip) at which the
+stream's lower surface passes the plane of the wall's outer face.
 
-The physics (an overfall at a sharp edge: Rouse 1936, "Discharge characteristics of the free overfall"; Henderson
-1966, "Open channel flow", the free overfall and the sharp-crested weir): liquid running over the top face of a
-wall leaves it at the face's outer edge, and the nappe's lower surface springs from that edge tangent to the face;
-from there each liquid particle is in free fall (zero pressure on both surfaces of the nappe). So the lower
-surface of a stream that leaves the real vessel passes through the real lip, the wall's outer top edge. A stream
-held on a crest that reaches past the real wall (dummy layers thicker than the wall) stays on the top face's line
-for longer and only then bends down: its lower surface, traced back along its free-fall parabola, passes the real
-outer face below the lip, inside the wall. One that the wall pushes off early passes above it.
+The physics of an overfall (Rouse 1936, "Discharge characteristics of the free overfall"; Henderson 1966, "Open
+channel flow", sharp-, narrow- and broad-crested weirs): once the nappe has left the wall its particles are in free
+fall (zero pressure on both of its surfaces), and its lower surface leaves from an edge of the wall's top face. A
+stream that stays on the top face leaves it at the face's outer edge, tangent to the face, and its lower surface
+passes the outer face's plane at the lip: height 0. A nappe over a top face short against its head (a narrow crest:
+length / head below about 0.4) springs from the face's upstream (inner) edge and passes the outer face above the lip:
+height > 0. A stream held on a crest that reaches past the real wall (dummy layers thicker than the wall) bends down
+only at that crest's end, so its free path, traced back, passes the real outer face below the lip, through the wall:
+height < 0, the lip a real vessel does not have. Which edge a thin wall's nappe leaves from depends on the head, so
+the height is checked on that side only (:data:`LIP_TOLERANCE`) and reported in full.
 
 The measure, per launched particle (the pour plane x-z, world frame, the vessel's pose at launch): its free-fall
-parabola p(s) = p0 + v s + g s^2 / 2 (g = (0, -g), s <= 0) traced back to its latest crossing of the plane
-n . (p - P) = 0, with P the wall's outer top edge and n the wall's outward normal (the vessel's +x); the crossing's
-coordinate along the outer face, e = u . (p(s) - P) with u the vessel's +z (positive: clear of the wall, on the
-opening's side; negative: behind the real lip, through the wall). The lowest particles of the stream are its lower
-row, whose centres lie half a spacing inside the liquid's surface (the liquid's first row lies dx / 2 from a wall's
-surface), so the lower surface passes at e_low - dx / 2. Tangential departure makes where along the stream it leaves
-ill-conditioned (a tangent and a parabola part quadratically) and, for the same reason, of second order for where
-it lands; the offset across the stream at the real lip is what moves the whole stream, and is what this measures.
+path p(s) = p0 + v s + g s^2 / 2 (g = (0, -g)) through its launch state, where it passes out through the plane
+n . (p - P) = 0, with P the lip and n the wall's outward normal (the vessel's +x); the crossing's coordinate along
+the outer face, e = u . (p(s) - P), u the vessel's +z (positive: clear of the wall, on the opening's side; negative:
+below the lip, through the wall). The stream's lowest particles are its lower row, whose centres lie half a spacing
+inside the liquid's surface (the liquid's first row lies dx / 2 from a wall's surface), so the lower surface passes at
+e_low - dx / 2. This is the offset across the stream at the lip, which moves the whole stream; where along the
+stream an attached nappe leaves is ill-conditioned (a tangent and a parabola part quadratically) and, for the same
+reason, of second order for where it lands.
 """
 
 from __future__ import annotations
