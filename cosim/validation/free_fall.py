@@ -18,8 +18,8 @@ Where the stream leaves the vessel (:mod:`cosim.validation.launch_point`): the h
 own outer top edge, ``VesselSpec.lip_local``) at which the stream's lower surface passes the plane of the wall's outer
 face, along each launched particle's free-fall path and from the particles' own crossings, per 50 ms of launch times;
 the same at the outer face of the wall the liquid sees (thicker when its dummy layers reach past the real wall).
-Checked: the free path passes no more than 1 mm below the real lip (below it the stream left from a crest the real
-vessel does not have).
+Checked: in no window does the free path pass more than 1 mm below the real lip (below it the stream left from a
+crest the real vessel does not have).
 
 This isolates the liquid's physics from the controller's measurement of the jet (``cosim pour``'s landing
 prediction from the mean outflow velocity at the lip): a stream that the liquid's own forces pull back while it
@@ -177,7 +177,7 @@ def run(p: Params) -> CaseResult:
     free_share, free_after = follower.free_in_flight()
     count = len(errors)
     departure = follower.departure(dx)
-    departure_median = float(np.median(departure["real_free_lower"])) if len(departure["real_free_lower"]) else float("nan")
+    lowest = float(np.min(departure["real_free_lower"])) if len(departure["real_free_lower"]) else float("nan")
     median = float(np.median(np.abs(errors))) if count else float("nan")
     mean = float(np.mean(errors)) if count else float("nan")
     metrics = [
@@ -185,7 +185,7 @@ def run(p: Params) -> CaseResult:
         Metric("particles followed to the landing plane", float(count), float(MIN_FOLLOWED), 0.0 if count >= MIN_FOLLOWED else 1.0, 0.0, "",
                absolute=True),
         Metric("landing error vs own parabola (median |.|)", median, 0.0, median, LANDING_TOLERANCE, "m", absolute=True),
-        Metric("stream's lower surface below the real lip (free path, median)", departure_median, 0.0, min(departure_median, 0.0),
+        Metric("stream's lower surface below the real lip (free path, lowest window)", lowest, 0.0, min(lowest, 0.0),
                launch_point.LIP_TOLERANCE, "m", absolute=True),
     ]
     raw = {

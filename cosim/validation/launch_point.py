@@ -10,7 +10,7 @@ length / head below about 0.4) springs from the face's upstream (inner) edge and
 height > 0. A stream held on a crest that reaches past the real wall (dummy layers thicker than the wall) bends down
 only at that crest's end, so its free path, traced back, passes the real outer face below the lip, through the wall:
 height < 0, the lip a real vessel does not have. Which edge a thin wall's nappe leaves from depends on the head, so
-the height is checked on that side only (:data:`LIP_TOLERANCE`) and reported in full.
+the height is checked on that side only, in every window of the pour (:data:`LIP_TOLERANCE`), and reported in full.
 
 The measure, per launched particle (the pour plane x-z, world frame, the vessel's pose at launch): its free-fall
 path p(s) = p0 + v s + g s^2 / 2 (g = (0, -g)) through its launch state, where it passes out through the plane
@@ -29,9 +29,10 @@ import numpy as np
 
 from cosim.fluid.config import GRAVITY
 
-# Acceptance: the stream's lower surface, on its free-fall path, passes the real wall's outer face no more than this
-# below the lip. Below it, the stream left from a crest the real vessel does not have; above it, the nappe sprang
-# clear of the wall's top face, as a thin wall's does (a narrow-crested weir's nappe leaves its upstream edge).
+# Acceptance: in every window of launch times, the stream's lower surface, on its free-fall path, passes the real
+# wall's outer face no more than this below the lip. Below it, the stream left from a crest the real vessel does not
+# have; above it, the nappe sprang clear of the wall's top face, as a thin wall's does under a head several times its
+# thickness (a narrow-crested weir's nappe leaves its upstream edge).
 LIP_TOLERANCE = 0.001  # m
 WINDOW = 0.05  # s of launch time per lower-edge sample: several particles of the lower row launch in each
 LOWER_QUANTILE = 0.1  # of a window's crossings, taken as its lower row (robust to a single stray particle)
