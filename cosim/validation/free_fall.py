@@ -15,6 +15,13 @@ first such sample, NaN for never):
 under ``fluid.free_liquid_rule`` 'outside_vessels' the stream is free, and so without tension, by construction;
 under 'free_surface' only where the free-surface indicator finds it at the surface (docs/free_surface.md).
 
+Where the stream leaves the vessel (:mod:`cosim.validation.launch_point`): the height over the real lip (the wall's
+own outer top edge, ``VesselSpec.lip_local``) at which the stream's lower surface passes the plane of the wall's outer
+face, along each launched particle's free-fall path and from the particles' own crossings, per 50 ms of launch times;
+the same at the outer face of the wall the liquid sees (thicker when its dummy layers reach past the real wall).
+Checked: in no window does the free path pass more than 1 mm below the real lip (below it the stream left from a
+crest the real vessel does not have).
+
 This isolates the liquid's physics from the controller's measurement of the jet (``cosim pour``'s landing
 prediction from the mean outflow velocity at the lip): a stream that the liquid's own forces pull back while it
 falls (continuity WCSPH's tension; docs/physics-and-validation.md, The falling stream) lands short of every
@@ -32,6 +39,7 @@ from cosim.fluid.config import GRAVITY
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
 from cosim.pour_scene import FluidSettings
+from cosim.validation import launch_point
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
 from cosim.validation.scripted import FALL_HEIGHT, domain_around, run_scripted, tilt_about_lip
 from cosim.vessel import VesselSpec, seed_pouring_vessel
@@ -83,6 +91,12 @@ class ParticleFollower:
         self.lip_local = np.array([0.5 * self.spec.inner_width + float(solver.model.wall_thickness[0]), 0.0, self.spec.inner_height])
         n = solver.n_particles
         self.launch = np.full((n, 5), np.nan)  # t, x, z, v_x, v_z at launch
+        # at launch, in x-z: the vessel's +x and +z, the real lip (the wall's own outer top edge), the lip the liquid sees
+        self.launch_frame = np.full((n, 8), np.nan)
+        # the outer-face planes (vessel frame x) of the real wall and of the wall the liquid sees, and where each particle
+        # first passed out through each: t (s), height over the lip (m)
+        self.faces = np.array([self.spec.lip_local[0], self.lip_local[0]])
+        self.passed_face = np.full((n, 2, 2), np.nan)
         self.landed_x = np.full(n, np.nan)
         self.flight_samples = np.zeros(n, dtype=int)
         self.free_samples = np.zeros(n, dtype=int)
@@ -96,6 +110,10 @@ class ParticleFollower:
         if new.any():
             v = solver.velocities()
             self.launch[new] = np.column_stack([np.full(new.sum(), solver.time), x[new, 0], x[new, 2], v[new, 0], v[new, 2]])
+            axes = after.rotation[[0, 2]][:, [0, 2]].T.ravel()  # +x then +z of the vessel, world x-z
+            real = after.transform(self.spec.lip_local[None, :])[0, [0, 2]]
+            self.launch_frame[new] = np.concatenate([axes, real, lip[[0, 2]]])
+        self._pass_faces(solver.time, before.inverse_transform(self.previous), after.inverse_transform(x), active)
         plane = self.launch[:, 2] - self.drop
         crossing = np.isfinite(self.launch[:, 0]) & np.isnan(self.landed_x) & (self.previous[:, 2] >= plane) & (x[:, 2] < plane)
         crossing &= np.abs(x[:, 2] - self.previous[:, 2]) > 0.0
@@ -112,12 +130,38 @@ class ParticleFollower:
         """(n, 5): each landed particle's launch state t, x, z, v_x, v_z (s, m, m, m/s, m/s; world frame)."""
         return self.launch[np.isfinite(self.landed_x)]
 
+    def _pass_faces(self, t: float, previous: np.ndarray, local: np.ndarray, active: np.ndarray) -> None:
+        """Record, for particles passing out through an outer-face plane between two samples (vessel-frame positions,
+        m), the sample's time and the height over the lip where they passed (linear interpolation)."""
+        for k, face in enumerate(self.faces):
+            out = active & np.isnan(self.passed_face[:, k, 0]) & (previous[:, 0] < face) & (local[:, 0] >= face)
+            s = (face - previous[out, 0]) / (local[out, 0] - previous[out, 0])
+            self.passed_face[out, k, 0] = t
+            self.passed_face[out, k, 1] = previous[out, 2] + s * (local[out, 2] - previous[out, 2]) - self.spec.inner_height
+
     def errors(self) -> tuple[np.ndarray, np.ndarray]:
         """(launch times s, landing errors m: landed x minus the free-fall prediction) of the landed particles."""
         done = np.isfinite(self.landed_x)
         t, x0, z0, vx, vz = self.launch[done].T
         fall = (vz + np.sqrt(vz * vz + 2.0 * GRAVITY * self.drop)) / GRAVITY
         return t, self.landed_x[done] - (x0 + vx * fall)
+
+    def departure(self, spacing: float) -> dict[str, np.ndarray]:
+        """Where the stream's lower surface passed the outer-face plane of the real wall (``real``) and of the wall the
+        liquid sees (``seen``), m above that face's top edge along the vessel's +z (:mod:`cosim.validation.launch_point`).
+        ``*_free``: each launched particle's free-fall path through its launch state (``*_free_crossing``, per particle)
+        and the lower surface per launch-time window (``*_free_lower``, with ``*_free_window``, s); ``*_passed``: the
+        same from the particles' own positions where they passed the plane (``*_passed_lower``, ``*_passed_window``)."""
+        done = np.isfinite(self.launch[:, 0])
+        launch, frame = self.launch[done], self.launch_frame[done]
+        out = {"launch_time": launch[:, 0]}
+        for k, (name, edge) in enumerate((("real", frame[:, 4:6]), ("seen", frame[:, 6:8]))):
+            crossing = launch_point.plane_crossings(launch[:, 1:5], frame[:, 0:2], frame[:, 2:4], edge)
+            out[f"{name}_free_crossing"] = crossing
+            out[f"{name}_free_window"], out[f"{name}_free_lower"] = launch_point.lower_edge(launch[:, 0], crossing, spacing)
+            t, height = self.passed_face[:, k].T
+            out[f"{name}_passed_window"], out[f"{name}_passed_lower"] = launch_point.lower_edge(t, height, spacing)
+        return out
 
     def free_in_flight(self) -> tuple[np.ndarray, np.ndarray]:
         """Of each landed particle: the fraction of its flight samples in which it was free liquid, and the time from
@@ -137,6 +181,8 @@ def run(p: Params) -> CaseResult:
     t_launch, errors = follower.errors()
     free_share, free_after = follower.free_in_flight()
     count = len(errors)
+    departure = follower.departure(dx)
+    lowest = float(np.min(departure["real_free_lower"])) if len(departure["real_free_lower"]) else float("nan")
     median = float(np.median(np.abs(errors))) if count else float("nan")
     mean = float(np.mean(errors)) if count else float("nan")
     metrics = [
@@ -144,6 +190,8 @@ def run(p: Params) -> CaseResult:
         Metric("particles followed to the landing plane", float(count), float(MIN_FOLLOWED), 0.0 if count >= MIN_FOLLOWED else 1.0, 0.0, "",
                absolute=True),
         Metric("landing error vs own parabola (median |.|)", median, 0.0, median, LANDING_TOLERANCE, "m", absolute=True),
+        Metric("stream's lower surface below the real lip (free path, lowest window)", lowest, 0.0, min(lowest, 0.0),
+               launch_point.LIP_TOLERANCE, "m", absolute=True),
     ]
     raw = {
         "failure": run_.failure,
@@ -155,6 +203,10 @@ def run(p: Params) -> CaseResult:
         "free_after_launch": free_after.tolist(),
         "mean_error": mean,
         "p90_abs_error": float(np.quantile(np.abs(errors), 0.9)) if count else float("nan"),
+        "real_lip_local": spec.lip_local[[0, 2]].tolist(),
+        "seen_lip_local": follower.lip_local[[0, 2]].tolist(),
+        **{f"departure_{k}": v.tolist() for k, v in departure.items()},
+        **{f"departure_{k}_summary": launch_point.summary(departure[f"{k}_lower"]) for k in ("real_free", "seen_free", "real_passed", "seen_passed")},
         "particles": run_.solver.n_particles,
         "steps": run_.solver.step_count,
         "simulated_time": run_.solver.time,
