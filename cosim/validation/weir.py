@@ -96,11 +96,11 @@ def piston_speed(head: float, crest_height: float) -> float:
 
 def piston_thickness(cfg: FluidConfig) -> float:
     """m, the piston's wall thickness: the kernel-covering layers', as ``kernel_layers`` lays them (at least the
-    default vessel wall's). Under ``real_thickness`` a 5 mm plate holds one layer, fitted and offset for liquid in
-    the piston's own cavity (its inner corners short by 0.42 rho0); pushed by its outer face, with its trailing wall
-    on the channel's floor, its corner particles then sum the floor's particles over that offset and are held
-    compressed with no liquid to move (1.14 rho0), so DFSPH fires the liquid at the plate's foot off at 24 m/s in
-    the first step. A covering wall has no fit and no offset."""
+    default vessel wall's). A thinner wall (``real_thickness``) is fitted and, under DFSPH's ``solved_rest_sum``,
+    offset for liquid resting in its own vessel's cavity (its inner corners the most); the piston pushes with its
+    floor's outer face and slides its trailing wall on the channel's floor, so its corner particles would sum the
+    floor's particles on top of that offset and be held compressed with no liquid to move, a stiffness that fires
+    the liquid at the plate's foot off. A covering wall has neither fit nor offset (docs/walls.md)."""
     return numerical_wall_thickness(VesselSpec(), replace(cfg, wall_model=WallModel.KERNEL_LAYERS))
 
 
