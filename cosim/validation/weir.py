@@ -96,11 +96,12 @@ def piston_speed(head: float, crest_height: float) -> float:
 
 def piston_thickness(cfg: FluidConfig) -> float:
     """m, the piston's wall thickness: the kernel-covering layers', as ``kernel_layers`` lays them (at least the
-    default vessel wall's). A thinner wall (``real_thickness``) is fitted and, under DFSPH's ``solved_rest_sum``,
-    offset for liquid resting in its own vessel's cavity (its inner corners the most); the piston pushes with its
-    floor's outer face and slides its trailing wall on the channel's floor, so its corner particles would sum the
-    floor's particles on top of that offset and be held compressed with no liquid to move, a stiffness that fires
-    the liquid at the plate's foot off. A covering wall has neither fit nor offset (docs/walls.md)."""
+    default vessel wall's). A thinner wall (``real_thickness``) is fitted for liquid resting in its own vessel's
+    cavity and, under DFSPH's ``solved_rest_sum``, offset for the covering layers it lacks behind its inner face
+    (its inner corners the most); the piston pushes with its floor's outer face and slides its trailing wall on the
+    channel's floor, so its corner particles would sum the floor's particles on top of that offset and be held
+    compressed with no liquid to move, a stiffness that fires the liquid at the plate's foot off. A covering wall
+    has neither fit nor offset (docs/walls.md)."""
     return numerical_wall_thickness(VesselSpec(), replace(cfg, wall_model=WallModel.KERNEL_LAYERS))
 
 
