@@ -27,7 +27,7 @@ def test_the_piston_supplies_rehbocks_discharge_at_the_nominal_head() -> None:
 def test_the_piston_plate_stands_on_the_floor_and_stays_behind_the_head_strip() -> None:
     p = weir.Params()
     dx, thickness = p.resolved_spacing, 0.012
-    ch = weir.Channel(p, dx, thickness)
+    ch = weir.Channel(p, dx, 0.005, thickness)
     spec = ch.piston()
     half = 0.5 * spec.inner_width + thickness  # the floor slab the liquid sees: the numerical wall's thickness
     corners = np.array([[x, 0.0, z] for x in (-half, half) for z in (-thickness, 0.0)])
@@ -37,6 +37,20 @@ def test_the_piston_plate_stands_on_the_floor_and_stays_behind_the_head_strip() 
         assert world[:, 2].min() == pytest.approx(0.0) and world[:, 2].max() == pytest.approx(ch.plate)
     assert ch.piston_face + ch.speed * p.duration < ch.station - 0.5 * ch.strip - 2 * p.head
     assert -ch.length < ch.piston_face - 6 * thickness  # the channel's back wall clear of the piston's trailing walls
+
+
+# 8 across the head: the piston's own 20 mm cavity (four of its walls' thickness) holds the 3 rows its fit needs
+REAL_WALLS_SPACING = 0.005
+REAL_WALLS = (("wall_model", "real_thickness"), ("wall_pressure", "solved_rest_sum"))
+
+
+def test_under_real_thickness_walls_the_weir_is_real_and_the_piston_covers_the_support() -> None:
+    """The weir plate (the crest the nappe leaves) is the vessel's own 5 mm; the piston, a driver pushing with its
+    floor's outer face, keeps the kernel-covering walls, so its thin-wall fit and rest offsets (made for liquid in
+    its own cavity) never meet the liquid: the first 0.05 s run without the liquid at its foot being fired off."""
+    result = weir.run(weir.Params(head=0.04, spacing=REAL_WALLS_SPACING, solver="dfsph", numerics=REAL_WALLS, duration=0.05, window=0.05))
+    assert result.raw["crest_thickness"] == pytest.approx(0.005)
+    assert result.raw["steps"] > 0 and result.raw["head"] == pytest.approx(0.04, rel=0.1)
 
 
 @pytest.mark.parametrize("kwargs, field", [({"dim": 3}, "dim"), ({"window": 2.0}, "window"), ({"head": 0.5}, "head"),

@@ -96,3 +96,18 @@ def test_mirrored_walls_carry_a_resting_column_with_no_wall_unknown():
     assert -fluid.vessel_wrenches()[0, 2] == pytest.approx(weight, rel=hydrostatic.WEIGHT_TOLERANCE)
     scratch = fluid.step.scratch
     assert not scratch.b_kappa_density.numpy().any() and not scratch.b_kappa_divergence.numpy().any()
+
+
+def test_a_thin_walls_rim_is_offset_for_the_wall_it_lacks_not_for_liquid_above_it():
+    """The offset makes up the layers a thin wall lacks behind it; the rim's particles also lack liquid above them
+    (the vessel holds none above its rim), which liquid flowing over the crest supplies: offset for that too, the
+    crest would push the flowing liquid off as if it were a step. So the rim's particle is offset no more than the
+    wall's particles below it, which have the same layers missing."""
+    cfg = _config(20, WallModel.REAL_THICKNESS, WallPressure.SOLVED_REST_SUM)
+    points, volumes = sample_vessel_walls(TANK, cfg)
+    offsets = wall_rest_offsets(TANK, cfg, points, volumes)
+    side = points[:, 0] > 0.5 * TANK.inner_width
+    rim = side & (points[:, 2] == points[side, 2].max())
+    below = side & (points[:, 2] > cfg.support_radius) & (points[:, 2] < TANK.inner_height - cfg.support_radius)
+    assert below.sum() > 5
+    assert offsets[rim].max() <= offsets[below].min() + 1e-3 * cfg.rest_density

@@ -231,22 +231,23 @@ def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray,
 
 
 def wall_rest_offsets(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, volumes: np.ndarray) -> np.ndarray:
-    """(n,) kg/m^3: how far each dummy particle's summation density falls short of rho0 with liquid resting against
-    it, max(rho0 - rho_b^rest, 0): rho_b^rest = rho0 (V_b W(0) + sum_b' V_b' W_bb' + sum_p dx^dim W(x_b - p)) / s
-    over the vessel's own particles ``points`` (volumes ``volumes``) and the liquid's initial lattice filling the
-    vessel to its rim (the points :func:`fit_wall_volumes` fits at; s: a resting lattice's kernel sum, as the
-    solver divides by). A wall thinner than the kernel support lacks the layers behind its particles, so liquid at
-    rest against it leaves them short (0.79 rho0 for one layer, 0.59 at the inner corners); held to rho0 they would
-    never be compressed. Walls covering the support need no offset (zeros)."""
-    from cosim.fluid.seeding import fill_vessel
-
+    """(n,) kg/m^3: the wall support each dummy particle of a thin wall lacks, against walls that cover the kernel
+    support: o_b = max(rho0 (sum_c dx^dim W(x_b - x_c) - sum_b' V_b' W(x_b - x_b')) / s, 0), c over the covering
+    walls' particles (``kernel_layers``: the liquid's lattice continued behind every face, of which the thin wall's
+    particles ``points``, volumes ``volumes``, are the part inside the vessel's own wall), b' over the thin wall's
+    own (self included), s a resting lattice's kernel sum, as the solver divides by. A thin wall's particle misses
+    the layers behind it (0.79 rho0 for one layer with liquid at rest, 0.59 at the inner corners); held to rho0 it
+    would never be compressed. With the offset it sums, wherever liquid at rest fills its support, to rho0 exactly
+    as a covering wall's particle at the same place does (the liquid's lattice and the covering walls together
+    tile its support), and where the liquid does not fill it, as at the rim, it is as short as that particle: the
+    offset makes up the missing wall, not missing liquid, so liquid flowing over the rim compresses the crest no
+    sooner than it compresses a covering wall's. Walls covering the support need no offset (zeros)."""
     if covers_support(spec, cfg):
         return np.zeros(len(points))
-    probes = fill_vessel(spec, spec.inner_height, cfg).positions
-    liquid = _kernel_sums(_kernel_pairs(points, probes, cfg), np.full(len(probes), cfg.spacing**cfg.dim), len(points))
-    walls = _kernel_sums(_kernel_pairs(points, points, cfg), volumes, len(points))
-    rest = cfg.rest_density * (liquid + walls) / lattice_kernel_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim)
-    return np.maximum(cfg.rest_density - rest, 0.0)
+    cover_points, cover_volumes = slab_particles(spec, replace(cfg, wall_model=WallModel.KERNEL_LAYERS))
+    cover = _kernel_sums(_kernel_pairs(points, cover_points, cfg), cover_volumes, len(points))
+    own = _kernel_sums(_kernel_pairs(points, points, cfg), volumes, len(points))
+    return np.maximum(cfg.rest_density * (cover - own) / lattice_kernel_sum(cfg.kernel, cfg.smoothing_ratio, cfg.dim), 0.0)
 
 
 def wetted_layer(spec: VesselSpec, points: np.ndarray, spacing: float, dim: int) -> np.ndarray:

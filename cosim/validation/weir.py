@@ -18,20 +18,25 @@ compared with Rehbock's C_d = 0.611 + 0.08 H / P (Rehbock 1929, as given by Hend
 Sec. 6.8), valid for a fully ventilated nappe, which the 2-D liquid has: nothing fills the space under it.
 
 The crest is the top of the weir's dummy-particle layers: flat, ceil(2h/dx) spacings thick (3 dx at the default
-h = 1.5 dx). A crest acts as a sharp one while the head is well above its thickness (the nappe springs clear of the
-upstream edge); H / thickness is reported.
+h = 1.5 dx; the vessel's own 5 mm under ``wall_model = "real_thickness"``). A crest acts as a sharp one while the
+head is well above its thickness (the nappe springs clear of the upstream edge); H / thickness is reported.
+
+The piston is a driver, not a vessel under test: its walls are always those that cover the kernel support
+(:func:`piston_thickness`), whatever the wall model, so that the liquid it pushes with its floor's outer face sees
+a full wall. A wall thinner than the support is fitted for liquid inside its own vessel
+(:func:`cosim.fluid.wall_sampling.fit_wall_volumes`, ``wall_rest_offsets``), not against its outer face.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from cosim.errors import InputError
-from cosim.fluid.config import GRAVITY
+from cosim.fluid.config import GRAVITY, FluidConfig, WallModel
 from cosim.fluid.seeding import ParticleSet, liquid_block
 from cosim.fluid.solver import FluidSolver
 from cosim.fluid.wall_sampling import numerical_wall_thickness
@@ -89,17 +94,29 @@ def piston_speed(head: float, crest_height: float) -> float:
     return rehbock(head, crest_height) * WEIR_FACTOR * head**1.5 / (crest_height + head)
 
 
-class Channel:
-    """The channel, its piston and where things are measured (world frame, m; the weir's upstream face at x = 0)."""
+def piston_thickness(cfg: FluidConfig) -> float:
+    """m, the piston's wall thickness: the kernel-covering layers', as ``kernel_layers`` lays them (at least the
+    default vessel wall's). A thinner wall (``real_thickness``) is fitted for liquid resting in its own vessel's
+    cavity and, under DFSPH's ``solved_rest_sum``, offset for the covering layers it lacks behind its inner face
+    (its inner corners the most); the piston pushes with its floor's outer face and slides its trailing wall on the
+    channel's floor, so its corner particles would sum the floor's particles on top of that offset and be held
+    compressed with no liquid to move, a stiffness that fires the liquid at the plate's foot off. A covering wall
+    has neither fit nor offset (docs/walls.md)."""
+    return numerical_wall_thickness(VesselSpec(), replace(cfg, wall_model=WallModel.KERNEL_LAYERS))
 
-    def __init__(self, p: Params, dx: float, wall_thickness: float) -> None:
-        self.dx, self.crest, self.head, self.thickness = dx, p.crest_height, p.head, wall_thickness
+
+class Channel:
+    """The channel, its piston and where things are measured (world frame, m; the weir's upstream face at x = 0).
+    ``wall_thickness``: the channel's walls the liquid sees (the weir plate's); ``piston_wall``: the piston's."""
+
+    def __init__(self, p: Params, dx: float, wall_thickness: float, piston_wall: float) -> None:
+        self.dx, self.crest, self.head, self.thickness, self.piston_wall = dx, p.crest_height, p.head, wall_thickness, piston_wall
         self.speed = piston_speed(p.head, p.crest_height)
         self.station = -STATION_HEADS * p.head
         self.strip = STATION_SPACINGS * dx
         start_gap = self.speed * p.duration + PISTON_CLEARANCE_HEADS * p.head + 0.5 * self.strip
         self.piston_face = self.station - start_gap  # at t = 0
-        self.length = -self.piston_face + 7.0 * wall_thickness  # the channel's -x wall clear of the piston's trailing walls
+        self.length = -self.piston_face + 7.0 * piston_wall  # the channel's -x wall clear of the piston's trailing walls
         self.plate = p.crest_height + 4.0 * p.head  # m, the piston plate's height above the floor
 
     def tank(self) -> VesselSpec:
@@ -107,7 +124,8 @@ class Channel:
 
     def piston(self) -> VesselSpec:
         """A box whose floor (spanning its inner width plus the walls) is the plate; its walls trail behind."""
-        return VesselSpec(name="piston", inner_width=self.plate - 2.0 * self.thickness, inner_depth=DEPTH, inner_height=4.0 * self.thickness)
+        t = self.piston_wall
+        return VesselSpec(name="piston", inner_width=self.plate - 2.0 * t, inner_depth=DEPTH, inner_height=4.0 * t, wall_thickness=t)
 
     def tank_pose(self) -> Pose:
         return Pose((-0.5 * self.length, 0.0, 0.0))
@@ -116,7 +134,7 @@ class Channel:
         """The piston's vessel frame turned -90 deg about y (its +z pointing to -x, its +x up): the floor's outer
         face, the plate, faces the liquid at x = piston_face + U t, its lower edge on the channel's floor."""
         turned = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
-        return Pose((self.piston_face - self.thickness + self.speed * t, 0.0, 0.5 * self.plate), turned)
+        return Pose((self.piston_face - self.piston_wall + self.speed * t, 0.0, 0.5 * self.plate), turned)
 
     def heads_at_station(self, x: np.ndarray, active: np.ndarray) -> tuple[float, float]:
         """m, the level above the crest in the strip, twice: from the liquid area in the strip over its width (the
@@ -140,8 +158,8 @@ def run(p: Params) -> CaseResult:
     # the kernel's support and the wall model (the domain does not matter to them) set the dummy layers, and so the
     # channel's layout
     layout = case_fluid_config(2, dx, p.crest_height + p.head, DEPTH, (-1, -1, -1), (1, 1, 1), p.solver, numerics=p.numerics)
-    thickness = numerical_wall_thickness(VesselSpec(), layout)  # the walls the liquid sees, both vessels'
-    ch = Channel(p, dx, thickness)
+    thickness = numerical_wall_thickness(VesselSpec(), layout)  # the channel's walls the liquid sees
+    ch = Channel(p, dx, thickness, piston_thickness(layout))
     margin = 0.05  # m
     cfg = case_fluid_config(
         2, dx, p.crest_height + p.head, DEPTH,
