@@ -81,6 +81,7 @@ class FluidSettings:
     free_liquid_rule: FreeLiquidRule | None = like(FluidConfig, "free_liquid_rule")
     free_surface_threshold: float = like(FluidConfig, "free_surface_threshold")
     free_artificial_viscosity: float | None = like(FluidConfig, "free_artificial_viscosity")
+    artificial_viscosity_beta: float | None = like(FluidConfig, "artificial_viscosity_beta")
     initial_state: InitialState = like(FluidConfig, "initial_state")
     particle_shifting: ParticleShifting = like(FluidConfig, "particle_shifting")
     shifting_coefficient: float = like(FluidConfig, "shifting_coefficient")

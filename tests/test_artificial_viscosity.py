@@ -12,6 +12,7 @@ import pytest
 import warp as wp
 
 from cosim.cli.main import main
+from cosim.errors import InputError
 from cosim.fluid.config import (
     DEFAULT_ARTIFICIAL_VISCOSITY, DEFAULT_DENSITY_TOLERANCE, GRAVITY, SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY, ArtificialViscosityScale, DensityIteration,
     FluidConfig,
@@ -164,3 +165,84 @@ def test_bad_viscosity_input_exits_2_with_one_line(flag, value, capsys):
     assert main(["validate", "hydrostatic", flag, value, "--no-plot"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("cosim validate: error:")
+
+
+# ---- Monaghan's quadratic coefficient beta (fluid.artificial_viscosity_beta)
+
+def _beta_config(beta: float | None, **kw) -> FluidConfig:
+    """WCSPH with one alpha (0.5 for the bulk and the free liquid alike) and Monaghan's beta."""
+    return _config(pressure_solver="wcsph", free_artificial_viscosity=0.5, artificial_viscosity_beta=beta, **kw)
+
+
+def test_beta_is_the_approach_terms_coefficient_on_top_of_c0():
+    # Pi = -(alpha c0 + beta w) mu / rho: the kernel's alpha (c + b w) with b = beta / alpha
+    cfg = _beta_config(2.0)
+    assert cfg.viscosity_speed == cfg.sound_speed
+    assert cfg.viscosity_approach_weight == pytest.approx(2.0 / 0.5)
+    assert make_params(cfg, 0).viscosity_approach_weight == pytest.approx(4.0)
+    for closing_speed in (0.1, 1.0):
+        a, gw = _pair(cfg, closing_speed)
+        np.testing.assert_allclose(a, _monaghan(cfg, closing_speed, cfg.sound_speed + (2.0 / 0.5) * closing_speed, gw), rtol=1e-5, atol=0.0)
+    a_receding, _ = _pair(cfg, -1.0)
+    assert np.all(a_receding == 0.0)
+
+
+def test_an_unset_beta_leaves_each_scale_as_it_was():
+    assert _beta_config(None).viscosity_approach_weight == 0.0  # c0: no approach term
+    assert _config(artificial_viscosity_scale="sound_speed").viscosity_approach_weight == 0.0
+    assert _config(artificial_viscosity_scale="signal_velocity").viscosity_approach_weight == 2.0  # Monaghan (1997)'s
+    # with the signal velocity beta replaces its 2 alpha: alpha 0.5, beta 2 -> b = 4 on sqrt(g h)
+    signal = _config(artificial_viscosity_scale="signal_velocity", artificial_viscosity_beta=2.0)
+    assert signal.viscosity_approach_weight == pytest.approx(4.0)
+    assert signal.viscosity_speed == pytest.approx(math.sqrt(GRAVITY * signal.smoothing_length))
+
+
+def test_the_viscous_criterion_takes_beta_at_the_planned_approach():
+    # nu_art = h (alpha c0 + beta w) / 8, w = 2 v (two particles head on at the planned flow speed v)
+    cfg = FluidConfig(dim=2, spacing=SPACING, pressure_solver="wcsph", max_expected_speed=1.0, artificial_viscosity=0.01,
+                      free_artificial_viscosity=0.01, artificial_viscosity_beta=2.0)
+    h, v = cfg.smoothing_length, 1.5
+    assert artificial_kinematic_viscosity(cfg, v, 0.0) == pytest.approx(h * (0.01 * cfg.sound_speed + 2.0 * 2.0 * v) / 8.0, rel=1e-12)
+    limits_dt = stable_time_step(cfg, 0.0, v, 1e-3)
+    viscous = VISCOUS_CFL * h * h / (cfg.kinematic_viscosity + artificial_kinematic_viscosity(cfg, v, 0.0))
+    acoustic = cfg.cfl * h / (cfg.sound_speed + v)
+    assert limits_dt == pytest.approx(min(viscous, acoustic), rel=1e-12)
+    # c0 = 10 v: beta 2 leaves WCSPH's step to the CFL condition (dt_visc = h / (alpha c0 + 4 beta v) ~ 0.12 h / v
+    # against 0.6 h / (11 v) = 0.055 h / v at the largest Courant number); the top of beta's range, 10, binds it
+    # (~0.025 h / v)
+    for beta, binds in ((2.0, False), (10.0, True)):
+        fast = replace(cfg, cfl=0.6, artificial_viscosity_beta=beta)
+        viscous = VISCOUS_CFL * h * h / (fast.kinematic_viscosity + artificial_kinematic_viscosity(fast, 1.0, 0.0))
+        acoustic = fast.cfl * h / (fast.sound_speed + 1.0)
+        assert stable_time_step(fast, 0.0, 1.0, 1e-3) == pytest.approx(viscous if binds else acoustic, rel=1e-12)
+        assert (viscous < acoustic) is binds
+
+
+@pytest.mark.parametrize("kw, message", [
+    ({"artificial_viscosity_beta": 2.0}, "needs one alpha for all liquid"),  # WCSPH's free alpha 0.25 against 0.01
+    ({"artificial_viscosity_beta": 2.0, "free_artificial_viscosity": 0.0, "artificial_viscosity": 0.0}, "needs Monaghan's alpha above 0"),
+    ({"artificial_viscosity_beta": -1.0, "free_artificial_viscosity": 0.01}, "fluid.artificial_viscosity_beta"),
+    ({"artificial_viscosity_beta": 11.0, "free_artificial_viscosity": 0.01}, "fluid.artificial_viscosity_beta"),
+])
+def test_bad_beta_is_refused_with_what_to_do(kw, message):
+    with pytest.raises(InputError, match=message):
+        FluidConfig(pressure_solver="wcsph", **kw)
+
+
+def test_beta_goes_without_one_alpha_where_no_liquid_is_free():
+    cfg = FluidConfig(pressure_solver="wcsph", free_liquid=False, artificial_viscosity_beta=2.0)
+    assert cfg.viscosity_approach_weight == pytest.approx(200.0)
+
+
+def test_the_validation_cases_take_beta(capsys):
+    argv = ["validate", "hydrostatic", "--solver", "wcsph", "--free-artificial-viscosity", "0.01", "--spacing", "0.0125", "--width", "0.1",
+            "--fill", "0.05", "--no-plot", "--json"]
+    assert main(argv) == 0
+    one_alpha = json.loads(capsys.readouterr().out)["cases"][0]
+    assert main([*argv, "--artificial-viscosity-beta", "2"]) == 0
+    with_beta = json.loads(capsys.readouterr().out)["cases"][0]
+    assert with_beta["pressure"] != one_alpha["pressure"]  # the settling column's approaching pairs feel beta
+    # WCSPH's free alpha left at its 0.25: refused as bad input, one line
+    assert main(["validate", "hydrostatic", "--solver", "wcsph", "--artificial-viscosity-beta", "2", "--no-plot"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "needs one alpha for all liquid" in err[0]

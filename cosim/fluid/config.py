@@ -248,6 +248,19 @@ class FluidConfig:
                                                       "signal velocity (its approach term damps impacts); "
                                                       f"{SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY:g} with c0 (WCSPH, or "
                                                       "DFSPH's 'sound_speed')")
+    artificial_viscosity_beta: float | None = setting(None, PRESSURE, "Monaghan's quadratic coefficient beta of the "
+                                                      "artificial viscosity (Monaghan & Gingold 1983; Monaghan 1992: "
+                                                      "Pi_ij = (-alpha c mu_ij + beta mu_ij^2) / rho_ij), in the signal-"
+                                                      "velocity form Pi_ij = -(alpha c + beta w) mu_ij / rho_ij with w = "
+                                                      "max(0, -v_ij . r_ij / |r_ij|) the pair's approach speed (Monaghan "
+                                                      "1997; about beta mu_ij^2 at |r_ij| = h): it damps each pair by "
+                                                      "its own approach speed, an impact wherever it happens, on top of "
+                                                      "the linear term alpha c. Needs alpha > 0 and one alpha for all "
+                                                      "liquid (free_artificial_viscosity equal to the bulk's, or "
+                                                      "free_liquid off): the kernel scales the approach term with each "
+                                                      "pair's alpha (docs/wcsph_knobs.md).", "", 0.0, 10.0, kind="float",
+                                                      none_means="the velocity scale's own: 0 with c0 (WCSPH, or DFSPH's "
+                                                      f"'sound_speed'), {APPROACH_WEIGHT:g} alpha with the signal velocity")
     particle_shifting: ParticleShifting = setting(ParticleShifting.OFF, PRESSURE, "Particle shifting at the start of "
                                                   "every substep, both solvers: 'fickian' moves each particle down the "
                                                   "gradient of the particle concentration (walls counted), "
@@ -333,11 +346,11 @@ class FluidConfig:
     viscous_time_step: ViscousTimeStep = setting(
         ViscousTimeStep.PLANNED_APPROACH, TIME_STEPPING, "The approach speed w at which the artificial viscosity's "
         "time-step criterion dt <= 0.125 h^2 / (nu + alpha h v_sig / (2 (dim + 2))) takes the velocity scale v_sig = "
-        "c + beta w (with c0, beta = 0 and w has no effect): 'planned_approach', the fastest approach the planned flow "
-        "allows, two particles head on at the CFL condition's flow speed (at least max_expected_speed) or one against "
-        "the walls; 'measured_approach', the fastest the last interval's largest particle speed v_max allows, "
-        "max(2 v_max, v_max + v_wall), with no floor: the criterion follows the approaches the liquid has, as Monaghan "
-        "(1997)'s dt <= C h / max v_sig,ij does (docs/artificial_viscosity.md).")
+        "c + b w (with c0 and no artificial_viscosity_beta, b = 0 and w has no effect): 'planned_approach', the "
+        "fastest approach the planned flow allows, two particles head on at the CFL condition's flow speed (at least "
+        "max_expected_speed) or one against the walls; 'measured_approach', the fastest the last interval's largest "
+        "particle speed v_max allows, max(2 v_max, v_max + v_wall), with no floor: the criterion follows the "
+        "approaches the liquid has, as Monaghan (1997)'s dt <= C h / max v_sig,ij does (docs/artificial_viscosity.md).")
     adaptive_time_step: bool = setting(True, TIME_STEPPING, "True: every interval plans its step from the previous "
                                        "interval's largest speed and acceleration and the walls' speed (the CFL "
                                        "condition plus the force criterion). False: one fixed step for the whole run "
@@ -369,6 +382,19 @@ class FluidConfig:
 
     def __post_init__(self) -> None:
         check_settings(self, "fluid")
+        if self.artificial_viscosity_beta is not None:
+            if self.alpha <= 0.0:
+                raise InputError(
+                    "fluid.artificial_viscosity_beta: needs Monaghan's alpha above 0 (the kernel's approach term is "
+                    f"alpha times beta / alpha), got artificial_viscosity {self.alpha:g}"
+                )
+            if self.free_liquid and self.free_liquid_alpha != self.alpha:
+                raise InputError(
+                    "fluid.artificial_viscosity_beta: needs one alpha for all liquid (the kernel's approach term is "
+                    "each pair's alpha times beta / alpha, so a free-liquid alpha would scale beta with it): set "
+                    f"fluid.free_artificial_viscosity to the bulk's {self.alpha:g} (it is {self.free_liquid_alpha:g}) or "
+                    "free_liquid = false"
+                )
         for axis in range(3):
             if self.domain_max[axis] - self.domain_min[axis] < 4.0 * self.support_radius:
                 raise InputError(
@@ -444,7 +470,11 @@ class FluidConfig:
 
     @property
     def viscosity_approach_weight(self) -> float:
-        """beta of the velocity scale (:attr:`viscosity_speed`): 0 with c0."""
+        """b of the velocity scale c + b w (:attr:`viscosity_speed`), which the kernel multiplies by alpha: Monaghan's
+        quadratic coefficient over alpha, ``artificial_viscosity_beta`` / alpha where set; otherwise 0 with c0 and
+        :data:`APPROACH_WEIGHT` with the signal velocity (there alpha b = 2 alpha is the quadratic coefficient)."""
+        if self.artificial_viscosity_beta is not None:
+            return self.artificial_viscosity_beta / self.alpha
         return APPROACH_WEIGHT if self.signal_velocity_viscosity else 0.0
 
     @property

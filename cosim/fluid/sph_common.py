@@ -109,10 +109,11 @@ def viscous_pair(
     """Acceleration (m/s^2) of particle i from neighbour j of mass ``mass_j`` (kg, or kg/m in 2-D): Monaghan (1992)
     artificial viscosity with coefficient ``alpha`` on the approaching relative velocity ``v_rel`` = v_i - v_j,
     -m_j Pi_ij grad W with Pi_ij = -alpha v_sig mu_ij / rho_ij, mu_ij = h min(v_rel . r, 0) / (r^2 + eta^2), its velocity
-    scale v_sig = c + beta max(0, -v_rel . r / |r|) (Monaghan 1997, "SPH and Riemann solvers"; c =
-    ``prm.viscosity_speed``, beta = ``prm.viscosity_approach_weight``: c0 and 0, or sqrt(|g| h) and 2,
-    ``FluidConfig.viscosity_speed``), plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the
-    neighbour's, or a wall's no-slip, velocity)."""
+    scale v_sig = c + b max(0, -v_rel . r / |r|) (Monaghan 1997, "SPH and Riemann solvers"; c =
+    ``prm.viscosity_speed``, b = ``prm.viscosity_approach_weight``: c0 and 0, or sqrt(|g| h) and 2, or with
+    ``artificial_viscosity_beta`` set Monaghan's quadratic coefficient over alpha, ``FluidConfig.viscosity_speed``),
+    plus Morris et al. (1997) laminar viscosity on ``v_rel_laminar`` (v_i minus the neighbour's, or a wall's no-slip,
+    velocity)."""
     # min(vr, 0) instead of a branch on the approach: about half the pairs approach, so the branch is mispredicted
     # about half the time (docs/tuning.md); a receding pair adds exactly zero, as the branch would skip it
     approach = wp.min(wp.dot(v_rel, r), 0.0)

@@ -16,8 +16,8 @@ from declared_settings.setting import check_settings, declared, like
 # FluidConfig fields a case's numerics may override (the rest is the case's geometry, physics and solver).
 NUMERICS_FIELDS = (
     "kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "free_liquid_rule", "free_surface_threshold", "density_iteration",
-    "density_tolerance", "wall_model", "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity", "initial_state",
-    "wall_pressure", "divergence_constraint", "max_tension", "tension_treatment", "particle_shifting",
+    "density_tolerance", "wall_model", "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity", "artificial_viscosity_beta",
+    "initial_state", "wall_pressure", "divergence_constraint", "max_tension", "tension_treatment", "particle_shifting",
     "shifting_coefficient", "viscous_time_step",
 )
 
@@ -87,7 +87,8 @@ class FluidCaseParams:
         for name, _ in self.numerics:
             if name not in NUMERICS_FIELDS:
                 raise InputError(f"numerics: {name!r} cannot be overridden; choose from {', '.join(NUMERICS_FIELDS)}")
-        FluidConfig(**dict(self.numerics))  # the values' own range checks, before anything runs
+        # the values' own range checks and those between settings (under the case's solver), before anything runs
+        FluidConfig(pressure_solver=self.solver, **dict(self.numerics))
         check_settings(self)
 
     def tank_depth(self, spacing: float) -> float:
