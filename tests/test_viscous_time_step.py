@@ -92,7 +92,7 @@ def test_scenes_and_the_validation_cases_take_the_setting():
     from cosim.pour_scene import FluidSettings
     from cosim.validation.common import NUMERICS_FIELDS
 
-    assert FluidSettings().fluid_config(0.191).viscous_time_step is ViscousTimeStep.PLANNED_APPROACH
-    measured = FluidSettings(viscous_time_step=ViscousTimeStep.MEASURED_APPROACH)
-    assert measured.fluid_config(0.191).viscous_time_step is ViscousTimeStep.MEASURED_APPROACH
+    assert FluidSettings().fluid_config(0.191).viscous_time_step is ViscousTimeStep.MEASURED_APPROACH
+    planned = FluidSettings(viscous_time_step=ViscousTimeStep.PLANNED_APPROACH)
+    assert planned.fluid_config(0.191).viscous_time_step is ViscousTimeStep.PLANNED_APPROACH
     assert "viscous_time_step" in NUMERICS_FIELDS

@@ -344,13 +344,14 @@ class FluidConfig:
                          "cfl h / (v_max + v_wall) (DFSPH, no sound speed), v_wall the vessel walls' speed.", "",
                          0.0, 0.6, lo_open=True)
     viscous_time_step: ViscousTimeStep = setting(
-        ViscousTimeStep.PLANNED_APPROACH, TIME_STEPPING, "The approach speed w at which the artificial viscosity's "
+        ViscousTimeStep.MEASURED_APPROACH, TIME_STEPPING, "The approach speed w at which the artificial viscosity's "
         "time-step criterion dt <= 0.125 h^2 / (nu + alpha h v_sig / (2 (dim + 2))) takes the velocity scale v_sig = "
         "c + b w (with c0 and no artificial_viscosity_beta, b = 0 and w has no effect): 'planned_approach', the "
         "fastest approach the planned flow allows, two particles head on at the CFL condition's flow speed (at least "
         "max_expected_speed) or one against the walls; 'measured_approach', the fastest the last interval's largest "
         "particle speed v_max allows, max(2 v_max, v_max + v_wall), with no floor: the criterion follows the "
-        "approaches the liquid has, as Monaghan (1997)'s dt <= C h / max v_sig,ij does (docs/artificial_viscosity.md).")
+        "approaches the liquid has, as Monaghan (1997)'s dt <= C h / max v_sig,ij does, the default "
+        "(docs/artificial_viscosity.md).")
     adaptive_time_step: bool = setting(True, TIME_STEPPING, "True: every interval plans its step from the previous "
                                        "interval's largest speed and acceleration and the walls' speed (the CFL "
                                        "condition plus the force criterion). False: one fixed step for the whole run "
