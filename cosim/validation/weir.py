@@ -49,6 +49,9 @@ from declared_settings.setting import documented, setting
 COEFFICIENT_TOLERANCE = 0.05
 HEADS = (0.04, 0.025)  # m, the nominal heads the validation runs (H / P = 0.5 and 0.31 at P = 0.08 m)
 HEAD_SPACINGS = 10  # default resolution: particles across the nominal head
+# The fewest particle spacings across the nominal head a run is built with: below about 1.5 the flow over the crest
+# is a row of particles, not a nappe (the head-floor study, cosim.bench.weir_head_floor, reaches down to it).
+MIN_HEAD_SPACINGS = 1.5
 STATION_HEADS = 4.0  # the head is measured this many nominal heads upstream of the weir
 STATION_SPACINGS = 10  # width of the head's strip, particle spacings
 PISTON_CLEARANCE_HEADS = 3.0  # the piston stays this many nominal heads behind the strip
@@ -80,9 +83,9 @@ class Params(FluidCaseParams):
         super().__post_init__()
         if self.dim != 2:
             raise InputError("dim: the weir case runs in 2-D only (the pour plane); choose 2")
-        if self.head / self.resolved_spacing < 4.0 - 1e-9:
+        if self.head / self.resolved_spacing < MIN_HEAD_SPACINGS - 1e-9:
             raise InputError(f"spacing: {self.resolved_spacing:g} m gives {self.head / self.resolved_spacing:.1f} particles across "
-                             f"the {self.head:g} m head; needs >= 4")
+                             f"the {self.head:g} m head; needs >= {MIN_HEAD_SPACINGS:g}")
 
     @property
     def resolved_spacing(self) -> float:
