@@ -21,6 +21,7 @@ import argparse
 import contextlib
 import cProfile
 import dataclasses
+import gc
 import math
 import os
 import pstats
@@ -117,10 +118,13 @@ def split_pour(scene: PourScene, duration: float) -> tuple[dict[str, list[float]
 
 def calls_per_step(scene: PourScene, duration: float) -> float:
     """Python function calls (cProfile's count, builtins included) per MuJoCo step over ``duration`` s of ``scene``'s
-    pour after the warm-up."""
+    pour after the warm-up, the garbage of what ran before collected first."""
     scene = dataclasses.replace(scene, coupling=dataclasses.replace(scene.coupling, max_duration=POUR_WARM_UP + duration))
     pour = prepare(scene)
     time_steps(pour, POUR_WARM_UP)
+    # earlier pours' garbage finalized now, not inside the count (a finalizer that stops a solver's lane threads
+    # waits on them, and its calls depend on the machine's load)
+    gc.collect()
     profile, steps = cProfile.Profile(), pour.steps
     profile.enable()
     try:
