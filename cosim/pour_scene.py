@@ -147,9 +147,9 @@ class CatcherSettings:
 
 
 # The CFS head's floor in particle spacings, by dimension (ControllerSettings.stream_particles not set). In 2-D the
-# smallest head the liquid resolves as a flow over a crest: the weir case's discharge coefficient is within its 5 % of
-# Rehbock's from 3 spacings on and 5-13 % low at 2.5, at 24, 32 and 48 across (python -m cosim.bench.weir_head_floor;
-# docs/outflow_validation.md). In 3-D the sheet leaving the lip spreads sideways under its head once the side walls
+# smallest head (on a half-spacing grid) the liquid resolves as a flow over a crest: the weir case's discharge
+# coefficient within its 5 % of Rehbock's at every resolution studied (python -m cosim.bench.weir_head_floor;
+# docs/outflow_validation.md has the table). In 3-D the sheet leaving the lip spreads sideways under its head once the side walls
 # end (no surface tension draws it in), past the catcher's depth, and spills the more the higher the head: one
 # spacing, chosen on the 3-D pour's spill (docs/physics-and-validation.md has the sweep; the weir case is 2-D only).
 STREAM_PARTICLES = {2: 3.0, 3: 1.0}

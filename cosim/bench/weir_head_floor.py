@@ -8,7 +8,8 @@ head is under one spacing at the default resolution, and a head of a fraction of
 resolves. This study measures where the resolved range starts, on the outflow validation rather than on a pour: the
 sharp-crested weir (:mod:`cosim.validation.weir`) at the spacing of ``--across`` particles across the default
 pourer's 0.191 m, at nominal heads of each of ``--spacings`` spacings, each run for ``--duration`` s and measured
-over its second half (3.2 s: the flow settled, the head's drift under a millimetre). Per head: the measured head,
+over its second half (3.2 s by default, twice the weir case's 1.6 s, over which the channel still drains:
+docs/walls.md). Per head: the measured head,
 the discharge against the piston's supply, and the discharge coefficient against Rehbock's (the case's 5 %
 tolerance). The floor it reports is the smallest head from which on every head run is within the tolerance.
 """
