@@ -16,7 +16,6 @@ from cosim.trajectory.csv_file import write_trajectory_csv
 from cosim.trajectory.joint_trajectory import JointTrajectory
 from cosim.trajectory.json_file import trajectory_json_text, write_json_text
 from cosim.trajectory.limits import ArmLimits
-from cosim.trajectory.mcap_file import trajectory_mcap_bytes, write_mcap_bytes
 
 
 def write_trajectory_files(
@@ -39,7 +38,11 @@ def write_trajectory_files(
     if abs(spacing - 1.0 / sample_rate_hz) > TIME_TOLERANCE:
         raise ValueError(f"write_trajectory_files: samples are {spacing!r} s apart, not 1/{sample_rate_hz!r} Hz")
     text = trajectory_json_text(trajectory, limits, sample_rate_hz, driver_names)  # validates the joints and names
-    data = trajectory_mcap_bytes(trajectory, limits, driver_names) if mcap_path is not None else b""
+    data = b""
+    if mcap_path is not None:  # mcap-ros2-support imported only where the MCAP is written
+        from cosim.trajectory.mcap_file import trajectory_mcap_bytes, write_mcap_bytes
+
+        data = trajectory_mcap_bytes(trajectory, limits, driver_names)
     if csv_path is not None:
         write_trajectory_csv(csv_path, trajectory)
     if json_path is not None:
