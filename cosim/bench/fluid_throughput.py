@@ -13,7 +13,10 @@ force criterion, with its iterations per substep). On the CPU each thread count 
 (``FluidConfig.cpu_threads``; 0: one per core, at most one per 200 particles), the threads column the number used.
 ``example_sph``: warp's own
 3-D toy (Mueller 2003 kernels on ``wp.HashGrid``, a handful of neighbours per particle), re-sized to the same
-count by reallocating its particle arrays with its own initialisation kernel. Both are timed after a warm-up
+count by reallocating its particle arrays with its own initialisation kernel. Since the two differ in neighbours
+per particle, each row also gives the mean neighbours (liquid particles within the kernel's support, counted on the
+final positions by :func:`mean_neighbours`; ours leave out the wall particles, which the liquid at the tank's
+walls also sums over) and the pair interactions per second, particle-steps/s times that mean. Both are timed after a warm-up
 step (kernel compilation excluded); the median of ``repeats`` timed batches is reported. Appends a dated section
 to the Markdown file with the machine and versions.
 """
@@ -66,10 +69,21 @@ def resting_block(
     return fluid, steps * cfg.cfl * cfg.smoothing_length / cfg.sound_speed * 0.999
 
 
+def mean_neighbours(positions: np.ndarray, radius: float) -> float:
+    """Mean number of other points closer than ``radius`` (m) to each point of ``positions`` (n, dim), the
+    kernel's support (points at exactly ``radius`` left out, as the neighbour walk does)."""
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(positions)
+    within = tree.count_neighbors(tree, radius * (1.0 - 1e-6))  # ordered pairs, each point with itself included
+    return (float(within) - len(positions)) / len(positions)
+
+
 def solver_throughput(
     n: int, dim: int, device: str, steps: int, repeats: int, solver: PressureSolver, graphs: bool, threads: int, iteration: DensityIteration,
-) -> tuple[float, float, int, float, int]:
-    """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s, threads) of our
+) -> tuple[float, float, int, float, int, float]:
+    """(median particle-steps/s, median simulated s per wall s, actual particle count, mean substep dt in s, threads,
+    mean liquid neighbours at the end) of our
     solver on a resting liquid block of ~n particles, timed over intervals of ``steps`` WCSPH substeps after a
     settling interval of the same length (kernel compilation, DFSPH's cold start and the CUDA graph capture
     excluded)."""
@@ -85,11 +99,14 @@ def solver_throughput(
         rates.append(fluid.n_particles * fluid.last_report.substeps / wall)
         speeds.append(interval / wall)
         dts.append(fluid.last_report.dt)
-    return statistics.median(rates), statistics.median(speeds), fluid.n_particles, statistics.mean(dts), fluid.lanes.count
+    x = fluid.positions()[:, [0, 2]] if dim == 2 else fluid.positions()
+    neighbours = mean_neighbours(x, fluid.config.support_radius)
+    return statistics.median(rates), statistics.median(speeds), fluid.n_particles, statistics.mean(dts), fluid.lanes.count, neighbours
 
 
-def example_sph_throughput(n: int, device: str, steps: int, repeats: int) -> float:
-    """Median particle-steps/s of warp's bundled example_sph re-sized to n particles."""
+def example_sph_throughput(n: int, device: str, steps: int, repeats: int) -> tuple[float, float]:
+    """(median particle-steps/s, mean neighbours at the end) of warp's bundled example_sph re-sized to n particles
+    (its kernels' support is its smoothing length)."""
     from warp.examples.core import example_sph
 
     with wp.ScopedDevice(device):
@@ -118,7 +135,8 @@ def example_sph_throughput(n: int, device: str, steps: int, repeats: int) -> flo
                 ex.step()
                 wp.synchronize_device()
                 rates.append(n * steps / (time.perf_counter() - start))
-    return statistics.median(rates)
+        neighbours = mean_neighbours(ex.x.numpy(), h)
+    return statistics.median(rates), neighbours
 
 
 def machine_description() -> str:
@@ -154,22 +172,24 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for dim, counts in ((2, args.counts2d), (3, args.counts3d)):
         for n in counts:
-            theirs = float("nan")
+            theirs, their_neighbours = float("nan"), float("nan")
             for name in args.solvers:
                 for threads in args.threads:
-                    ours, sim_rate, actual, dt, used = solver_throughput(
+                    ours, sim_rate, actual, dt, used, neighbours = solver_throughput(
                         n, dim, str(device), args.steps, args.repeats, PressureSolver(name), not args.no_graphs, threads, DensityIteration(args.density_iteration),
                     )
                     if dim == 3 and math.isnan(theirs):
-                        theirs = example_sph_throughput(actual, str(device), args.steps, args.repeats)
-                    rows.append((dim, actual, name, used, ours, sim_rate, dt, theirs))
-                    print(f"{dim}-D {actual:>8d} particles {name} {used} threads: {ours / 1e6:8.3f} M particle-steps/s, dt {dt * 1e6:8.1f} us, "
-                          f"{sim_rate:8.4f} simulated s per wall s" + (f"   example_sph {theirs / 1e6:8.3f} M" if dim == 3 else ""), flush=True)
-    table = ["| dim | particles | solver | threads | M particle-steps/s | steps/s | substep dt (us) | simulated s / wall s | warp example_sph (M particle-steps/s) |",
-             "|---|---|---|---|---|---|---|---|---|"]
-    for dim, n, name, used, ours, sim_rate, dt, theirs in rows:
-        ex = f"{theirs / 1e6:.3f}" if not math.isnan(theirs) else "- (3-D only)"
-        table.append(f"| {dim}-D | {n} | {name} | {used} | {ours / 1e6:.3f} | {ours / n:.0f} | {dt * 1e6:.1f} | {sim_rate:.4f} | {ex} |")
+                        theirs, their_neighbours = example_sph_throughput(actual, str(device), args.steps, args.repeats)
+                    rows.append((dim, actual, name, used, ours, sim_rate, dt, neighbours, theirs, their_neighbours))
+                    print(f"{dim}-D {actual:>8d} particles {name} {used} threads: {ours / 1e6:8.3f} M particle-steps/s, {neighbours:.1f} neighbours, "
+                          f"{ours * neighbours / 1e9:8.3f} G pairs/s, dt {dt * 1e6:8.1f} us, {sim_rate:8.4f} simulated s per wall s"
+                          + (f"   example_sph {theirs / 1e6:8.3f} M, {their_neighbours:.1f} neighbours" if dim == 3 else ""), flush=True)
+    table = ["| dim | particles | solver | threads | M particle-steps/s | steps/s | neighbours | G pair interactions/s | substep dt (us) | simulated s / wall s "
+             "| warp example_sph: M particle-steps/s | its neighbours | its G pair interactions/s |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for dim, n, name, used, ours, sim_rate, dt, neighbours, theirs, their_neighbours in rows:
+        ex = f"{theirs / 1e6:.3f} | {their_neighbours:.1f} | {theirs * their_neighbours / 1e9:.3f}" if not math.isnan(theirs) else "- (3-D only) | - | -"
+        table.append(f"| {dim}-D | {n} | {name} | {used} | {ours / 1e6:.3f} | {ours / n:.0f} | {neighbours:.1f} | {ours * neighbours / 1e9:.3f} | {dt * 1e6:.1f} | {sim_rate:.4f} | {ex} |")
     header = (
         f"\n## Fluid step throughput, {device} ({datetime.now(timezone.utc):%Y-%m-%d})\n\n"
         f"Machine: {machine_description()}. Versions: Python {platform.python_version()}, warp {wp.__version__}, numpy {np.__version__}.\n"
