@@ -2,6 +2,7 @@
 run on the CPU: the same particle state bit for bit as the CPU layout, the sums the same to float32 rounding."""
 
 import math
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -71,6 +72,21 @@ def test_the_cuda_layouts_give_the_cpu_layouts_state(dim, solver, layout):
             np.testing.assert_allclose(b[key], a[key], rtol=SUM_ORDER_RTOL, atol=0.0)
         else:
             assert np.array_equal(a[key], b[key]), key
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_wcsph_without_pair_tables_walks_the_neighbours_again_to_the_same_state(dim):
+    # the density rate sums the neighbours compute_forces walked, in the same order, from the cells instead of the
+    # tables: the same terms in the same order, so the same state to the bit and nothing allocated for the tables
+    ref = _shaken_tank(dim, "wcsph", CPU_LAYOUT)
+    walking = _shaken_tank(dim, "wcsph", replace(CPU_LAYOUT, pair_tables=False))
+    assert walking.step.scratch.pairs.index.shape == (1, 1) and ref.step.scratch.pairs.index.shape[0] == ref.n_particles
+    assert np.array_equal(ref.positions(), walking.positions())
+    assert np.array_equal(ref.state.v.numpy(), walking.state.v.numpy())
+    assert np.array_equal(ref.state.rho.numpy(), walking.state.rho.numpy())
+    assert np.array_equal(ref.vessel_wrenches(), walking.vessel_wrenches())
+    a, b = ref.history(), walking.history()
+    assert len(a["dt"]) > 5 and all(np.array_equal(a[key], b[key]) for key in a)
 
 
 @pytest.mark.parametrize("lanes", [1, 3])

@@ -13,7 +13,8 @@ when it is done), the lanes' shares one after the other, by the thread's CPU tim
 the OS gave the core to another process (on a shared machine a profile's wall times swing with the load).
 ``--pair-layouts`` profiles each case once per layout of the neighbour-pair tables (``rows``: a row per particle;
 ``columns``: slot-major, CUDA's; ``packed``: DFSPH's lists of each block of particles one after the other, the
-CPU's, the CPU only; :mod:`cosim.fluid.device_layout`, :mod:`cosim.fluid.pair_slots`), the rest of the device's layout kept:
+CPU's, the CPU only; ``none``: WCSPH keeps no pair tables and its density rate walks the cells again, DFSPH rows;
+:mod:`cosim.fluid.device_layout`, :mod:`cosim.fluid.pair_slots`), the rest of the device's layout kept:
 the particles are the same under either, so the kernels' times compare the layouts alone.
 Writes DIR/kernel_profile.md (atomically) besides printing it.
 """
@@ -38,9 +39,10 @@ from cosim.fluid.runtime import resolve_device
 DEFAULT_CASES = [f"{size}:{solver}" for size in ("3:1000000", "2:10000") for solver in ("wcsph", "dfsph:jacobi", "dfsph:gauss_seidel")]
 # --pair-layouts: name -> the DeviceLayout fields of the pair tables
 PAIR_LAYOUTS = {
-    "rows": dict(pairs_by_column=False, pairs_packed=False),
-    "columns": dict(pairs_by_column=True, pairs_packed=False),
-    "packed": dict(pairs_by_column=False, pairs_packed=True),
+    "rows": dict(pairs_by_column=False, pairs_packed=False, pair_tables=True),
+    "columns": dict(pairs_by_column=True, pairs_packed=False, pair_tables=True),
+    "packed": dict(pairs_by_column=False, pairs_packed=True, pair_tables=True),
+    "none": dict(pairs_by_column=False, pairs_packed=False, pair_tables=False),  # WCSPH: the density rate walks again
 }
 
 

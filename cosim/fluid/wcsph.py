@@ -19,10 +19,13 @@ compute_forces: per particle, over fluid and wall neighbours,
   - the reaction on each vessel: -m a_ib summed per particle, and its moment about the vessel's centre of mass,
     stored per particle so they can be reduced in a fixed order (deterministic on every device);
   - the substep's pair list (each neighbour and its kernel gradient, in loop order), which the density rate sums
-    over instead of searching the cells a second time (the same sums in the same order: identical results).
+    over instead of searching the cells a second time (the same sums in the same order: identical results), where
+    the device layout keeps pair tables (``cosim.fluid.device_layout.DeviceLayout.pair_tables``).
 compute_density_rate: continuity equation (liquid and wall particles) evaluated with the kicked velocities, plus
   delta-SPH diffusion with the renormalised density gradient of Antuono et al. (2010), so a resting column keeps
-  its hydrostatic density profile and loose liquid exchanges nothing.
+  its hydrostatic density profile and loose liquid exchanges nothing. Summed over the pair list, or
+  (compute_density_rate_walking, a layout without pair tables) over the same neighbours walked again in the same
+  order.
 integrate: symplectic Euler, i.e. leapfrog with velocities at half steps: v += dt a(rho_n); rho += dt
   Drho(v_new) (safety floor 0.8 rho0, see the kernel; free liquid keeps its summation density); x += dt v_new;
   p from the Tait equation. (Updating rho with the old velocity instead would be forward Euler for the acoustic
@@ -213,6 +216,7 @@ def compute_forces(
     b_v_noslip: wp.array(dtype=wp.vec3),
     row: wp.array(dtype=wp.int32),
     capacity: int,
+    record_pairs: int,
     tic: int,
     indicator: wp.array(dtype=float),
     # Out
@@ -231,14 +235,16 @@ def compute_forces(
     (x) grad W (Antuono et al. 2010; liquid neighbours only; zero where L is too ill-conditioned to invert). Also
     the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``:
     grad_i W), in the order of the neighbour loop, which compute_density_rate sums over instead of searching the
-    cells again; more than ``capacity`` neighbours count as an overflow, an instability. ``tic`` 1: the pressure
+    cells again (``record_pairs`` 0: none kept, compute_density_rate_walking walks them again); more than
+    ``capacity`` neighbours count as an overflow, an instability, either way. ``tic`` 1: the pressure
     terms with Sun et al. (2018)'s tensile-instability control (:func:`pressure_pair_factor`), ``indicator`` each
     particle's free-surface indicator (read only then)."""
     i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
-    pair_count[i] = 0
+    if record_pairs != 0:
+        pair_count[i] = 0
     if active[i] == 0:
         acc[i] = wp.vec3(0.0)
         rho_grad[i] = wp.vec3(0.0)
@@ -264,7 +270,7 @@ def compute_forces(
         r = walk.r
         r2 = walk.r2
         gw = kernel_gradient(prm, r, r2)
-        if count < capacity:
+        if record_pairs != 0 and count < capacity:
             pair_index[i, count] = pair_code(walk)
             pair_grad[i, count] = gw
         count += 1
@@ -289,7 +295,8 @@ def compute_forces(
         walk = next_neighbor(nb, walk)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
-    pair_count[i] = wp.min(count, capacity)
+    if record_pairs != 0:
+        pair_count[i] = wp.min(count, capacity)
     a += prm.gravity
     acc[i] = a
     if prm.dim == 2:
@@ -299,6 +306,26 @@ def compute_forces(
         grad = wp.inverse(moment) @ gsum
     rho_grad[i] = grad
     wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_ACCEL, wp.length(a))
+
+
+@wp.func
+def add_liquid_density_rate(
+    prm: SPHParams, dr: float, diffusion: float, rhoi: float, grad_i: wp.vec3, vi: wp.vec3, r: wp.vec3, r2: float, gw: wp.vec3,
+    vj: wp.vec3, rhoj: float, grad_j: wp.vec3, mj: float,
+) -> float:
+    """The density rate sum ``dr`` (kg/m^3/s) with a liquid neighbour j's share added: continuity
+    m_j v_ij . grad W, then delta-SPH diffusion ``diffusion`` (m_j / rho_j) psi_ij (``diffusion`` = delta h c0,
+    m^2/s), at the kicked velocities vi, vj (m/s); r = x_i - x_j (m), r2 = r . r, gw = grad_i W."""
+    dr += mj * wp.dot(vi - vj, gw)
+    psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + grad_j, gw)
+    return dr + diffusion * (mj / rhoj) * psi
+
+
+@wp.func
+def wall_density_rate(prm: SPHParams, volume: float, vi: wp.vec3, vb: wp.vec3, gw: wp.vec3) -> float:
+    """A wall particle's share of particle i's density rate (kg/m^3/s): rho0 V_b (v_i - v_b) . grad W, the wall
+    moving at vb (m/s)."""
+    return prm.rest_density * volume * wp.dot(vi - vb, gw)
 
 
 @item_kernel
@@ -343,16 +370,55 @@ def compute_density_rate(
         gw = pair_grad[i, k]
         if j >= 0:
             r = xi - x[j]
-            r2 = wp.dot(r, r)
-            vij = vi - (v[j] + h * acc[j])
-            rhoj = rho[j]
-            mj = mass[j]
-            dr += mj * wp.dot(vij, gw)
-            psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + rho_grad[j], gw)
-            dr += diffusion * (mj / rhoj) * psi
+            dr = add_liquid_density_rate(prm, dr, diffusion, rhoi, grad_i, vi, r, wp.dot(r, r), gw, v[j] + h * acc[j], rho[j], rho_grad[j], mass[j])
         else:
             b = pair_wall(j)
-            dr += prm.rest_density * b_volume[b] * wp.dot(vi - bv[b], gw)
+            dr += wall_density_rate(prm, b_volume[b], vi, bv[b], gw)
+    drho[i] = dr
+
+
+@item_kernel
+def compute_density_rate_walking(
+    # Model
+    prm: SPHParams,
+    b_volume: wp.array(dtype=float),
+    # State in
+    nb: Neighborhood,
+    v: wp.array(dtype=wp.vec3),
+    acc: wp.array(dtype=wp.vec3),
+    rho: wp.array(dtype=float),
+    rho_grad: wp.array(dtype=wp.vec3),
+    active: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=float),
+    dt: wp.array(dtype=float),
+    bv: wp.array(dtype=wp.vec3),
+    # Out
+    drho: wp.array(dtype=float),
+):
+    """compute_density_rate's sum over the neighbours walked again from the cell ranges (the neighbours
+    compute_forces walked, in its order; nothing read from pair tables): a layout without pair tables trades their
+    writes and reads for a second walk and the kernel gradients computed again."""
+    i = wp.tid()
+    if active[i] == 0:
+        drho[i] = 0.0
+        return
+    h = dt[0]
+    xi = nb.x[i]
+    vi = v[i] + h * acc[i]
+    rhoi = rho[i]
+    grad_i = rho_grad[i]
+    diffusion = prm.delta * prm.h * prm.sound_speed
+    dr = float(0.0)
+    walk = first_neighbor(nb, xi, prm.support)
+    while walk.index >= 0:
+        gw = kernel_gradient(prm, walk.r, walk.r2)
+        if walk.wall == 0:
+            j = walk.index
+            dr = add_liquid_density_rate(prm, dr, diffusion, rhoi, grad_i, vi, walk.r, walk.r2, gw, v[j] + h * acc[j], rho[j], rho_grad[j], mass[j])
+        else:
+            b = walk.index
+            dr += wall_density_rate(prm, b_volume[b], vi, bv[b], gw)
+        walk = next_neighbor(nb, walk)
     drho[i] = dr
 
 

@@ -5,7 +5,8 @@
                             particle's free-surface indicator where the rule or the tensile-instability control uses it
     extrapolate_wall_state  the wall particles' pressure, density and no-slip velocity from the liquid around them
     compute_forces          pressure, viscous and wall forces; the substep's pair list; the density gradient
-    compute_density_rate    continuity with delta-SPH diffusion, over the pair list
+    compute_density_rate    continuity with delta-SPH diffusion, over the pair list (or over the neighbours walked
+                            again, where the device layout keeps no pair tables)
     integrate               symplectic Euler, the equation of state, the wall guard, diagnostics
     end_substep: reduce_wrenches; next_row (``cosim.fluid.substep``)
 """
@@ -28,7 +29,7 @@ from cosim.fluid.substep import PairList, SubstepScratch, end_substep, start_sub
 
 class WCSPHScratch:
     """WCSPH's per-substep arrays: acc (N,) m/s^2; rho_grad (N,) the renormalised density gradient (kg/m^4); drho
-    (N,) kg/m^3/s; pairs: the pair list; b_p (Pa), b_rho (kg/m^3), b_v_noslip (m/s): (Nb,) the wall particles'
+    (N,) kg/m^3/s; pairs: the pair list (tables of one slot where the layout keeps none); b_p (Pa), b_rho (kg/m^3), b_v_noslip (m/s): (Nb,) the wall particles'
     extrapolated state."""
 
     def __init__(self, m: FluidModel, sh: SubstepScratch):
@@ -36,8 +37,9 @@ class WCSPHScratch:
         self.acc = wp.zeros(n, dtype=wp.vec3, device=d)
         self.rho_grad = wp.zeros(n, dtype=wp.vec3, device=d)
         self.drho = wp.zeros(n, dtype=float, device=d)
+        rows, slots = (n, sh.pair_capacity) if sh.layout.pair_tables else (1, 1)
         self.pairs = PairList(
-            wp.zeros(n, dtype=wp.int32, device=d), pair_table(n, sh.pair_capacity, wp.int32, d, by_column), pair_table(n, sh.pair_capacity, wp.vec3, d, by_column),
+            wp.zeros(rows, dtype=wp.int32, device=d), pair_table(rows, slots, wp.int32, d, by_column), pair_table(rows, slots, wp.vec3, d, by_column),
         )
         self.b_p = wp.zeros(nb, dtype=float, device=d)
         self.b_rho = wp.zeros(nb, dtype=float, device=d)
@@ -80,7 +82,7 @@ def compute_forces(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScra
     rec.launch(
         wcsph.compute_forces, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, b_vessel=m.b_vessel,
         motions=sh.motions, nb=sh.neighborhood(m, st), v=st.v, rho=st.rho, p=st.p, active=st.active, free=st.free, mass=st.mass,
-        bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip, row=sh.row, capacity=sh.pair_capacity,
+        bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip, row=sh.row, capacity=sh.pair_capacity, record_pairs=int(sh.layout.pair_tables),
         tic=tension_control(m.config), indicator=sh.free_surface, acc=sc.acc, rho_grad=sc.rho_grad, wall_force=sh.wall_force, wall_torque=sh.wall_torque,
         pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad,
         diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
@@ -88,7 +90,14 @@ def compute_forces(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScra
 
 
 def compute_density_rate(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: WCSPHScratch) -> None:
-    """The continuity equation's density rate with delta-SPH diffusion, over the pair list."""
+    """The continuity equation's density rate with delta-SPH diffusion, over the pair list (or the neighbours
+    walked again, where the layout keeps no pair tables)."""
+    if not sh.layout.pair_tables:
+        rec.launch(
+            wcsph.compute_density_rate_walking, m.n_particles, prm=m.params, b_volume=m.b_volume, nb=sh.neighborhood(m, st), v=st.v, acc=sc.acc, rho=st.rho,
+            rho_grad=sc.rho_grad, active=st.active, mass=st.mass, dt=sh.dt, bv=sh.bv, drho=sc.drho,
+        )
+        return
     rec.launch(
         wcsph.compute_density_rate, m.n_particles, prm=m.params, b_volume=m.b_volume, x=st.x, v=st.v, acc=sc.acc, rho=st.rho, rho_grad=sc.rho_grad,
         active=st.active, mass=st.mass, dt=sh.dt, bv=sh.bv, pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, drho=sc.drho,
