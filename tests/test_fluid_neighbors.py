@@ -1,6 +1,7 @@
-"""The neighbour walk (cosim.fluid.neighbors.first_neighbor / next_neighbor) against a brute-force search: it finds
-exactly the points within the radius, in the one order every SPH sum relies on (cell by cell in grid order, in
-each cell the liquid before the wall particles)."""
+"""The neighbour loops every SPH sum writes (cosim.fluid.neighbors: neighbor_cells, reachable_cell, within_support,
+as the module's docstring spells them out) against a brute-force search: they find exactly the points within the
+radius, in the one order every SPH sum relies on (cell by cell in grid order, in each cell the liquid before the
+wall particles)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import numpy as np
 import pytest
 import warp as wp
 
-from cosim.fluid.neighbors import CellGrid, Neighborhood, first_liquid_neighbor, first_neighbor, neighborhood, next_neighbor
+from cosim.fluid.neighbors import COINCIDENT_R2, CellGrid, Neighborhood, neighbor_cells, neighborhood, reachable_cell, within_support
 
 MAX_FOUND = 64
 DOMAIN = (0.0, 1.0)
@@ -16,20 +17,39 @@ RADIUS = 0.1
 NOT_RECORDED = 2**30  # a slot no neighbour was recorded in
 
 
+@wp.func
+def record(found: wp.array2d(dtype=wp.int32), i: int, n: int, code: int) -> int:
+    """Neighbour ``code`` recorded as point i's n-th (where there is room); the count after it."""
+    if n < MAX_FOUND:
+        found[i, 1 + n] = code
+    return n + 1
+
+
 @wp.kernel
 def record_walk(nb: Neighborhood, radius: float, liquid_only: int, points: wp.array(dtype=wp.vec3), found: wp.array2d(dtype=wp.int32)):
-    """The neighbours the walk from each point visits, in the order it visits them (liquid particle j as j, wall
-    particle b as -1 - b), after their count in column 0; only neighbours within the radius are recorded."""
+    """The neighbours the loops from each point visit, in the order they visit them (liquid particle j as j, wall
+    particle b as -1 - b), after their count in column 0: the liquid and wall loops of the SPH sums, or with
+    ``liquid_only`` the wall layer's loop over the liquid, which counts a liquid particle however near."""
     i = wp.tid()
-    walk = first_neighbor(nb, points[i], radius)
-    if liquid_only != 0:
-        walk = first_liquid_neighbor(nb, points[i], radius)
+    x = points[i]
+    radius2 = radius * radius
+    min_r2 = wp.where(liquid_only != 0, 0.0, COINCIDENT_R2)
     n = int(0)
-    while walk.index >= 0:
-        if n < MAX_FOUND and walk.r2 < radius * radius:
-            found[i, 1 + n] = wp.where(walk.wall == 0, walk.index, -1 - walk.index)
-        n += 1
-        walk = next_neighbor(nb, walk)
+    cells = neighbor_cells(nb.spec, x)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, x, radius2)
+        if cell < 0:
+            continue
+        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+            r = x - nb.x[j]
+            if within_support(wp.dot(r, r), radius2, min_r2):
+                n = record(found, i, n, j)
+        if liquid_only == 0:
+            for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+                b = nb.b_order[item]
+                r = x - nb.bx[b]
+                if within_support(wp.dot(r, r), radius2, min_r2):
+                    n = record(found, i, n, -1 - b)
     found[i, 0] = n
 
 
@@ -121,7 +141,7 @@ def test_walk_visits_the_points_within_the_radius_in_cell_order(dim, liquid_only
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_walk_finds_the_points_on_cell_faces_and_beyond_the_grid(dim):
-    """The walk leaves out the cells of its block that lie beyond the radius (``cell_within_reach``): points on
+    """The loops leave out the cells of the block that lie beyond the radius (``reachable_cell``): points on
     the cells' faces and corners, a float32 ulp either side of them, and outside the grid (filed in its end cells)
     are found all the same."""
     rng = np.random.default_rng(11 + dim)

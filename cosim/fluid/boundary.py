@@ -23,7 +23,7 @@ import warp as wp
 
 from cosim.fluid.lanes import item_kernel
 from cosim.fluid.mesh_boundary import SHAPE_MESH, mesh_guard, mesh_inside
-from cosim.fluid.neighbors import Neighborhood, first_liquid_neighbor, next_neighbor
+from cosim.fluid.neighbors import Neighborhood, neighbor_cells, reachable_cell, within_support
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -150,15 +150,21 @@ def extrapolate_wall_state(
     sum_pw = float(0.0)
     sum_rho_r = wp.vec3(0.0)
     sum_v = wp.vec3(0.0)
-    walk = first_liquid_neighbor(nb, xb, prm.support)
-    while walk.index >= 0:
-        f = walk.index
-        w = kernel_w(wp.sqrt(walk.r2), prm.inv_h, prm.sigma, prm.kernel)
-        sum_w += w
-        sum_pw += p[f] * w
-        sum_rho_r += (rho[f] * w) * walk.r
-        sum_v += w * v[f]
-        walk = next_neighbor(nb, walk)
+    radius2 = prm.support * prm.support
+    cells = neighbor_cells(nb.spec, xb)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, xb, radius2)
+        if cell < 0:
+            continue
+        for f in range(nb.cell_start[cell], nb.cell_end[cell]):  # the liquid only, however near
+            r = xb - nb.x[f]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, 0.0):
+                w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                sum_w += w
+                sum_pw += p[f] * w
+                sum_rho_r += (rho[f] * w) * r
+                sum_v += w * v[f]
     pw = float(0.0)
     v_noslip = bv[b]
     if sum_w > 0.0:

@@ -94,7 +94,7 @@ from cosim.fluid.diagnostics import (
 )
 from cosim.fluid.free_surface import FREE_AT_SURFACE, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
-from cosim.fluid.neighbors import GridSpec, Neighborhood, first_neighbor, next_neighbor
+from cosim.fluid.neighbors import COINCIDENT_R2, GridSpec, Neighborhood, neighbor_cells, reachable_cell, within_support
 from cosim.fluid.pair_slots import PairSlots, close_pair_row, open_pair_row
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
@@ -102,12 +102,12 @@ from cosim.fluid.sph_common import (
     diag_slot,
     finish_particle,
     kernel_gradient,
-    neighbor_mass,
     next_free_state,
-    pair_code,
     pair_wall,
     summation_term,
     viscous_pair,
+    wall_mass,
+    wall_pair,
 )
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -276,23 +276,48 @@ def compute_density_factor(
     grad_sq = float(0.0)
     moment = wp.mat33(0.0)
     count = int(0)
-    walk = first_neighbor(nb, xi, prm.support)
-    while walk.index >= 0:
-        mj = neighbor_mass(prm, mass, b_volume, walk)
-        density += summation_term(prm, mj, walk)
-        gw = kernel_gradient(prm, walk.r, walk.r2)
-        gm = mj * gw
-        if free_liquid == FREE_AT_SURFACE:
-            moment += renormalisation_term(mj / prm.rest_density, walk.r, gw)
-        grad_sum += gm
-        if walk.wall == 0:
-            grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
-        if count < capacity:
-            pair_index[first + count * pair_slots.step] = pair_code(walk)
-            pair_grad[first + count * pair_slots.step] = gw
-            pair_mass_grad[first + count * pair_slots.step] = gm
-        count += 1
-        walk = next_neighbor(nb, walk)
+    radius2 = prm.support * prm.support
+    cells = neighbor_cells(nb.spec, xi)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, xi, radius2)
+        if cell < 0:
+            continue
+        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+            r = xi - nb.x[j]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                mj = mass[j]
+                density += summation_term(prm, mj, r2)
+                gw = kernel_gradient(prm, r, r2)
+                gm = mj * gw
+                if free_liquid == FREE_AT_SURFACE:
+                    moment += renormalisation_term(mj / prm.rest_density, r, gw)
+                grad_sum += gm
+                grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
+                if count < capacity:
+                    slot = first + count * pair_slots.step
+                    pair_index[slot] = j
+                    pair_grad[slot] = gw
+                    pair_mass_grad[slot] = gm
+                count += 1
+        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            b = nb.b_order[item]
+            r = xi - nb.bx[b]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                mb = wall_mass(prm, b_volume, b)
+                density += summation_term(prm, mb, r2)
+                gw = kernel_gradient(prm, r, r2)
+                gm = mb * gw
+                if free_liquid == FREE_AT_SURFACE:
+                    moment += renormalisation_term(mb / prm.rest_density, r, gw)
+                grad_sum += gm
+                if count < capacity:
+                    slot = first + count * pair_slots.step
+                    pair_index[slot] = wall_pair(b)
+                    pair_grad[slot] = gw
+                    pair_mass_grad[slot] = gm
+                count += 1
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
@@ -550,18 +575,31 @@ def compute_wall_density_factor(
     density = mb * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     grad_sq = float(0.0)
     count = int(0)
-    walk = first_neighbor(nb, nb.bx[b], prm.support)
-    while walk.index >= 0:
-        mj = neighbor_mass(prm, mass, b_volume, walk)
-        density += summation_term(prm, mj, walk)
-        if walk.wall == 0:
-            gw = kernel_gradient(prm, walk.r, walk.r2)
-            grad_sq += mj * mb * wp.dot(gw, gw)
-            if count < capacity:
-                b_pair_index[first + count * b_pair_slots.step] = walk.index
-                b_pair_mass_grad[first + count * b_pair_slots.step] = mj * gw
-            count += 1
-        walk = next_neighbor(nb, walk)
+    xb = nb.bx[b]
+    radius2 = prm.support * prm.support
+    cells = neighbor_cells(nb.spec, xb)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, xb, radius2)
+        if cell < 0:
+            continue
+        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+            r = xb - nb.x[j]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                mj = mass[j]
+                density += summation_term(prm, mj, r2)
+                gw = kernel_gradient(prm, r, r2)
+                grad_sq += mj * mb * wp.dot(gw, gw)
+                if count < capacity:
+                    b_pair_index[first + count * b_pair_slots.step] = j
+                    b_pair_mass_grad[first + count * b_pair_slots.step] = mj * gw
+                count += 1
+        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            other = nb.b_order[item]
+            r = xb - nb.bx[other]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                density += summation_term(prm, wall_mass(prm, b_volume, other), r2)
     if count == 0:
         return
     if count > capacity:

@@ -12,11 +12,29 @@ build occupied (from its sorted keys): O(points), so the grid costs what the reg
 walls) needs, however large the domain. :attr:`GridReset.WHOLE` clears every cell of the domain: O(cells). Both
 leave the same ranges, so the neighbour lists, and every result, are identical.
 
-Every SPH sum over neighbours is one walk (:func:`first_neighbor`, :func:`next_neighbor`, in the manner of warp's
-``hash_grid_query``/``hash_grid_query_next``) over a :class:`Neighborhood`, the liquid and the wall particles in one
-grid: the walk owns the order of the cells, the liquid before the walls in each cell, and the support test, so
-every kernel adds its terms in the same order and only says what a neighbour contributes. It opens only the cells
-of the block whose box lies within the radius (:func:`cell_within_reach`): a support sphere reaches 20.6 of the
+Every SPH sum over neighbours walks the same cells in the same order, written out as nested loops over a
+:class:`Neighborhood`, the liquid and the wall particles in one grid::
+
+    cells = neighbor_cells(nb.spec, xi)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, xi, radius2)
+        if cell < 0:
+            continue
+        for j in range(nb.cell_start[cell], nb.cell_end[cell]):        # the liquid, in cell order
+            r = xi - nb.x[j]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                ...
+        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):  # then the cell's wall particles
+            b = nb.b_order[item]
+            r = xi - nb.bx[b]
+            ...
+
+so every kernel adds its terms in one order (cell by cell, in each the liquid before the walls). Nested loops,
+not an iterator: on CUDA a walk kept in a struct and advanced by a function (in the manner of warp's
+``hash_grid_query_next``) made the same sums markedly slower than these loops (``python -m
+cosim.bench.kernel_profile``; the figures are in docs/benchmarks.md). The loop opens only the cells of the block whose box
+lies within the radius (:func:`reachable_cell`, :func:`cell_within_reach`): a support sphere reaches 20.6 of the
 27 cells on average in 3-D (1 + 6 + 12 pi/4 + 8 pi/6 for a point uniformly placed in its cell; 8.1 of 9 in 2-D),
 so in a uniform liquid 4.9 points are tested per neighbour instead of 6.5, and the neighbours and their order stay
 the same.
@@ -86,15 +104,15 @@ def neighbor_cells(g: GridSpec, x: wp.vec3) -> CellBlock:
 @wp.func
 def block_cell_coords(block: CellBlock, k: int) -> wp.vec3i:
     """Cell coordinates of the k-th cell of ``block`` (0 <= k < ``block.count``), x fastest, then y, then z: the
-    neighbour walk (:func:`first_neighbor`) visits the cells, and so sums the neighbours, in this one order."""
+    neighbour loops (:func:`reachable_cell`) visit the cells, and so sum the neighbours, in this one order."""
     sx = block.size[0]
     sy = block.size[1]
     return wp.vec3i(block.first[0] + k % sx, block.first[1] + (k // sx) % sy, block.first[2] + k // (sx * sy))
 
 
 # Slack (in cells) by which a cell's box is widened before it is found out of reach: a point is filed by the floor
-# of its rounded cell coordinate, so it may lie a few ulps outside its cell's exact box, and the walk's own
-# distance test rounds too; 1e-3 of a cell is far above both and keeps every cell the walk could find a
+# of its rounded cell coordinate, so it may lie a few ulps outside its cell's exact box, and the loops' own
+# distance test rounds too; 1e-3 of a cell is far above both and keeps every cell the loops could find a
 # neighbour in.
 CELL_REACH_SLACK = wp.constant(1.0e-3)
 
@@ -130,7 +148,7 @@ def cell_within_reach(g: GridSpec, c: wp.vec3i, x: wp.vec3, radius2: float) -> b
 
 @wp.struct
 class Neighborhood:
-    """The liquid and the wall particles sorted into one cell grid ``spec``, as the neighbour walk reads them: the
+    """The liquid and the wall particles sorted into one cell grid ``spec``, as the neighbour loops read them: the
     liquid in cell order (``x``, m; ``cell_start``/``cell_end``: each cell's range of it), the wall particles by
     indirection (``b_order``: their indices in cell order; ``b_cell_start``/``b_cell_end``: each cell's range of
     ``b_order``; ``bx``, m)."""
@@ -145,116 +163,27 @@ class Neighborhood:
     bx: wp.array(dtype=wp.vec3)
 
 
-@wp.struct
-class NeighborWalk:
-    """A walk over the neighbours of the point ``x``: every liquid particle, and with ``walls`` every wall
-    particle, at a squared distance r2 with ``min_r2`` <= r2 < ``radius2``, cell by cell in :func:`block_cell_coords`'s
-    order, in each cell the liquid first (in cell order), then the wall particles (in cell order). Where it stands:
-    the neighbour ``index`` (a liquid particle, or with ``wall`` 1 a wall particle; -1 once the walk is done), its
-    offset ``r`` = x - x_neighbour (m) and ``r2`` = r . r; and, for the next step, the block of cells, the open
-    cell ``k`` and its range [``item``, ``end``) of the liquid (``wall`` 0) or of ``b_order`` (``wall`` 1)."""
-
-    x: wp.vec3
-    radius2: float
-    min_r2: float
-    walls: int
-    cells: CellBlock
-    k: int
-    cell: int
-    wall: int
-    item: int
-    end: int
-    index: int
-    r: wp.vec3
-    r2: float
-
-
-# Below this squared distance (m^2) a point is taken to be at x itself (the particle whose neighbours are walked),
+# Below this squared distance (m^2) a point is taken to be at x itself (the particle whose neighbours are summed),
 # where the pair's direction is undefined
 COINCIDENT_R2 = wp.constant(1.0e-24)
 
 
 @wp.func
-def next_neighbor(nb: Neighborhood, walk: NeighborWalk) -> NeighborWalk:
-    """The walk advanced to its next neighbour (``index`` -1 once there is none)."""
-    w = walk
-    while True:
-        if w.item < w.end:
-            item = w.item
-            w.item = item + 1
-            index = item
-            p = wp.vec3(0.0)
-            if w.wall == 0:
-                p = nb.x[item]
-            else:
-                index = nb.b_order[item]
-                p = nb.bx[index]
-            r = w.x - p
-            r2 = wp.dot(r, r)
-            if not (r2 >= w.radius2 or r2 < w.min_r2):
-                w.index = index
-                w.r = r
-                w.r2 = r2
-                return w
-        elif w.wall == 0 and w.walls != 0 and w.k >= 0:
-            w.wall = 1
-            w.item = nb.b_cell_start[w.cell]
-            w.end = nb.b_cell_end[w.cell]
-        elif w.k + 1 < w.cells.count:
-            w.k = w.k + 1
-            c = block_cell_coords(w.cells, w.k)
-            w.cell = grid_index(nb.spec, c[0], c[1], c[2])
-            if cell_within_reach(nb.spec, c, w.x, w.radius2):
-                w.wall = 0
-                w.item = nb.cell_start[w.cell]
-                w.end = nb.cell_end[w.cell]
-            else:  # no point of this cell is a neighbour: neither its liquid nor its walls are opened
-                w.wall = 1
-                w.item = 0
-                w.end = 0
-        else:
-            w.index = -1
-            return w
+def reachable_cell(nb: Neighborhood, cells: CellBlock, k: int, x: wp.vec3, radius2: float) -> int:
+    """The grid index of the k-th cell of ``cells`` (:func:`block_cell_coords`' order), or -1 where no point filed
+    in it can lie within sqrt(``radius2``) (m) of ``x`` (:func:`cell_within_reach`): neither its liquid nor its
+    wall particles are then opened."""
+    c = block_cell_coords(cells, k)
+    if cell_within_reach(nb.spec, c, x, radius2):
+        return grid_index(nb.spec, c[0], c[1], c[2])
+    return -1
 
 
 @wp.func
-def start_walk(nb: Neighborhood, x: wp.vec3, radius: float, walls: int, min_r2: float) -> NeighborWalk:
-    """The walk over the neighbours of ``x`` within ``radius`` (m), the wall particles too where ``walls`` != 0,
-    none nearer than sqrt(``min_r2``), standing at its first neighbour."""
-    w = NeighborWalk()
-    w.x = x
-    w.radius2 = radius * radius
-    w.min_r2 = min_r2
-    w.walls = walls
-    w.cells = neighbor_cells(nb.spec, x)
-    w.k = -1
-    w.cell = -1
-    w.wall = 0
-    w.item = 0
-    w.end = 0
-    w.index = -1
-    w.r = wp.vec3(0.0)
-    w.r2 = 0.0
-    return next_neighbor(nb, w)
-
-
-@wp.func
-def first_neighbor(nb: Neighborhood, x: wp.vec3, radius: float) -> NeighborWalk:
-    """The walk over the liquid and wall neighbours of the particle at ``x`` within ``radius`` (m), the particle
-    itself left out (:data:`COINCIDENT_R2`), standing at the first. Every neighbour loop reads
-
-        walk = first_neighbor(nb, x, radius)
-        while walk.index >= 0:
-            ... walk.index, walk.wall, walk.r, walk.r2 ...
-            walk = next_neighbor(nb, walk)"""
-    return start_walk(nb, x, radius, 1, COINCIDENT_R2)
-
-
-@wp.func
-def first_liquid_neighbor(nb: Neighborhood, x: wp.vec3, radius: float) -> NeighborWalk:
-    """The walk over the liquid within ``radius`` (m) of a point that is not a liquid particle (a wall
-    particle's), every liquid particle counted however near, standing at the first."""
-    return start_walk(nb, x, radius, 0, 0.0)
+def within_support(r2: float, radius2: float, min_r2: float) -> bool:
+    """Whether a point at squared distance ``r2`` (m^2) is a neighbour: ``min_r2`` <= r2 < ``radius2``
+    (:data:`COINCIDENT_R2` leaves the particle itself out; 0 counts every point however near)."""
+    return not (r2 >= radius2 or r2 < min_r2)
 
 
 @wp.kernel

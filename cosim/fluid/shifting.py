@@ -51,10 +51,10 @@ import warp as wp
 from cosim.fluid.config import FluidConfig, ParticleShifting, PressureSolver
 from cosim.fluid.free_surface import renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
-from cosim.fluid.neighbors import Neighborhood, first_neighbor, next_neighbor
+from cosim.fluid.neighbors import COINCIDENT_R2, Neighborhood, neighbor_cells, reachable_cell, within_support
 from cosim.fluid.params import SPHParams
 from cosim.fluid.program import Recorder
-from cosim.fluid.sph_common import kernel_gradient, neighbor_mass
+from cosim.fluid.sph_common import kernel_gradient, wall_mass
 from cosim.fluid.sph_kernels import kernel_values, kernel_w
 
 if TYPE_CHECKING:
@@ -92,6 +92,15 @@ def plane_block(dim: int, m: wp.mat33) -> wp.mat33:
     return wp.mat33(m[0, 0], 0.0, m[0, 2], 0.0, 1.0, 0.0, m[2, 0], 0.0, m[2, 2])
 
 
+@wp.func
+def concentration_gradient_term(prm: SPHParams, w_spacing: float, volume: float, r2: float, gw: wp.vec3) -> wp.vec3:
+    """A neighbour's share of the concentration gradient with the tensile term (Sun et al. 2017),
+    (1 + R (W(r) / W(dx))^n) V_j grad W (1/m): ``volume`` V_j (m^3, or m^2 in 2-D), ``r2`` its squared distance
+    (m^2), ``gw`` grad_i W, ``w_spacing`` W(dx)."""
+    ratio = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel) / w_spacing
+    return (1.0 + TENSILE_WEIGHT * wp.pow(ratio, TENSILE_POWER)) * volume * gw
+
+
 @item_kernel
 def measure_concentration(
     # Model
@@ -125,19 +134,31 @@ def measure_concentration(
     gradient = wp.vec3(0.0)
     rho_sum = wp.vec3(0.0)
     p_sum = wp.vec3(0.0)
-    walk = first_neighbor(nb, xi, prm.support)
-    while walk.index >= 0:
-        volume = neighbor_mass(prm, mass, b_volume, walk) / prm.rest_density
-        gw = kernel_gradient(prm, walk.r, walk.r2)
-        ratio = kernel_w(wp.sqrt(walk.r2), prm.inv_h, prm.sigma, prm.kernel) / w_spacing
-        if walk.wall == 0:
-            moment += renormalisation_term(volume, walk.r, gw)
-            kernel_sum_grad += volume * gw
-            if correct_fields != 0:
-                rho_sum += (rho[walk.index] - rho[i]) * volume * gw
-                p_sum += (p[walk.index] - p[i]) * volume * gw
-        gradient += (1.0 + TENSILE_WEIGHT * wp.pow(ratio, TENSILE_POWER)) * volume * gw
-        walk = next_neighbor(nb, walk)
+    radius2 = prm.support * prm.support
+    cells = neighbor_cells(nb.spec, xi)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, xi, radius2)
+        if cell < 0:
+            continue
+        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+            r = xi - nb.x[j]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                volume = mass[j] / prm.rest_density
+                gw = kernel_gradient(prm, r, r2)
+                moment += renormalisation_term(volume, r, gw)
+                kernel_sum_grad += volume * gw
+                if correct_fields != 0:
+                    rho_sum += (rho[j] - rho[i]) * volume * gw
+                    p_sum += (p[j] - p[i]) * volume * gw
+                gradient += concentration_gradient_term(prm, w_spacing, volume, r2, gw)
+        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            b = nb.b_order[item]
+            r = xi - nb.bx[b]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                volume = wall_mass(prm, b_volume, b) / prm.rest_density
+                gradient += concentration_gradient_term(prm, w_spacing, volume, r2, kernel_gradient(prm, r, r2))
     lam = surface_indicator(prm.dim, moment)
     n = wp.vec3(0.0)
     if lam >= SURFACE_REGION:
@@ -176,11 +197,17 @@ def compute_shift(
     if active[i] == 0 or indicator[i] < SURFACE_REGION:
         return
     near_surface = bool(False)
-    walk = first_neighbor(nb, nb.x[i], prm.support)
-    while walk.index >= 0:
-        if walk.wall == 0 and indicator[walk.index] < SURFACE_REGION:
-            near_surface = True
-        walk = next_neighbor(nb, walk)
+    xi = nb.x[i]
+    radius2 = prm.support * prm.support
+    cells = neighbor_cells(nb.spec, xi)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, xi, radius2)
+        if cell < 0:
+            continue
+        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+            r = xi - nb.x[j]
+            if within_support(wp.dot(r, r), radius2, COINCIDENT_R2) and indicator[j] < SURFACE_REGION:
+                near_surface = True
     dr = -per_second * dt[0] * grad_c[i]
     if near_surface:
         n = normal[i]

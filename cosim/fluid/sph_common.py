@@ -1,5 +1,5 @@
-"""Warp functions and kernels both pressure solvers share: what a walked neighbour brings into the sums (its mass,
-its share of the summation density, its pair-list code), the pair kernel gradient, the viscous pair terms, the
+"""Warp functions and kernels both pressure solvers share: what a neighbour brings into the sums (a wall particle's
+mass, a neighbour's share of the summation density), the pair-list codes, the pair kernel gradient, the viscous pair terms, the
 end of a particle's substep (wall guard, deactivation outside the domain, the substep's common diagnostics), the
 reorder of the particle state into cell order and the fixed-order reduction of the wall wrenches."""
 
@@ -22,7 +22,6 @@ from cosim.fluid.diagnostics import (
     DIAG_NONFINITE,
 )
 from cosim.fluid.lanes import item_kernel
-from cosim.fluid.neighbors import NeighborWalk
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_dw, kernel_w
 
@@ -73,25 +72,17 @@ def pair_wall(j: int) -> int:
 
 
 @wp.func
-def pair_code(walk: NeighborWalk) -> int:
-    """The pair-list code of the neighbour a walk stands at: liquid particle j itself, wall particle b as
-    :func:`wall_pair`."""
-    return wp.where(walk.wall == 0, walk.index, wall_pair(walk.index))
+def wall_mass(prm: SPHParams, b_volume: wp.array(dtype=float), b: int) -> float:
+    """The mass wall particle b brings into the SPH sums (kg, or kg/m in 2-D): rho0 V_b, the liquid it stands for
+    (a liquid neighbour j brings its own m_j)."""
+    return prm.rest_density * b_volume[b]
 
 
 @wp.func
-def neighbor_mass(prm: SPHParams, mass: wp.array(dtype=float), b_volume: wp.array(dtype=float), walk: NeighborWalk) -> float:
-    """The mass the neighbour a walk stands at brings into the SPH sums (kg, or kg/m in 2-D): its own m_j for a
-    liquid particle, rho0 V_b for a wall particle (the liquid it stands for)."""
-    if walk.wall == 0:
-        return mass[walk.index]
-    return prm.rest_density * b_volume[walk.index]
-
-
-@wp.func
-def summation_term(prm: SPHParams, m_pair: float, walk: NeighborWalk) -> float:
-    """The neighbour's share m W(|r|) of the summation density (kg/m^3), ``m_pair`` from :func:`neighbor_mass`."""
-    return m_pair * kernel_w(wp.sqrt(walk.r2), prm.inv_h, prm.sigma, prm.kernel)
+def summation_term(prm: SPHParams, m_pair: float, r2: float) -> float:
+    """A neighbour's share m W(|r|) of the summation density (kg/m^3) at squared distance ``r2`` (m^2), ``m_pair``
+    its mass (kg, or kg/m in 2-D)."""
+    return m_pair * kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
 
 
 @wp.func

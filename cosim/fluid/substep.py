@@ -115,8 +115,8 @@ class SubstepScratch:
         return wrench.astype(np.float64) * (1.0 / substeps)
 
     def neighborhood(self, model: FluidModel, st: FluidState) -> Neighborhood:
-        """The liquid of ``st`` and the wall particles in the model's cell grids, as the neighbour walk reads them
-        (``cosim.fluid.neighbors.first_neighbor``)."""
+        """The liquid of ``st`` and the wall particles in the model's cell grids, as the neighbour loops read them
+        (``cosim.fluid.neighbors``)."""
         return neighborhood(model.grid, st.x, model.b_grid, self.bx)
 
     def guard_args(self, model: FluidModel) -> dict:

@@ -41,7 +41,7 @@ from cosim.fluid.boundary import VesselGeometry, VesselMotion
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
 from cosim.fluid.free_surface import FREE_AT_SURFACE, FREE_LIQUID_OFF, FREE_OUTSIDE_VESSELS, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
-from cosim.fluid.neighbors import Neighborhood, first_neighbor, next_neighbor
+from cosim.fluid.neighbors import COINCIDENT_R2, Neighborhood, neighbor_cells, reachable_cell, within_support
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
     add_wall_reaction,
@@ -49,12 +49,12 @@ from cosim.fluid.sph_common import (
     finish_particle,
     inside_any_vessel,
     kernel_gradient,
-    neighbor_mass,
     next_free_state,
-    pair_code,
     pair_wall,
     summation_term,
     viscous_pair,
+    wall_mass,
+    wall_pair,
 )
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -169,13 +169,29 @@ def update_free_liquid(
     surface = mode == FREE_AT_SURFACE or measure_surface != 0
     density = mass[i] * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     moment = wp.mat33(0.0)
-    walk = first_neighbor(nb, xi, prm.support)
-    while walk.index >= 0:
-        mj = neighbor_mass(prm, mass, b_volume, walk)
-        density += summation_term(prm, mj, walk)
-        if surface:
-            moment += renormalisation_term(mj / prm.rest_density, walk.r, kernel_gradient(prm, walk.r, walk.r2))
-        walk = next_neighbor(nb, walk)
+    radius2 = prm.support * prm.support
+    cells = neighbor_cells(nb.spec, xi)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, xi, radius2)
+        if cell < 0:
+            continue
+        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+            r = xi - nb.x[j]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                mj = mass[j]
+                density += summation_term(prm, mj, r2)
+                if surface:
+                    moment += renormalisation_term(mj / prm.rest_density, r, kernel_gradient(prm, r, r2))
+        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            b = nb.b_order[item]
+            r = xi - nb.bx[b]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                mb = wall_mass(prm, b_volume, b)
+                density += summation_term(prm, mb, r2)
+                if surface:
+                    moment += renormalisation_term(mb / prm.rest_density, r, kernel_gradient(prm, r, r2))
     density = density / prm.lattice_density
     lam = float(0.0)
     if surface:
@@ -265,34 +281,46 @@ def compute_forces(
     a = wp.vec3(0.0)
     moment = wp.mat33(0.0)
     gsum = wp.vec3(0.0)
-    walk = first_neighbor(nb, xi, prm.support)
-    while walk.index >= 0:
-        r = walk.r
-        r2 = walk.r2
-        gw = kernel_gradient(prm, r, r2)
-        if record_pairs != 0 and count < capacity:
-            pair_index[i, count] = pair_code(walk)
-            pair_grad[i, count] = gw
-        count += 1
-        mj = neighbor_mass(prm, mass, b_volume, walk)
-        if walk.wall == 0:
-            j = walk.index
-            vij = vi - v[j]
-            rhoj = rho[j]
-            vol = mj / rhoj
-            moment += renormalisation_term(vol, r, gw)
-            gsum += (vol * (rhoj - rhoi)) * gw
-            a -= mj * pressure_pair_factor(tic, own, rhoi, p[j], rhoj) * gw
-            alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
-            a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
-        else:
-            b = walk.index
-            rhob = b_rho[b]
-            ab = -(mj * pressure_pair_factor(tic, own_wall, rhoi, b_p[b], rhob)) * gw
-            ab += viscous_pair(prm, alpha_wall, mj, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
-            a += ab
-            add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
-        walk = next_neighbor(nb, walk)
+    radius2 = prm.support * prm.support
+    cells = neighbor_cells(nb.spec, xi)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, xi, radius2)
+        if cell < 0:
+            continue
+        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+            r = xi - nb.x[j]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                gw = kernel_gradient(prm, r, r2)
+                if record_pairs != 0 and count < capacity:
+                    pair_index[i, count] = j
+                    pair_grad[i, count] = gw
+                count += 1
+                mj = mass[j]
+                vij = vi - v[j]
+                rhoj = rho[j]
+                vol = mj / rhoj
+                moment += renormalisation_term(vol, r, gw)
+                gsum += (vol * (rhoj - rhoi)) * gw
+                a -= mj * pressure_pair_factor(tic, own, rhoi, p[j], rhoj) * gw
+                alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
+                a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
+        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            b = nb.b_order[item]
+            r = xi - nb.bx[b]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                gw = kernel_gradient(prm, r, r2)
+                if record_pairs != 0 and count < capacity:
+                    pair_index[i, count] = wall_pair(b)
+                    pair_grad[i, count] = gw
+                count += 1
+                mb = wall_mass(prm, b_volume, b)
+                rhob = b_rho[b]
+                ab = -(mb * pressure_pair_factor(tic, own_wall, rhoi, b_p[b], rhob)) * gw
+                ab += viscous_pair(prm, alpha_wall, mb, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
+                a += ab
+                add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     if record_pairs != 0:
@@ -409,16 +437,24 @@ def compute_density_rate_walking(
     grad_i = rho_grad[i]
     diffusion = prm.delta * prm.h * prm.sound_speed
     dr = float(0.0)
-    walk = first_neighbor(nb, xi, prm.support)
-    while walk.index >= 0:
-        gw = kernel_gradient(prm, walk.r, walk.r2)
-        if walk.wall == 0:
-            j = walk.index
-            dr = add_liquid_density_rate(prm, dr, diffusion, rhoi, grad_i, vi, walk.r, walk.r2, gw, v[j] + h * acc[j], rho[j], rho_grad[j], mass[j])
-        else:
-            b = walk.index
-            dr += wall_density_rate(prm, b_volume[b], vi, bv[b], gw)
-        walk = next_neighbor(nb, walk)
+    radius2 = prm.support * prm.support
+    cells = neighbor_cells(nb.spec, xi)
+    for k in range(cells.count):
+        cell = reachable_cell(nb, cells, k, xi, radius2)
+        if cell < 0:
+            continue
+        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+            r = xi - nb.x[j]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                gw = kernel_gradient(prm, r, r2)
+                dr = add_liquid_density_rate(prm, dr, diffusion, rhoi, grad_i, vi, r, r2, gw, v[j] + h * acc[j], rho[j], rho_grad[j], mass[j])
+        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            b = nb.b_order[item]
+            r = xi - nb.bx[b]
+            r2 = wp.dot(r, r)
+            if within_support(r2, radius2, COINCIDENT_R2):
+                dr += wall_density_rate(prm, b_volume[b], vi, bv[b], kernel_gradient(prm, r, r2))
     drho[i] = dr
 
 
