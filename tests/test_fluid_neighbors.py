@@ -1,7 +1,7 @@
-"""The neighbour loops every SPH sum writes (cosim.fluid.neighbors: neighbor_cells, reachable_cell, within_support,
-as the module's docstring spells them out) against a brute-force search: they find exactly the points within the
-radius, in the one order every SPH sum relies on (cell by cell in grid order, in each cell the liquid before the
-wall particles)."""
+"""The neighbour loops every SPH sum writes (cosim.fluid.neighbors: neighbor_cells, reachable_cell and the scans
+next_liquid_neighbor / next_wall_neighbor, as the module's docstring spells them out) against a brute-force
+search: they find exactly the points within the radius, in the one order every SPH sum relies on (cell by cell in
+grid order, in each cell the liquid before the wall particles)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import warp as wp
 
-from cosim.fluid.neighbors import COINCIDENT_R2, CellGrid, Neighborhood, neighbor_cells, neighborhood, reachable_cell, within_support
+from cosim.fluid.neighbors import COINCIDENT_R2, CellGrid, Neighborhood, neighbor_cells, neighborhood, next_liquid_neighbor, next_wall_neighbor, reachable_cell
 
 MAX_FOUND = 64
 DOMAIN = (0.0, 1.0)
@@ -40,16 +40,17 @@ def record_walk(nb: Neighborhood, radius: float, liquid_only: int, points: wp.ar
         cell = reachable_cell(nb, cells, k, x, radius2)
         if cell < 0:
             continue
-        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
-            r = x - nb.x[j]
-            if within_support(wp.dot(r, r), radius2, min_r2):
-                n = record(found, i, n, j)
+        liquid_end = nb.cell_end[cell]
+        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, x, radius2, min_r2)
+        while j < liquid_end:
+            n = record(found, i, n, j)
+            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, x, radius2, min_r2)
         if liquid_only == 0:
-            for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
-                b = nb.b_order[item]
-                r = x - nb.bx[b]
-                if within_support(wp.dot(r, r), radius2, min_r2):
-                    n = record(found, i, n, -1 - b)
+            wall_end = nb.b_cell_end[cell]
+            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, x, radius2, min_r2)
+            while item < wall_end:
+                n = record(found, i, n, -1 - nb.b_order[item])
+                item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, x, radius2, min_r2)
     found[i, 0] = n
 
 

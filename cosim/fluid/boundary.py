@@ -23,7 +23,7 @@ import warp as wp
 
 from cosim.fluid.lanes import item_kernel
 from cosim.fluid.mesh_boundary import SHAPE_MESH, mesh_guard, mesh_inside
-from cosim.fluid.neighbors import Neighborhood, neighbor_cells, reachable_cell, within_support
+from cosim.fluid.neighbors import Neighborhood, neighbor_cells, next_liquid_neighbor, reachable_cell
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -156,15 +156,17 @@ def extrapolate_wall_state(
         cell = reachable_cell(nb, cells, k, xb, radius2)
         if cell < 0:
             continue
-        for f in range(nb.cell_start[cell], nb.cell_end[cell]):  # the liquid only, however near
+        liquid_end = nb.cell_end[cell]  # the liquid only, however near
+        f = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xb, radius2, 0.0)
+        while f < liquid_end:
             r = xb - nb.x[f]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, 0.0):
-                w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                sum_w += w
-                sum_pw += p[f] * w
-                sum_rho_r += (rho[f] * w) * r
-                sum_v += w * v[f]
+            w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+            sum_w += w
+            sum_pw += p[f] * w
+            sum_rho_r += (rho[f] * w) * r
+            sum_v += w * v[f]
+            f = next_liquid_neighbor(nb.x, f + 1, liquid_end, xb, radius2, 0.0)
     pw = float(0.0)
     v_noslip = bv[b]
     if sum_w > 0.0:

@@ -94,7 +94,7 @@ from cosim.fluid.diagnostics import (
 )
 from cosim.fluid.free_surface import FREE_AT_SURFACE, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
-from cosim.fluid.neighbors import COINCIDENT_R2, GridSpec, Neighborhood, neighbor_cells, reachable_cell, within_support
+from cosim.fluid.neighbors import COINCIDENT_R2, GridSpec, Neighborhood, neighbor_cells, next_liquid_neighbor, next_wall_neighbor, reachable_cell
 from cosim.fluid.pair_slots import PairSlots, close_pair_row, open_pair_row
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
@@ -282,42 +282,46 @@ def compute_density_factor(
         cell = reachable_cell(nb, cells, k, xi, radius2)
         if cell < 0:
             continue
-        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+        liquid_end = nb.cell_end[cell]
+        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xi, radius2, COINCIDENT_R2)
+        while j < liquid_end:
             r = xi - nb.x[j]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                mj = mass[j]
-                density += summation_term(prm, mj, r2)
-                gw = kernel_gradient(prm, r, r2)
-                gm = mj * gw
-                if free_liquid == FREE_AT_SURFACE:
-                    moment += renormalisation_term(mj / prm.rest_density, r, gw)
-                grad_sum += gm
-                grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
-                if count < capacity:
-                    slot = first + count * pair_slots.step
-                    pair_index[slot] = j
-                    pair_grad[slot] = gw
-                    pair_mass_grad[slot] = gm
-                count += 1
-        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            mj = mass[j]
+            density += summation_term(prm, mj, r2)
+            gw = kernel_gradient(prm, r, r2)
+            gm = mj * gw
+            if free_liquid == FREE_AT_SURFACE:
+                moment += renormalisation_term(mj / prm.rest_density, r, gw)
+            grad_sum += gm
+            grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
+            if count < capacity:
+                slot = first + count * pair_slots.step
+                pair_index[slot] = j
+                pair_grad[slot] = gw
+                pair_mass_grad[slot] = gm
+            count += 1
+            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
+        wall_end = nb.b_cell_end[cell]
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        while item < wall_end:
             b = nb.b_order[item]
             r = xi - nb.bx[b]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                mb = wall_mass(prm, b_volume, b)
-                density += summation_term(prm, mb, r2)
-                gw = kernel_gradient(prm, r, r2)
-                gm = mb * gw
-                if free_liquid == FREE_AT_SURFACE:
-                    moment += renormalisation_term(mb / prm.rest_density, r, gw)
-                grad_sum += gm
-                if count < capacity:
-                    slot = first + count * pair_slots.step
-                    pair_index[slot] = wall_pair(b)
-                    pair_grad[slot] = gw
-                    pair_mass_grad[slot] = gm
-                count += 1
+            mb = wall_mass(prm, b_volume, b)
+            density += summation_term(prm, mb, r2)
+            gw = kernel_gradient(prm, r, r2)
+            gm = mb * gw
+            if free_liquid == FREE_AT_SURFACE:
+                moment += renormalisation_term(mb / prm.rest_density, r, gw)
+            grad_sum += gm
+            if count < capacity:
+                slot = first + count * pair_slots.step
+                pair_index[slot] = wall_pair(b)
+                pair_grad[slot] = gw
+                pair_mass_grad[slot] = gm
+            count += 1
+            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
@@ -582,24 +586,28 @@ def compute_wall_density_factor(
         cell = reachable_cell(nb, cells, k, xb, radius2)
         if cell < 0:
             continue
-        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+        liquid_end = nb.cell_end[cell]
+        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xb, radius2, COINCIDENT_R2)
+        while j < liquid_end:
             r = xb - nb.x[j]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                mj = mass[j]
-                density += summation_term(prm, mj, r2)
-                gw = kernel_gradient(prm, r, r2)
-                grad_sq += mj * mb * wp.dot(gw, gw)
-                if count < capacity:
-                    b_pair_index[first + count * b_pair_slots.step] = j
-                    b_pair_mass_grad[first + count * b_pair_slots.step] = mj * gw
-                count += 1
-        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            mj = mass[j]
+            density += summation_term(prm, mj, r2)
+            gw = kernel_gradient(prm, r, r2)
+            grad_sq += mj * mb * wp.dot(gw, gw)
+            if count < capacity:
+                b_pair_index[first + count * b_pair_slots.step] = j
+                b_pair_mass_grad[first + count * b_pair_slots.step] = mj * gw
+            count += 1
+            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xb, radius2, COINCIDENT_R2)
+        wall_end = nb.b_cell_end[cell]
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xb, radius2, COINCIDENT_R2)
+        while item < wall_end:
             other = nb.b_order[item]
             r = xb - nb.bx[other]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                density += summation_term(prm, wall_mass(prm, b_volume, other), r2)
+            density += summation_term(prm, wall_mass(prm, b_volume, other), r2)
+            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xb, radius2, COINCIDENT_R2)
     if count == 0:
         return
     if count > capacity:

@@ -20,24 +20,31 @@ Every SPH sum over neighbours walks the same cells in the same order, written ou
         cell = reachable_cell(nb, cells, k, xi, radius2)
         if cell < 0:
             continue
-        for j in range(nb.cell_start[cell], nb.cell_end[cell]):        # the liquid, in cell order
+        liquid_end = nb.cell_end[cell]                                  # the liquid, in cell order
+        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xi, radius2, COINCIDENT_R2)
+        while j < liquid_end:
             r = xi - nb.x[j]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                ...
-        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):  # then the cell's wall particles
-            b = nb.b_order[item]
-            r = xi - nb.bx[b]
             ...
+            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
+        wall_end = nb.b_cell_end[cell]                                  # then the cell's wall particles
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        while item < wall_end:
+            b = nb.b_order[item]
+            ...
+            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
 
-so every kernel adds its terms in one order (cell by cell, in each the liquid before the walls). Nested loops,
-not an iterator: on CUDA a walk kept in a struct and advanced by a function (in the manner of warp's
-``hash_grid_query_next``) made the same sums markedly slower than these loops (``python -m
-cosim.bench.kernel_profile``; the figures are in docs/benchmarks.md). The loop opens only the cells of the block whose box
-lies within the radius (:func:`reachable_cell`, :func:`cell_within_reach`): a support sphere reaches 20.6 of the
-27 cells on average in 3-D (1 + 6 + 12 pi/4 + 8 pi/6 for a point uniformly placed in its cell; 8.1 of 9 in 2-D),
-so in a uniform liquid 4.9 points are tested per neighbour instead of 6.5, and the neighbours and their order stay
-the same.
+(a body must not ``continue``: the loop advances at its end). So every kernel adds its terms in one order, cell
+by cell, in each the liquid before the walls. Each cell's candidates are scanned by a tight loop of their own
+(:func:`next_liquid_neighbor`; about four of five candidates lie outside the support) and the body runs only for
+a neighbour. Loops, not an iterator: on CUDA a walk kept in a struct and advanced by a function (in the manner of
+warp's ``hash_grid_query_next``) made the same sums markedly slower than plain nested loops; on the CPU a plain
+loop with the body inside the candidate loop was slower than the walk, which the separate scan avoids (``python -m
+cosim.bench.kernel_profile``; the figures are in docs/benchmarks.md). The loops open only the cells of the block
+whose box lies within the radius (:func:`reachable_cell`, :func:`cell_within_reach`): a support sphere reaches
+20.6 of the 27 cells on average in 3-D (1 + 6 + 12 pi/4 + 8 pi/6 for a point uniformly placed in its cell; 8.1 of
+9 in 2-D), so in a uniform liquid 4.9 points are tested per neighbour instead of 6.5, and the neighbours and their
+order stay the same.
 """
 
 from __future__ import annotations
@@ -184,6 +191,34 @@ def within_support(r2: float, radius2: float, min_r2: float) -> bool:
     """Whether a point at squared distance ``r2`` (m^2) is a neighbour: ``min_r2`` <= r2 < ``radius2``
     (:data:`COINCIDENT_R2` leaves the particle itself out; 0 counts every point however near)."""
     return not (r2 >= radius2 or r2 < min_r2)
+
+
+@wp.func
+def next_liquid_neighbor(points: wp.array(dtype=wp.vec3), item: int, end: int, x: wp.vec3, radius2: float, min_r2: float) -> int:
+    """The first of ``points`` (the liquid, ``Neighborhood.x``) from ``item`` on, before ``end`` (a cell's range of
+    it), that is a neighbour of ``x`` (:func:`within_support`); ``end`` where none is. The arrays, not the whole
+    :class:`Neighborhood`, are passed: a function call may copy its arguments."""
+    j = item
+    while j < end:
+        r = x - points[j]
+        if within_support(wp.dot(r, r), radius2, min_r2):
+            return j
+        j += 1
+    return end
+
+
+@wp.func
+def next_wall_neighbor(order: wp.array(dtype=wp.int32), points: wp.array(dtype=wp.vec3), item: int, end: int, x: wp.vec3, radius2: float, min_r2: float) -> int:
+    """The first item of ``order`` (``Neighborhood.b_order``) from ``item`` on, before ``end`` (a cell's range of it),
+    whose wall particle in ``points`` (``Neighborhood.bx``) is a neighbour of ``x`` (:func:`within_support`); ``end``
+    where none is."""
+    j = item
+    while j < end:
+        r = x - points[order[j]]
+        if within_support(wp.dot(r, r), radius2, min_r2):
+            return j
+        j += 1
+    return end
 
 
 @wp.kernel

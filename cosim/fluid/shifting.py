@@ -51,7 +51,7 @@ import warp as wp
 from cosim.fluid.config import FluidConfig, ParticleShifting, PressureSolver
 from cosim.fluid.free_surface import renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
-from cosim.fluid.neighbors import COINCIDENT_R2, Neighborhood, neighbor_cells, reachable_cell, within_support
+from cosim.fluid.neighbors import COINCIDENT_R2, Neighborhood, neighbor_cells, next_liquid_neighbor, next_wall_neighbor, reachable_cell
 from cosim.fluid.params import SPHParams
 from cosim.fluid.program import Recorder
 from cosim.fluid.sph_common import kernel_gradient, wall_mass
@@ -140,25 +140,29 @@ def measure_concentration(
         cell = reachable_cell(nb, cells, k, xi, radius2)
         if cell < 0:
             continue
-        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+        liquid_end = nb.cell_end[cell]
+        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xi, radius2, COINCIDENT_R2)
+        while j < liquid_end:
             r = xi - nb.x[j]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                volume = mass[j] / prm.rest_density
-                gw = kernel_gradient(prm, r, r2)
-                moment += renormalisation_term(volume, r, gw)
-                kernel_sum_grad += volume * gw
-                if correct_fields != 0:
-                    rho_sum += (rho[j] - rho[i]) * volume * gw
-                    p_sum += (p[j] - p[i]) * volume * gw
-                gradient += concentration_gradient_term(prm, w_spacing, volume, r2, gw)
-        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            volume = mass[j] / prm.rest_density
+            gw = kernel_gradient(prm, r, r2)
+            moment += renormalisation_term(volume, r, gw)
+            kernel_sum_grad += volume * gw
+            if correct_fields != 0:
+                rho_sum += (rho[j] - rho[i]) * volume * gw
+                p_sum += (p[j] - p[i]) * volume * gw
+            gradient += concentration_gradient_term(prm, w_spacing, volume, r2, gw)
+            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
+        wall_end = nb.b_cell_end[cell]
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        while item < wall_end:
             b = nb.b_order[item]
             r = xi - nb.bx[b]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                volume = wall_mass(prm, b_volume, b) / prm.rest_density
-                gradient += concentration_gradient_term(prm, w_spacing, volume, r2, kernel_gradient(prm, r, r2))
+            volume = wall_mass(prm, b_volume, b) / prm.rest_density
+            gradient += concentration_gradient_term(prm, w_spacing, volume, r2, kernel_gradient(prm, r, r2))
+            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
     lam = surface_indicator(prm.dim, moment)
     n = wp.vec3(0.0)
     if lam >= SURFACE_REGION:
@@ -204,10 +208,12 @@ def compute_shift(
         cell = reachable_cell(nb, cells, k, xi, radius2)
         if cell < 0:
             continue
-        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
-            r = xi - nb.x[j]
-            if within_support(wp.dot(r, r), radius2, COINCIDENT_R2) and indicator[j] < SURFACE_REGION:
+        liquid_end = nb.cell_end[cell]
+        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xi, radius2, COINCIDENT_R2)
+        while j < liquid_end:
+            if indicator[j] < SURFACE_REGION:
                 near_surface = True
+            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
     dr = -per_second * dt[0] * grad_c[i]
     if near_surface:
         n = normal[i]

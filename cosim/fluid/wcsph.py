@@ -41,7 +41,7 @@ from cosim.fluid.boundary import VesselGeometry, VesselMotion
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
 from cosim.fluid.free_surface import FREE_AT_SURFACE, FREE_LIQUID_OFF, FREE_OUTSIDE_VESSELS, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
-from cosim.fluid.neighbors import COINCIDENT_R2, Neighborhood, neighbor_cells, reachable_cell, within_support
+from cosim.fluid.neighbors import COINCIDENT_R2, Neighborhood, neighbor_cells, next_liquid_neighbor, next_wall_neighbor, reachable_cell
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
     add_wall_reaction,
@@ -175,23 +175,27 @@ def update_free_liquid(
         cell = reachable_cell(nb, cells, k, xi, radius2)
         if cell < 0:
             continue
-        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+        liquid_end = nb.cell_end[cell]
+        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xi, radius2, COINCIDENT_R2)
+        while j < liquid_end:
             r = xi - nb.x[j]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                mj = mass[j]
-                density += summation_term(prm, mj, r2)
-                if surface:
-                    moment += renormalisation_term(mj / prm.rest_density, r, kernel_gradient(prm, r, r2))
-        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            mj = mass[j]
+            density += summation_term(prm, mj, r2)
+            if surface:
+                moment += renormalisation_term(mj / prm.rest_density, r, kernel_gradient(prm, r, r2))
+            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
+        wall_end = nb.b_cell_end[cell]
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        while item < wall_end:
             b = nb.b_order[item]
             r = xi - nb.bx[b]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                mb = wall_mass(prm, b_volume, b)
-                density += summation_term(prm, mb, r2)
-                if surface:
-                    moment += renormalisation_term(mb / prm.rest_density, r, kernel_gradient(prm, r, r2))
+            mb = wall_mass(prm, b_volume, b)
+            density += summation_term(prm, mb, r2)
+            if surface:
+                moment += renormalisation_term(mb / prm.rest_density, r, kernel_gradient(prm, r, r2))
+            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
     density = density / prm.lattice_density
     lam = float(0.0)
     if surface:
@@ -287,40 +291,44 @@ def compute_forces(
         cell = reachable_cell(nb, cells, k, xi, radius2)
         if cell < 0:
             continue
-        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+        liquid_end = nb.cell_end[cell]
+        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xi, radius2, COINCIDENT_R2)
+        while j < liquid_end:
             r = xi - nb.x[j]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                gw = kernel_gradient(prm, r, r2)
-                if record_pairs != 0 and count < capacity:
-                    pair_index[i, count] = j
-                    pair_grad[i, count] = gw
-                count += 1
-                mj = mass[j]
-                vij = vi - v[j]
-                rhoj = rho[j]
-                vol = mj / rhoj
-                moment += renormalisation_term(vol, r, gw)
-                gsum += (vol * (rhoj - rhoi)) * gw
-                a -= mj * pressure_pair_factor(tic, own, rhoi, p[j], rhoj) * gw
-                alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
-                a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
-        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            gw = kernel_gradient(prm, r, r2)
+            if record_pairs != 0 and count < capacity:
+                pair_index[i, count] = j
+                pair_grad[i, count] = gw
+            count += 1
+            mj = mass[j]
+            vij = vi - v[j]
+            rhoj = rho[j]
+            vol = mj / rhoj
+            moment += renormalisation_term(vol, r, gw)
+            gsum += (vol * (rhoj - rhoi)) * gw
+            a -= mj * pressure_pair_factor(tic, own, rhoi, p[j], rhoj) * gw
+            alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
+            a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
+            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
+        wall_end = nb.b_cell_end[cell]
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        while item < wall_end:
             b = nb.b_order[item]
             r = xi - nb.bx[b]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                gw = kernel_gradient(prm, r, r2)
-                if record_pairs != 0 and count < capacity:
-                    pair_index[i, count] = wall_pair(b)
-                    pair_grad[i, count] = gw
-                count += 1
-                mb = wall_mass(prm, b_volume, b)
-                rhob = b_rho[b]
-                ab = -(mb * pressure_pair_factor(tic, own_wall, rhoi, b_p[b], rhob)) * gw
-                ab += viscous_pair(prm, alpha_wall, mb, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
-                a += ab
-                add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
+            gw = kernel_gradient(prm, r, r2)
+            if record_pairs != 0 and count < capacity:
+                pair_index[i, count] = wall_pair(b)
+                pair_grad[i, count] = gw
+            count += 1
+            mb = wall_mass(prm, b_volume, b)
+            rhob = b_rho[b]
+            ab = -(mb * pressure_pair_factor(tic, own_wall, rhoi, b_p[b], rhob)) * gw
+            ab += viscous_pair(prm, alpha_wall, mb, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
+            a += ab
+            add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
+            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     if record_pairs != 0:
@@ -443,18 +451,22 @@ def compute_density_rate_walking(
         cell = reachable_cell(nb, cells, k, xi, radius2)
         if cell < 0:
             continue
-        for j in range(nb.cell_start[cell], nb.cell_end[cell]):
+        liquid_end = nb.cell_end[cell]
+        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xi, radius2, COINCIDENT_R2)
+        while j < liquid_end:
             r = xi - nb.x[j]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                gw = kernel_gradient(prm, r, r2)
-                dr = add_liquid_density_rate(prm, dr, diffusion, rhoi, grad_i, vi, r, r2, gw, v[j] + h * acc[j], rho[j], rho_grad[j], mass[j])
-        for item in range(nb.b_cell_start[cell], nb.b_cell_end[cell]):
+            gw = kernel_gradient(prm, r, r2)
+            dr = add_liquid_density_rate(prm, dr, diffusion, rhoi, grad_i, vi, r, r2, gw, v[j] + h * acc[j], rho[j], rho_grad[j], mass[j])
+            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
+        wall_end = nb.b_cell_end[cell]
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        while item < wall_end:
             b = nb.b_order[item]
             r = xi - nb.bx[b]
             r2 = wp.dot(r, r)
-            if within_support(r2, radius2, COINCIDENT_R2):
-                dr += wall_density_rate(prm, b_volume[b], vi, bv[b], kernel_gradient(prm, r, r2))
+            dr += wall_density_rate(prm, b_volume[b], vi, bv[b], kernel_gradient(prm, r, r2))
+            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
     drho[i] = dr
 
 
