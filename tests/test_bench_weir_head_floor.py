@@ -24,15 +24,17 @@ def test_the_floor_is_the_smallest_head_from_which_on_every_head_passes() -> Non
 
 def test_the_heads_are_checked_against_the_weirs_own_range() -> None:
     assert study.parse_spacings("4,2.5,2.5") == [2.5, 4.0]
-    for bad in ("", "x", "1", "2,30"):
-        with pytest.raises(InputError, match=r"^--spacings: .*\[1\.5, 20\]"):
+    assert study.parse_spacings("1") == [1.0]  # the 3-D pour's floor, one row of particles over the crest
+    for bad in ("", "x", "0.5", "2,30"):
+        with pytest.raises(InputError, match=r"^--spacings: .*\[1, 20\]"):
             study.parse_spacings(bad)
-    with pytest.raises(InputError, match=r"^spacing: .* needs >= 1\.5"):
-        weir.Params(head=0.01, spacing=0.008)
+    with pytest.raises(InputError, match=r"^spacing: .* needs >= 1$"):
+        weir.Params(head=0.007, spacing=0.008)
 
 
 @pytest.mark.parametrize("argv, field", [(["--across", "4"], "--across"), (["--duration", "0"], "--duration"),
-                                          (["--spacings", "1,2"], "--spacings")])
+                                          (["--spacings", "0.5,2"], "--spacings"), (["--dim", "4"], "--dim"),
+                                          (["--dim", "3", "--depth", "0.01"], "--depth")])
 def test_bad_input_is_one_line_and_exit_status_2(argv, field, capsys) -> None:
     assert study.main(argv) == 2
     err = capsys.readouterr().err

@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from cosim.errors import InputError
+from cosim.fluid.seeding import liquid_block
 from cosim.validation import weir
+from cosim.validation.common import case_fluid_config
 
 # The coarse run: 5 particles across the 40 mm head (dx = 8 mm), about 1000 particles. The resolution study in
 # docs/outflow_validation.md gives C_d / Rehbock = 1.030 at this resolution, 1.037 at 7 and 1.035 at 10 across
@@ -53,8 +55,61 @@ def test_under_real_thickness_walls_the_weir_is_real_and_the_piston_covers_the_s
     assert result.raw["steps"] > 0 and result.raw["head"] == pytest.approx(0.04, rel=0.1)
 
 
-@pytest.mark.parametrize("kwargs, field", [({"dim": 3}, "dim"), ({"window": 2.0}, "window"), ({"head": 0.5}, "head"),
-                                           ({"spacing": 0.03}, "spacing")])
+def test_in_3d_the_piston_plate_spans_the_channel_between_its_side_walls() -> None:
+    p = weir.Params(dim=3, spacing=0.006, depth=0.1)
+    thickness = 0.018
+    ch = weir.Channel(p, p.resolved_spacing, 0.018, thickness)
+    assert ch.depth == pytest.approx(0.102)  # whole spacings: 17 x 6 mm
+    assert ch.tank().inner_depth == ch.depth
+    assert ch.piston().inner_depth + 2 * thickness == pytest.approx(ch.depth)  # the plate: wall to wall
+    with pytest.raises(InputError, match=r"^depth: .*>= 0\.042 m at spacing 0\.006 m, got 0\.03$"):
+        weir.Params(dim=3, spacing=0.006, depth=0.03)  # the piston's walls, 3 spacings each, and one spacing
+
+
+def test_in_3d_side_plates_above_the_crest_keep_the_liquid_in_the_channel() -> None:
+    """The channel's own walls stand only as high as its weir: above them, a plate on each side wall's inner face up to
+    the piston plate's top, from the channel's upstream end to the domain's downstream end; none in 2-D."""
+    assert weir.Channel(weir.Params(), 0.004, 0.012, 0.012).side_plates() == []
+    p = weir.Params(dim=3, spacing=0.006, depth=0.1)
+    t = 0.018
+    ch = weir.Channel(p, p.resolved_spacing, 0.018, t)
+    plates = ch.side_plates()
+    assert len(plates) == 2
+    for (spec, pose), side in zip(plates, (-1.0, 1.0)):
+        u, v = 0.5 * spec.inner_width + t, 0.5 * spec.inner_depth + t
+        face = pose.transform(np.array([[x, y, -t] for x in (-u, u) for y in (-v, v)]))  # the plate's outer face
+        assert face[:, 1] == pytest.approx(np.full(4, side * 0.5 * ch.depth))
+        assert face[:, 2].min() == pytest.approx(p.crest_height) and face[:, 2].max() == pytest.approx(ch.plate) == pytest.approx(ch.top)
+        assert face[:, 0].min() == pytest.approx(-ch.length - 0.018) and face[:, 0].max() == pytest.approx(0.018 + weir.DOMAIN_MARGIN)
+        walls = pose.transform(np.array([[0.0, 0.0, spec.inner_height]]))  # its walls trail outward
+        assert side * walls[0, 1] > 0.5 * ch.depth + t
+    low = weir.Channel(weir.Params(dim=3, spacing=0.006, depth=0.1, head=0.006), 0.006, 0.018, t)  # 4 H0 < 3 t
+    assert low.side_height == pytest.approx(3 * t) and low.top == pytest.approx(0.08 + 3 * t) and low.top > low.plate
+    assert [spec.inner_depth for spec, _ in low.side_plates()] == pytest.approx([t, t])
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_a_level_seeded_channel_reads_its_nominal_head(dim) -> None:
+    """The head from the liquid's section area in the strip: dx^2 a particle in 2-D, dx^3 / width in 3-D."""
+    p = weir.Params(dim=dim, head=0.03, crest_height=0.06, spacing=0.006, depth=0.05)
+    dx = p.resolved_spacing
+    ch = weir.Channel(p, dx, 0.018, 0.018)
+    cfg = case_fluid_config(dim, dx, p.crest_height + p.head, ch.depth, (-1, -1, -1), (1, 1, 1))
+    block = liquid_block((ch.piston_face, -0.5 * ch.depth, 0.0), (0.0, 0.5 * ch.depth, p.crest_height + p.head), cfg)
+    head, surface_head = ch.heads_at_station(block.positions, np.ones(len(block), bool))
+    assert head == pytest.approx(p.head, abs=1e-9) and surface_head == pytest.approx(p.head, abs=1e-9)
+    assert ch.passed_area(block.positions, np.zeros(len(block), bool)) == pytest.approx(-ch.piston_face * (p.crest_height + p.head), rel=0.02)
+
+
+def test_a_short_3d_run_flows_over_the_weir() -> None:
+    result = weir.run(weir.Params(head=0.024, spacing=0.008, dim=3, depth=0.056, solver="dfsph", duration=0.1, window=0.05))
+    assert result.parameters["dim"] == 3 and result.parameters["depth"] == pytest.approx(0.056)
+    assert result.raw["steps"] > 0 and result.raw["head"] == pytest.approx(0.024, rel=0.15)
+    assert result.raw["discharge"] > 0.0
+
+
+@pytest.mark.parametrize("kwargs, field", [({"depth": 0.0}, "depth"), ({"window": 2.0}, "window"), ({"head": 0.5}, "head"),
+                                           ({"spacing": 0.05}, "spacing")])
 def test_bad_input_names_the_field(kwargs, field) -> None:
     with pytest.raises(InputError, match=rf"^{field}: "):
         weir.Params(**kwargs)

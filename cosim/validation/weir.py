@@ -1,21 +1,23 @@
 """Outflow over a sharp-crested weir: the SPH discharge coefficient against Rehbock's.
 
-A 2-D channel (a box vessel, inner floor at z = 0) ends at its +x wall, the weir, whose crest stands P above the
-floor. A piston, a second box vessel turned on its side so that its floor is a vertical plate across the whole
-liquid depth, pushes the liquid toward the weir at the constant speed U, so that in steady flow the discharge per
-unit width is q = U D, D being the depth at the piston. The liquid starts level at P + H0 (the nominal head H0 over
-the crest), moving at U with the piston; U is Rehbock's discharge at H0 over that depth, so the head the flow
-settles at is the liquid's own answer.
+A channel (a box vessel, inner floor at z = 0) ends at its +x wall, the weir, whose crest stands P above the
+floor: 2-D in the pour plane, or 3-D between side walls ``depth`` apart (whole spacings; the weir spans the channel's
+width, a suppressed weir as in Rehbock's flume). A piston, a second box vessel turned on its side so that its floor
+is a vertical plate across the whole liquid depth, pushes the liquid toward the weir at the constant speed U, so
+that in steady flow the discharge per unit width is q = U D, D being the depth at the piston. The liquid starts
+level at P + H0 (the nominal head H0 over the crest), moving at U with the piston; U is Rehbock's discharge at H0
+over that depth, so the head the flow settles at is the liquid's own answer.
 
-Over the last ``window`` s of the run the discharge q (m^2/s: the slope of the liquid area that has passed the
-weir's upstream face, the area of a 2-D particle being dx^2) and the head H (m: the liquid's level above the crest
-in a strip centred 4 H0 upstream of the weir, where the surface is level, from the liquid area in the strip) give
-the coefficient of the weir law
+Over the last ``window`` s of the run the discharge per unit width q (m^2/s: the slope of the liquid's section area
+that has passed the weir's upstream face, a particle's share of it being dx^2 in 2-D and dx^3 / depth in 3-D) and
+the head H (m: the liquid's level above the crest in a strip centred 4 H0 upstream of the weir, where the surface is
+level, from the liquid's section area in the strip) give the coefficient of the weir law
 
     q = (2/3) C_d sqrt(2 g) H^(3/2)        (H^(3/2) averaged over the window),
 
 compared with Rehbock's C_d = 0.611 + 0.08 H / P (Rehbock 1929, as given by Henderson, "Open Channel Flow", 1966,
-Sec. 6.8), valid for a fully ventilated nappe, which the 2-D liquid has: nothing fills the space under it.
+Sec. 6.8), valid for a fully ventilated nappe, which the liquid has: nothing fills the space under it (no air is
+modelled). In 3-D plates on the side walls above the crest keep the nappe between walls, as a flume does.
 
 The crest is the top of the weir's dummy-particle layers: flat, ceil(2h/dx) spacings thick (3 dx at the default
 h = 1.5 dx; the vessel's own 5 mm under ``wall_model = "real_thickness"``). A crest acts as a sharp one while the
@@ -49,15 +51,15 @@ from declared_settings.setting import documented, setting
 COEFFICIENT_TOLERANCE = 0.05
 HEADS = (0.04, 0.025)  # m, the nominal heads the validation runs (H / P = 0.5 and 0.31 at P = 0.08 m)
 HEAD_SPACINGS = 10  # default resolution: particles across the nominal head
-# The fewest particle spacings across the nominal head a run is built with: below about 1.5 the flow over the crest
-# is a row of particles, not a nappe (the head-floor study, cosim.bench.weir_head_floor, reaches down to it).
-MIN_HEAD_SPACINGS = 1.5
+# The fewest particle spacings across the nominal head a run is built with: one row of particles over the crest, which
+# the head-floor study (cosim.bench.weir_head_floor) reaches down to; below it no particle row is over the crest.
+MIN_HEAD_SPACINGS = 1.0
 STATION_HEADS = 4.0  # the head is measured this many nominal heads upstream of the weir
 STATION_SPACINGS = 10  # width of the head's strip, particle spacings
 PISTON_CLEARANCE_HEADS = 3.0  # the piston stays this many nominal heads behind the strip
 SAMPLE_INTERVAL = 0.01  # s
+DOMAIN_MARGIN = 0.05  # m, the domain past the channel's walls (downstream: where the nappe leaves it, counted as passed)
 WEIR_FACTOR = (2.0 / 3.0) * math.sqrt(2.0 * GRAVITY)  # m^(1/2)/s: q / (C_d H^(3/2))
-DEPTH = 0.1  # m, out-of-plane scale of the 2-D liquid (cancels in q per unit width)
 
 
 def rehbock(head: float, crest_height: float) -> float:
@@ -81,11 +83,16 @@ class Params(FluidCaseParams):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        if self.dim != 2:
-            raise InputError("dim: the weir case runs in 2-D only (the pour plane); choose 2")
         if self.head / self.resolved_spacing < MIN_HEAD_SPACINGS - 1e-9:
             raise InputError(f"spacing: {self.resolved_spacing:g} m gives {self.head / self.resolved_spacing:.1f} particles across "
                              f"the {self.head:g} m head; needs >= {MIN_HEAD_SPACINGS:g}")
+        if self.dim == 3:
+            dx = self.resolved_spacing
+            narrowest = 2.0 * piston_thickness(case_fluid_config(3, dx, self.crest_height, self.depth, (-1, -1, -1), (1, 1, 1),
+                                                                 self.solver, numerics=self.numerics)) + dx
+            if self.tank_depth(dx) < narrowest - 1e-9:
+                raise InputError(f"depth: the 3-D channel's width must hold its piston's two side walls and a spacing, "
+                                 f">= {narrowest:.4g} m at spacing {dx:g} m, got {self.depth:g}")
 
     @property
     def resolved_spacing(self) -> float:
@@ -110,10 +117,15 @@ def piston_thickness(cfg: FluidConfig) -> float:
 
 class Channel:
     """The channel, its piston and where things are measured (world frame, m; the weir's upstream face at x = 0).
-    ``wall_thickness``: the channel's walls the liquid sees (the weir plate's); ``piston_wall``: the piston's."""
+    ``wall_thickness``: the channel's walls the liquid sees (the weir plate's); ``piston_wall``: the piston's;
+    the channel's width across the flow is ``p.tank_depth(dx)`` (3-D; in 2-D the liquid's out-of-plane scale, which
+    cancels in q per unit width)."""
 
     def __init__(self, p: Params, dx: float, wall_thickness: float, piston_wall: float) -> None:
         self.dx, self.crest, self.head, self.thickness, self.piston_wall = dx, p.crest_height, p.head, wall_thickness, piston_wall
+        self.dim, self.depth = p.dim, p.tank_depth(dx)
+        # m^2, a particle's share of the liquid's section in the x-z plane (per unit width across the flow)
+        self.cell = dx**2 if p.dim == 2 else dx**3 / self.depth
         self.speed = piston_speed(p.head, p.crest_height)
         self.station = -STATION_HEADS * p.head
         self.strip = STATION_SPACINGS * dx
@@ -123,15 +135,47 @@ class Channel:
         self.plate = p.crest_height + 4.0 * p.head  # m, the piston plate's height above the floor
 
     def tank(self) -> VesselSpec:
-        return VesselSpec(name="channel", inner_width=self.length, inner_depth=DEPTH, inner_height=self.crest)
+        return VesselSpec(name="channel", inner_width=self.length, inner_depth=self.depth, inner_height=self.crest)
 
     def piston(self) -> VesselSpec:
-        """A box whose floor (spanning its inner width plus the walls) is the plate; its walls trail behind."""
+        """A box whose floor (spanning its inner size plus the walls) is the plate; its walls trail behind. In 3-D the
+        plate spans the channel's width between its side walls, the piston's own side walls trailing inside them (a
+        plate reaching into the channel's walls would double the wall the liquid in its corners sees)."""
         t = self.piston_wall
-        return VesselSpec(name="piston", inner_width=self.plate - 2.0 * t, inner_depth=DEPTH, inner_height=4.0 * t, wall_thickness=t)
+        across = self.depth if self.dim == 2 else self.depth - 2.0 * t
+        return VesselSpec(name="piston", inner_width=self.plate - 2.0 * t, inner_depth=across, inner_height=4.0 * t, wall_thickness=t)
 
     def tank_pose(self) -> Pose:
         return Pose((-0.5 * self.length, 0.0, 0.0))
+
+    @property
+    def side_height(self) -> float:
+        """m, the side plates' height above the crest: up to the piston plate's top, at least three of their walls'
+        thickness (a box's floor spans its inner size and two walls)."""
+        return max(self.plate - self.crest, 3.0 * self.piston_wall)
+
+    @property
+    def top(self) -> float:
+        """m, the highest wall above the floor: the piston plate's, or in 3-D the side plates' top."""
+        return self.plate if self.dim == 2 else max(self.plate, self.crest + self.side_height)
+
+    def side_plates(self) -> list[tuple[VesselSpec, Pose]]:
+        """3-D: the flume's side walls above the crest (the channel's own stand only as high as its weir), from the
+        channel's upstream end to the domain's downstream end and :attr:`side_height` high, so that the liquid
+        leaves over the weir alone and its nappe stays between side walls, a suppressed weir's. Each is a box turned
+        on its side whose floor, the plate, stands on the channel's side wall with its outer face on the wall's inner
+        face, its walls trailing outward. None in 2-D."""
+        if self.dim == 2:
+            return []
+        t = self.piston_wall
+        x0, x1 = -self.length - self.thickness, self.thickness + DOMAIN_MARGIN
+        height = self.side_height
+        spec = VesselSpec(name="side", inner_width=x1 - x0 - 2.0 * t, inner_depth=height - 2.0 * t, inner_height=t, wall_thickness=t)
+        plates = []
+        for sign in (-1.0, 1.0):  # the side at y < 0, then at y > 0; the plate's local +z (its walls) points outward
+            turned = np.column_stack([(1.0, 0.0, 0.0), (0.0, 0.0, -sign), (0.0, sign, 0.0)])
+            plates.append((spec, Pose((0.5 * (x0 + x1), sign * (0.5 * self.depth + t), self.crest + 0.5 * height), turned)))
+        return plates
 
     def piston_pose(self, t: float) -> Pose:
         """The piston's vessel frame turned -90 deg about y (its +z pointing to -x, its +x up): the floor's outer
@@ -140,42 +184,53 @@ class Channel:
         return Pose((self.piston_face - self.piston_wall + self.speed * t, 0.0, 0.5 * self.plate), turned)
 
     def heads_at_station(self, x: np.ndarray, active: np.ndarray) -> tuple[float, float]:
-        """m, the level above the crest in the strip, twice: from the liquid area in the strip over its width (the
-        measured head), and from the free surface, the top particle of each column dx wide plus dx/2, averaged over
-        the columns (a check: where the flowing particles have left their lattice, a column without a top-row
-        particle reports the row below, so this one reads low by a fraction of dx)."""
+        """m, the level above the crest in the strip, twice: from the liquid's section area in the strip over its
+        width (the measured head), and from the free surface, the top particle of each column dx wide (dx by dx in
+        3-D) plus dx/2, averaged over the columns (a check: where the flowing particles have left their lattice, a
+        column without a top-row particle reports the row below, so this one reads low by a fraction of dx)."""
         inside = active & (np.abs(x[:, 0] - self.station) < 0.5 * self.strip)
+        columns_x = int(round(self.strip / self.dx)) + 1
         column = np.floor((x[inside, 0] - self.station + 0.5 * self.strip) / self.dx).astype(int)
-        top = np.full(int(round(self.strip / self.dx)) + 1, -np.inf)
+        if self.dim == 3:
+            across = int(round(self.depth / self.dx)) + 1
+            row = np.clip(np.floor((x[inside, 1] + 0.5 * self.depth) / self.dx).astype(int), 0, across - 1)
+            column, columns_x = column * across + row, columns_x * across
+        top = np.full(columns_x, -np.inf)
         np.maximum.at(top, column, x[inside, 2])
         surface = float(np.mean(top[np.isfinite(top)])) + 0.5 * self.dx if inside.any() else 0.0
-        return float(inside.sum()) * self.dx**2 / self.strip - self.crest, surface - self.crest
+        return float(inside.sum()) * self.cell / self.strip - self.crest, surface - self.crest
 
     def passed_area(self, x: np.ndarray, active: np.ndarray) -> float:
-        """m^2, liquid area that has passed the weir's upstream face (still beyond it, or gone from the domain)."""
-        return float(((~active) | (x[:, 0] > 0.0)).sum()) * self.dx**2
+        """m^2, the liquid's section area (per unit width) that has passed the weir's upstream face (still beyond it,
+        or gone from the domain)."""
+        return float(((~active) | (x[:, 0] > 0.0)).sum()) * self.cell
 
 
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
     # the kernel's support and the wall model (the domain does not matter to them) set the dummy layers, and so the
     # channel's layout
-    layout = case_fluid_config(2, dx, p.crest_height + p.head, DEPTH, (-1, -1, -1), (1, 1, 1), p.solver, numerics=p.numerics)
+    depth = p.tank_depth(dx)
+    layout = case_fluid_config(p.dim, dx, p.crest_height + p.head, depth, (-1, -1, -1), (1, 1, 1), p.solver, numerics=p.numerics)
     thickness = numerical_wall_thickness(VesselSpec(), layout)  # the channel's walls the liquid sees
     ch = Channel(p, dx, thickness, piston_thickness(layout))
-    margin = 0.05  # m
+    margin = DOMAIN_MARGIN
+    # m, the domain's half extent across the flow: in 3-D past the side plates' trailing walls
+    side = depth if p.dim == 2 else 0.5 * depth + max(thickness, 3.0 * ch.piston_wall) + margin
     cfg = case_fluid_config(
-        2, dx, p.crest_height + p.head, DEPTH,
-        (-ch.length - thickness - margin, -DEPTH, -margin), (thickness + margin, DEPTH, ch.plate + margin), p.solver, numerics=p.numerics,
+        p.dim, dx, p.crest_height + p.head, depth,
+        (-ch.length - thickness - margin, -side, -margin), (thickness + margin, side, ch.top + margin), p.solver, numerics=p.numerics,
     )
-    block = liquid_block((ch.piston_face, -0.5 * DEPTH, 0.0), (0.0, 0.5 * DEPTH, p.crest_height + p.head), cfg)
+    block = liquid_block((ch.piston_face, -0.5 * depth, 0.0), (0.0, 0.5 * depth, p.crest_height + p.head), cfg)
     moving = ParticleSet(block.positions, np.tile([ch.speed, 0.0, 0.0], (len(block), 1)), block.densities)
     # the liquid starts moving with the piston, above the crest: nothing holds it for a relaxed start
-    solver = FluidSolver(cfg, [ch.tank(), ch.piston()], [ch.tank_pose(), ch.piston_pose(0.0)], moving, device=p.device, relax_start=False)
+    plates = ch.side_plates()
+    solver = FluidSolver(cfg, [ch.tank(), ch.piston(), *(spec for spec, _ in plates)],
+                         [ch.tank_pose(), ch.piston_pose(0.0), *(pose for _, pose in plates)], moving, device=p.device, relax_start=False)
     t, passed, heads, surface_heads = [0.0], [0.0], [p.head], [p.head]
     start = time.perf_counter()
     while solver.time < p.duration - 1e-9:
-        solver.set_vessel_poses([ch.tank_pose(), ch.piston_pose(solver.time + SAMPLE_INTERVAL)])
+        solver.set_vessel_poses([ch.tank_pose(), ch.piston_pose(solver.time + SAMPLE_INTERVAL), *(pose for _, pose in plates)])
         solver.advance(SAMPLE_INTERVAL)
         x, active = solver.positions(), solver.active_mask()
         t.append(solver.time)
@@ -216,14 +271,14 @@ def run(p: Params) -> CaseResult:
         "particles": solver.n_particles,
         "steps": solver.step_count,
     }
-    params = dict(head=p.head, crest_height=p.crest_height, spacing=dx, dim=2, device=p.device, solver=p.solver.value,
-                  duration=p.duration, window=p.window)
+    params = dict(head=p.head, crest_height=p.crest_height, spacing=dx, dim=p.dim, device=p.device, solver=p.solver.value,
+                  duration=p.duration, window=p.window, **({"depth": depth} if p.dim == 3 else {}))
     return CaseResult("outflow", params, metrics, raw, wall_time)
 
 
 def plot(result: CaseResult, path) -> None:
     r = result.raw
-    fig, ax, plt = new_figure(f"Weir (2-D, P = {result.parameters['crest_height']:g} m): discharge coefficient, "
+    fig, ax, plt = new_figure(f"Weir ({result.parameters['dim']}-D, P = {result.parameters['crest_height']:g} m): discharge coefficient, "
                               f"H0 = {1e3 * result.parameters['head']:g} mm")
     t, passed, heads = (np.asarray(r[k]) for k in ("t", "passed_area", "head_series"))
     k = max(1, round(0.1 / SAMPLE_INTERVAL))  # 0.1 s differences
