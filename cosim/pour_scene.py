@@ -146,13 +146,13 @@ class CatcherSettings:
         check_settings(self, "controller.catcher")
 
 
-# The CFS head's floor in particle spacings, by dimension (ControllerSettings.stream_particles not set). In 2-D the
-# smallest head (on a half-spacing grid) the liquid resolves as a flow over a crest: the weir case's discharge
-# coefficient within its 5 % of Rehbock's at every resolution studied (python -m cosim.bench.weir_head_floor;
-# docs/outflow_validation.md has the table). In 3-D the sheet leaving the lip spreads sideways under its head once the side walls
-# end (no surface tension draws it in), past the catcher's depth, and spills the more the higher the head: one
-# spacing, chosen on the 3-D pour's spill (docs/physics-and-validation.md has the sweep; the weir case is 2-D only).
-STREAM_PARTICLES = {2: 3.0, 3: 1.0}
+# The CFS head's floor in particle spacings, by dimension (ControllerSettings.stream_particles not set): the smallest
+# head (on a half-spacing grid) the liquid resolves as a flow over a crest, the weir case's discharge coefficient
+# within its 5 % of Rehbock's from that head on (python -m cosim.bench.weir_head_floor [--dim 3];
+# docs/outflow_validation.md has the tables). 2-D: at every resolution studied (24, 32, 48 across). 3-D: at the 3-D
+# pour's 32 across, in a channel as wide as the default pourer is deep (0.10 m), whose side walls cost the flow about
+# a point of C_d against a channel twice as wide.
+STREAM_PARTICLES = {2: 3.0, 3: 3.5}
 
 
 @documented
@@ -171,8 +171,8 @@ class ControllerSettings:
         None, POUR, "The CFS liquid height over the crest is at least this many particle spacings, so that the "
         "stream is resolved (the paper holds it near the smoothing length), up to cfs.h_q_ref's limit; a partial "
         "pour's final stage holds cfs.final_head_fraction of it.", "", 0.0, 10.0,
-        none_means=f"{STREAM_PARTICLES[2]:g} in 2-D, {STREAM_PARTICLES[3]:g} in 3-D (a 3-D sheet spreads sideways off "
-        "the lip under its head)")
+        none_means=f"{STREAM_PARTICLES[2]:g} in 2-D, {STREAM_PARTICLES[3]:g} in 3-D (the smallest heads the weir case "
+        "resolves, docs/outflow_validation.md)")
     sim: SimConfig = field(default_factory=SimConfig)
     approach: ApproachConfig = field(default_factory=ApproachConfig)
     cfs: CfsConfig = field(default_factory=CfsConfig)

@@ -261,7 +261,7 @@ def test_a_section_changes_only_its_own_keys_of_the_scene_default(tmp_path, toml
     "toml, dim, across, head_in_spacings",
     [
         ("", 2, 32, 3.0),  # the default scene: 3 dx = 17.9 mm, over the 5 mm of Camporredondo et al. (2019)
-        ("[fluid]\ndim = 3\nparticles_across = 16\n", 3, 16, 1.0),  # 3-D: one spacing, 11.9 mm
+        ("[fluid]\ndim = 3\n", 3, 32, 3.5),  # 3-D: 3.5 spacings, 20.9 mm
         ("[fluid]\ndim = 3\nparticles_across = 16\n[controller]\nstream_particles = 2.5\n", 3, 16, 2.5),
         ("[controller]\nstream_particles = 1.5\n", 2, 32, 1.5),
     ],
@@ -275,7 +275,7 @@ def test_cfs_head_floor_is_stream_particles_spacings_by_dimension_unless_set(tmp
     spacing = 0.191 / across  # the default pourer's inner width over the particles across
     assert scene.fluid.dim == dim
     assert cfs_head_reference(scene, spacing) == pytest.approx(head_in_spacings * spacing, rel=1e-12)
-    fine = 0.191 / 120  # a fine liquid: the paper's h_q_ref (5 mm) is the larger
+    fine = 0.191 / 150  # a fine liquid (1.27 mm): the paper's h_q_ref (5 mm) is the larger
     assert cfs_head_reference(scene, fine) == scene.controller.cfs.h_q_ref == 0.005
 
 
