@@ -34,7 +34,8 @@ def test_the_heads_are_checked_against_the_weirs_own_range() -> None:
 
 @pytest.mark.parametrize("argv, field", [(["--across", "4"], "--across"), (["--duration", "0"], "--duration"),
                                           (["--spacings", "0.5,2"], "--spacings"), (["--dim", "4"], "--dim"),
-                                          (["--dim", "3", "--depth", "0.01"], "--depth")])
+                                          (["--dim", "3", "--depth", "0.01"], "depth"),
+                                          (["--dim", "3", "--depth", "0.035"], "depth")])
 def test_bad_input_is_one_line_and_exit_status_2(argv, field, capsys) -> None:
     assert study.main(argv) == 2
     err = capsys.readouterr().err

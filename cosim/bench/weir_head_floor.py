@@ -27,9 +27,10 @@ from cosim.bench.fluid_throughput import machine_description
 from cosim.errors import InputError
 from cosim.validation import weir
 from cosim.validation.common import whole_spacings
+from cosim.vessel import VesselSpec
 
 POURER_WIDTH = 0.191  # m, the default pourer's inner width, which particles_across divides
-POURER_DEPTH = 0.10  # m, the default pourer's inner depth: the width of the sheet over its lip in a 3-D pour
+POURER_DEPTH = VesselSpec().inner_depth  # m, the default pourer's: the width of the sheet over its lip in a 3-D pour
 
 
 @dataclass(frozen=True)
@@ -100,8 +101,8 @@ def main(argv: list[str] | None = None) -> int:
         if args.dim not in (2, 3):
             raise InputError(f"--dim: 2 or 3, got {args.dim}")
         spacing = POURER_WIDTH / args.across
-        if not 4 * spacing <= args.depth <= 1.0:
-            raise InputError(f"--depth: the 3-D channel's width, m, in [{4 * spacing:.4g} (4 spacings), 1], got {args.depth:g}")
+        for n in heads:  # the weir's own checks (the head in spacings, the 3-D channel's width), before any run
+            weir.Params(head=n * spacing, spacing=spacing, dim=args.dim, depth=args.depth)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
