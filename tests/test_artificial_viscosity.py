@@ -14,8 +14,8 @@ import warp as wp
 from cosim.cli.main import main
 from cosim.errors import InputError
 from cosim.fluid.config import (
-    DEFAULT_ARTIFICIAL_VISCOSITY, DEFAULT_DENSITY_TOLERANCE, GRAVITY, SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY, ArtificialViscosityScale, DensityIteration,
-    FluidConfig,
+    DEFAULT_ARTIFICIAL_VISCOSITY, DEFAULT_DENSITY_TOLERANCE, GRAVITY, SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY, WCSPH_ARTIFICIAL_VISCOSITY_BETA,
+    ArtificialViscosityScale, DensityIteration, FluidConfig,
 )
 from cosim.fluid.params import SPHParams, make_params
 from cosim.fluid.seeding import fill_vessel
@@ -67,11 +67,17 @@ def test_dfsph_signal_velocity_is_the_gravity_wave_speed_plus_twice_the_approach
 
 
 def test_the_sound_speed_scale_is_c0_and_wcsph_keeps_it_with_either_setting():
+    # DFSPH's 'sound_speed': c0 alone; WCSPH: c0 under either setting, plus its default quadratic term beta w
+    # (Monaghan 1992's beta = 2; alpha (c0 + (beta / alpha) w), w the closing speed along r)
     closing_speed = 0.3
-    for cfg in (_config(artificial_viscosity_scale="sound_speed"), _config(pressure_solver="wcsph"),
-                _config(pressure_solver="wcsph", artificial_viscosity_scale="signal_velocity")):
+    dfsph = _config(artificial_viscosity_scale="sound_speed")
+    a, gw = _pair(dfsph, closing_speed)
+    np.testing.assert_allclose(a, _monaghan(dfsph, closing_speed, dfsph.sound_speed, gw), rtol=1e-5, atol=0.0)
+    for cfg in (_config(pressure_solver="wcsph"), _config(pressure_solver="wcsph", artificial_viscosity_scale="signal_velocity")):
+        assert cfg.quadratic_viscosity == WCSPH_ARTIFICIAL_VISCOSITY_BETA == 2.0
         a, gw = _pair(cfg, closing_speed)
-        np.testing.assert_allclose(a, _monaghan(cfg, closing_speed, cfg.sound_speed, gw), rtol=1e-5, atol=0.0)
+        scale = cfg.sound_speed + WCSPH_ARTIFICIAL_VISCOSITY_BETA / cfg.alpha * closing_speed
+        np.testing.assert_allclose(a, _monaghan(cfg, closing_speed, scale, gw), rtol=1e-5, atol=0.0)
 
 
 def test_a_receding_pair_feels_no_artificial_viscosity():
@@ -80,12 +86,25 @@ def test_a_receding_pair_feels_no_artificial_viscosity():
         assert np.all(a == 0.0)
 
 
-def test_an_unset_free_alpha_is_the_one_alpha_under_the_signal_velocity_and_its_own_under_c0():
+def test_an_unset_free_alpha_is_the_one_alpha_under_the_signal_velocity_and_wcsph_and_its_own_under_dfsphs_c0():
     assert _config(free_artificial_viscosity=None).free_liquid_alpha == 0.5
     assert make_params(_config(free_artificial_viscosity=None), 0).alpha_free == 0.5
     assert make_params(_config(free_artificial_viscosity=0.25), 0).alpha_free == 0.25
-    for c0_scaled in (_config(artificial_viscosity_scale="sound_speed"), _config(pressure_solver="wcsph")):
-        assert c0_scaled.free_liquid_alpha == SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY
+    assert make_params(_config(pressure_solver="wcsph"), 0).alpha_free == 0.5
+    assert _config(artificial_viscosity_scale="sound_speed").free_liquid_alpha == SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY
+
+
+def test_wcsphs_quadratic_term_needs_its_one_alpha():
+    # the kernel scales the approach term with each pair's alpha: a free-liquid alpha of its own (the former WCSPH
+    # default, 0.25), an alpha of 0 or no free liquid's rule decide whether the default beta applies
+    assert FluidConfig(pressure_solver="wcsph").quadratic_viscosity == WCSPH_ARTIFICIAL_VISCOSITY_BETA
+    assert FluidConfig(pressure_solver="wcsph").viscosity_approach_weight == WCSPH_ARTIFICIAL_VISCOSITY_BETA / 0.01
+    assert FluidConfig(pressure_solver="wcsph", free_artificial_viscosity=0.25).quadratic_viscosity is None
+    assert FluidConfig(pressure_solver="wcsph", free_artificial_viscosity=0.25).viscosity_approach_weight == 0.0
+    assert FluidConfig(pressure_solver="wcsph", artificial_viscosity=0.0).quadratic_viscosity is None
+    assert FluidConfig(pressure_solver="wcsph", free_liquid=False, free_artificial_viscosity=0.25).quadratic_viscosity == 2.0
+    assert FluidConfig(pressure_solver="wcsph", artificial_viscosity_beta=1.0).quadratic_viscosity == 1.0
+    assert FluidConfig(artificial_viscosity_scale="sound_speed").quadratic_viscosity is None  # DFSPH's c0: none
 
 
 def test_an_unset_alpha_is_the_velocity_scales_own():
@@ -187,9 +206,10 @@ def test_beta_is_the_approach_terms_coefficient_on_top_of_c0():
     assert np.all(a_receding == 0.0)
 
 
-def test_an_unset_beta_leaves_each_scale_as_it_was():
-    assert _beta_config(None).viscosity_approach_weight == 0.0  # c0: no approach term
-    assert _config(artificial_viscosity_scale="sound_speed").viscosity_approach_weight == 0.0
+def test_an_unset_beta_is_each_scales_own():
+    assert _beta_config(None).viscosity_approach_weight == pytest.approx(WCSPH_ARTIFICIAL_VISCOSITY_BETA / 0.5)  # WCSPH's beta 2
+    assert _beta_config(0.0).viscosity_approach_weight == 0.0  # c0 alone, as set
+    assert _config(artificial_viscosity_scale="sound_speed").viscosity_approach_weight == 0.0  # DFSPH's c0: no approach term
     assert _config(artificial_viscosity_scale="signal_velocity").viscosity_approach_weight == 2.0  # Monaghan (1997)'s
     # with the signal velocity beta replaces its 2 alpha: alpha 0.5, beta 2 -> b = 4 on sqrt(g h)
     signal = _config(artificial_viscosity_scale="signal_velocity", artificial_viscosity_beta=2.0)
@@ -219,7 +239,7 @@ def test_the_viscous_criterion_takes_beta_at_the_planned_approach():
 
 
 @pytest.mark.parametrize("kw, message", [
-    ({"artificial_viscosity_beta": 2.0}, "needs one alpha for all liquid"),  # WCSPH's free alpha 0.25 against 0.01
+    ({"artificial_viscosity_beta": 2.0, "free_artificial_viscosity": 0.25}, "needs one alpha for all liquid"),  # 0.25 against 0.01
     ({"artificial_viscosity_beta": 2.0, "free_artificial_viscosity": 0.0, "artificial_viscosity": 0.0}, "needs Monaghan's alpha above 0"),
     ({"artificial_viscosity_beta": -1.0, "free_artificial_viscosity": 0.01}, "fluid.artificial_viscosity_beta"),
     ({"artificial_viscosity_beta": 11.0, "free_artificial_viscosity": 0.01}, "fluid.artificial_viscosity_beta"),
@@ -235,14 +255,14 @@ def test_beta_goes_without_one_alpha_where_no_liquid_is_free():
 
 
 def test_the_validation_cases_take_beta(capsys):
-    argv = ["validate", "hydrostatic", "--solver", "wcsph", "--free-artificial-viscosity", "0.01", "--spacing", "0.0125", "--width", "0.1",
-            "--fill", "0.05", "--no-plot", "--json"]
+    argv = ["validate", "hydrostatic", "--solver", "wcsph", "--spacing", "0.0125", "--width", "0.1", "--fill", "0.05", "--no-plot", "--json"]
+    assert main([*argv, "--artificial-viscosity-beta", "0"]) == 0
+    without_beta = json.loads(capsys.readouterr().out)["cases"][0]
     assert main(argv) == 0
-    one_alpha = json.loads(capsys.readouterr().out)["cases"][0]
-    assert main([*argv, "--artificial-viscosity-beta", "2"]) == 0
-    with_beta = json.loads(capsys.readouterr().out)["cases"][0]
-    assert with_beta["pressure"] != one_alpha["pressure"]  # the settling column's approaching pairs feel beta
-    # WCSPH's free alpha left at its 0.25: refused as bad input, one line
-    assert main(["validate", "hydrostatic", "--solver", "wcsph", "--artificial-viscosity-beta", "2", "--no-plot"]) == 2
+    with_beta = json.loads(capsys.readouterr().out)["cases"][0]  # WCSPH's default, beta 2
+    assert with_beta["pressure"] != without_beta["pressure"]  # the settling column's approaching pairs feel beta
+    # beta with a free-liquid alpha of its own: refused as bad input, one line
+    assert main(["validate", "hydrostatic", "--solver", "wcsph", "--artificial-viscosity-beta", "2", "--free-artificial-viscosity", "0.25",
+                 "--no-plot"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "needs one alpha for all liquid" in err[0]

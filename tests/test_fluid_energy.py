@@ -54,11 +54,12 @@ def test_a_lift_balances_the_walls_work_against_the_liquids_energy(solver_name):
 def test_liquid_momentum_changes_by_gravity_minus_the_walls_reaction_guard_impulses_included():
     # WCSPH on a coarse grid tilted at 2 rad/s: the guard (shared by both solvers) corrects particles at the walls
     # (counted below), so the balance holds only if its impulses are in the reaction wrench. (DFSPH's
-    # pressure-carrying walls keep its particles off the guard in this tilt.)
+    # pressure-carrying walls keep its particles off the guard in this tilt, and so does WCSPH's default quadratic
+    # viscosity: the former free-liquid alpha 0.25, which turns it off, is set to keep the guard acting.)
     spec = seed_pouring_vessel()
     lo, hi = domain_around(spec, 0.0)
     cfg = FluidConfig(dim=2, spacing=spec.inner_width / 12, pressure_solver="wcsph", max_expected_speed=1.4,
-                      domain_min=lo, domain_max=hi)
+                      domain_min=lo, domain_max=hi, free_artificial_viscosity=0.25)
     pose_at = tilt_about_lip(spec, 2.0, math.pi / 2)
     solver = FluidSolver(cfg, [spec], [pose_at(0.0)], fill_vessel(spec, 0.5 * spec.inner_height, cfg), device="cpu")
     mass = cfg.rest_density * cfg.particle_volume
@@ -79,9 +80,10 @@ def test_energy_creating_configuration_stops_with_the_instability_error():
     # The stability matrix's silent configuration before the account existed: 3-D, 8 across, half full, tilted at
     # 5 rad/s from rest within one step; it finished with plausible densities and 0.43 M g L of created energy.
     # The energy came from the Tait liquid's tension: with it clamped at the default fluid.max_tension (1 kPa) the
-    # same run dissipates 0.24 M g L, so the tension is left unclamped here (1 MPa) to keep a creating run.
+    # same run dissipates 0.24 M g L, so the tension is left unclamped here (1 MPa) to keep a creating run, and so is
+    # the viscosity of that run, the former free-liquid alpha 0.25 (WCSPH's default quadratic term dissipates it).
     config = StressConfig(Motion.TILT, 5.0, 0.5, 8, 1.0, 3, "wcsph")
-    cfg = replace(config.fluid_config(), max_tension=1.0e6)
+    cfg = replace(config.fluid_config(), max_tension=1.0e6, free_artificial_viscosity=0.25)
     run = run_scripted(config.spec(), config.fill_depth, cfg, config.pose_script(), 0.6)
     assert "created" in run.failure and "M g L of energy" in run.failure and "fluid.max_energy_creation" in run.failure
     assert run.solver.energy_account.created > run.solver.config.max_energy_creation

@@ -132,11 +132,17 @@ DEFAULT_ARTIFICIAL_VISCOSITY = {ArtificialViscosityScale.SOUND_SPEED: 0.01, Arti
 # threshold above a resting surface's indicator under it, so WCSPH keeps the vessels' inner volumes
 # (docs/free_surface.md).
 DEFAULT_FREE_LIQUID_RULE = {PressureSolver.DFSPH: FreeLiquidRule.FREE_SURFACE, PressureSolver.WCSPH: FreeLiquidRule.OUTSIDE_VESSELS}
-# Monaghan's alpha of pairs with free liquid under c0 when none is given (FluidConfig.free_artificial_viscosity): c0
-# does not grow with an impact, so the free liquid's impacts need their own, larger alpha (a value set on the pour,
-# docs/artificial_viscosity.md). The signal velocity's approach term damps impacts wherever they happen, so under it
-# one alpha serves all liquid.
+# Monaghan's alpha of pairs with free liquid under DFSPH's 'sound_speed' scale when none is given
+# (FluidConfig.free_artificial_viscosity): c0 does not grow with an impact, so without an approach term the free
+# liquid's impacts need their own, larger alpha (a value set on the pour, docs/artificial_viscosity.md). The signal
+# velocity's approach term, and WCSPH's quadratic term (WCSPH_ARTIFICIAL_VISCOSITY_BETA), damp impacts wherever they
+# happen, so under them one alpha serves all liquid.
 SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY = 0.25
+# Monaghan's quadratic coefficient beta under WCSPH when none is given (FluidConfig.artificial_viscosity_beta), with
+# one alpha for all liquid: Monaghan (1992)'s standard beta = 2 (his alpha = 1; WCSPH's alpha stays 0.01, which the
+# slosh bounds), as DFSPH's signal velocity's approach term 2 alpha w at its alpha 1. Not fitted: it replaces a
+# free-liquid alpha that was set on the pour; what it passes and fails: docs/wcsph_knobs.md.
+WCSPH_ARTIFICIAL_VISCOSITY_BETA = 2.0
 
 # The concerns the settings are grouped by, in the order references list them.
 DISCRETISATION = "discretisation"
@@ -243,11 +249,11 @@ class FluidConfig:
                                                       "particle (and of a free particle against walls): free liquid "
                                                       "has no tension, so this makes its impacts inelastic; alpha acts "
                                                       "only on approaching pairs, so a separating stream flies free.",
-                                                      "", 0.0, 1.0, kind="float", none_means="the velocity scale's "
-                                                      "own: artificial_viscosity, one alpha for all liquid, with the "
-                                                      "signal velocity (its approach term damps impacts); "
-                                                      f"{SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY:g} with c0 (WCSPH, or "
-                                                      "DFSPH's 'sound_speed')")
+                                                      "", 0.0, 1.0, kind="float", none_means="artificial_viscosity, "
+                                                      "one alpha for all liquid, with the signal velocity or under "
+                                                      "WCSPH (their approach terms damp impacts); "
+                                                      f"{SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY:g} with DFSPH's "
+                                                      "'sound_speed'")
     artificial_viscosity_beta: float | None = setting(None, PRESSURE, "Monaghan's quadratic coefficient beta of the "
                                                       "artificial viscosity (Monaghan & Gingold 1983; Monaghan 1992: "
                                                       "Pi_ij = (-alpha c mu_ij + beta mu_ij^2) / rho_ij), in the signal-"
@@ -259,8 +265,10 @@ class FluidConfig:
                                                       "liquid (free_artificial_viscosity equal to the bulk's, or "
                                                       "free_liquid off): the kernel scales the approach term with each "
                                                       "pair's alpha (docs/wcsph_knobs.md).", "", 0.0, 10.0, kind="float",
-                                                      none_means="the velocity scale's own: 0 with c0 (WCSPH, or DFSPH's "
-                                                      f"'sound_speed'), {APPROACH_WEIGHT:g} alpha with the signal velocity")
+                                                      none_means=f"{WCSPH_ARTIFICIAL_VISCOSITY_BETA:g} under WCSPH "
+                                                      "with one alpha above 0 for all liquid (0 with a free-liquid "
+                                                      "alpha of its own); 0 with DFSPH's 'sound_speed'; "
+                                                      f"{APPROACH_WEIGHT:g} alpha with the signal velocity")
     particle_shifting: ParticleShifting = setting(ParticleShifting.OFF, PRESSURE, "Particle shifting at the start of "
                                                   "every substep, both solvers: 'fickian' moves each particle down the "
                                                   "gradient of the particle concentration (walls counted), "
@@ -346,8 +354,8 @@ class FluidConfig:
     viscous_time_step: ViscousTimeStep = setting(
         ViscousTimeStep.MEASURED_APPROACH, TIME_STEPPING, "The approach speed w at which the artificial viscosity's "
         "time-step criterion dt <= 0.125 h^2 / (nu + alpha h v_sig / (2 (dim + 2))) takes the velocity scale v_sig = "
-        "c + b w (with c0 and no artificial_viscosity_beta, b = 0 and w has no effect): 'planned_approach', the "
-        "fastest approach the planned flow allows, two particles head on at the CFL condition's flow speed (at least "
+        "c + b w (b = 0, so that w has no effect, under DFSPH's 'sound_speed' without artificial_viscosity_beta): "
+        "'planned_approach', the fastest approach the planned flow allows, two particles head on at the CFL condition's flow speed (at least "
         "max_expected_speed) or one against the walls; 'measured_approach', the fastest the last interval's largest "
         "particle speed v_max allows, max(2 v_max, v_max + v_wall), with no floor: the criterion follows the "
         "approaches the liquid has, as Monaghan (1997)'s dt <= C h / max v_sig,ij does, the default "
@@ -451,10 +459,23 @@ class FluidConfig:
     @property
     def free_liquid_alpha(self) -> float:
         """Monaghan's alpha of pairs with free liquid: ``free_artificial_viscosity``; where unset, the one alpha under
-        the signal velocity, :data:`SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY` under c0."""
+        the signal velocity and under WCSPH, :data:`SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY` under DFSPH's c0."""
         if self.free_artificial_viscosity is not None:
             return self.free_artificial_viscosity
-        return self.alpha if self.signal_velocity_viscosity else SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY
+        one_alpha = self.signal_velocity_viscosity or self.pressure_solver is PressureSolver.WCSPH
+        return self.alpha if one_alpha else SOUND_SPEED_FREE_ARTIFICIAL_VISCOSITY
+
+    @property
+    def quadratic_viscosity(self) -> float | None:
+        """Monaghan's quadratic coefficient beta in effect: ``artificial_viscosity_beta`` where set; where unset,
+        :data:`WCSPH_ARTIFICIAL_VISCOSITY_BETA` under WCSPH with one alpha above 0 for all liquid (the kernel scales
+        the approach term with each pair's alpha), otherwise none."""
+        if self.artificial_viscosity_beta is not None:
+            return self.artificial_viscosity_beta
+        one_alpha = not self.free_liquid or self.free_liquid_alpha == self.alpha
+        if self.pressure_solver is PressureSolver.WCSPH and self.alpha > 0.0 and one_alpha:
+            return WCSPH_ARTIFICIAL_VISCOSITY_BETA
+        return None
 
     @property
     def signal_velocity_viscosity(self) -> bool:
@@ -472,10 +493,11 @@ class FluidConfig:
     @property
     def viscosity_approach_weight(self) -> float:
         """b of the velocity scale c + b w (:attr:`viscosity_speed`), which the kernel multiplies by alpha: Monaghan's
-        quadratic coefficient over alpha, ``artificial_viscosity_beta`` / alpha where set; otherwise 0 with c0 and
-        :data:`APPROACH_WEIGHT` with the signal velocity (there alpha b = 2 alpha is the quadratic coefficient)."""
-        if self.artificial_viscosity_beta is not None:
-            return self.artificial_viscosity_beta / self.alpha
+        quadratic coefficient over alpha, :attr:`quadratic_viscosity` / alpha where there is one; otherwise 0 with c0
+        and :data:`APPROACH_WEIGHT` with the signal velocity (there alpha b = 2 alpha is the quadratic coefficient)."""
+        beta = self.quadratic_viscosity
+        if beta is not None:
+            return beta / self.alpha
         return APPROACH_WEIGHT if self.signal_velocity_viscosity else 0.0
 
     @property

@@ -8,7 +8,8 @@ update_free_liquid: free liquid (``FluidConfig.free_liquid``): a particle outsid
   below rest density) pulls the falling stream back toward the vessel it left, 16-22 mm short of its parabola in
   ``cosim validate free-fall``; but without tension the continuity density cannot hold caught liquid together,
   because it remembers the loose packing a drop arrived in (its offset from the summation density) and props the
-  caught liquid up. Free liquid pairs use ``free_artificial_viscosity``, so its impacts are inelastic. The same
+  caught liquid up. Free liquid pairs use ``FluidConfig.free_liquid_alpha`` (by default the bulk's one alpha, with
+  Monaghan's quadratic term beta w damping every approaching pair: impacts are inelastic wherever they happen). The same
   neighbour walk measures each particle's free-surface indicator where the 'free_surface' rule or the
   tensile-instability control needs it.
 compute_forces: per particle, over fluid and wall neighbours,
