@@ -93,8 +93,9 @@ def test_a_block_in_uniform_tension_feels_no_clumping_force_inside_under_the_con
     assert (v[top & ~inside, 2] < g * STEP - 1e-4).all()
 
 
-def test_the_symmetric_sum_pushes_the_disordered_interior_of_a_block_in_tension():
-    solver, _ = _block_in_tension("clamp")
+@pytest.mark.parametrize("treatment", ["clamp", "symmetric"])
+def test_the_symmetric_sum_pushes_the_disordered_interior_of_a_block_in_tension(treatment):
+    solver, _ = _block_in_tension(treatment)
     v = solver.velocities()
     x = solver.positions()
     middle = (np.abs(x[:, 0]) < 0.02) & (np.abs(x[:, 2] - 0.04) < 0.02)
@@ -102,7 +103,7 @@ def test_the_symmetric_sum_pushes_the_disordered_interior_of_a_block_in_tension(
     assert np.abs(v[middle, 0]).max() > 1e-3
 
 
-@pytest.mark.parametrize("treatment, floor", [("clamp", -1000.0), ("tic", None)])
+@pytest.mark.parametrize("treatment, floor", [("clamp", -1000.0), ("symmetric", None), ("tic", None)])
 def test_only_the_clamp_treatment_clamps_the_tension(treatment, floor):
     cfg = FluidConfig(dim=2, spacing=DX, pressure_solver="wcsph", max_expected_speed=1.0, tension_treatment=treatment,
                       max_tension=1000.0, domain_min=(-0.3, -0.3, -0.3), domain_max=(0.3, 0.3, 0.3))
@@ -111,3 +112,19 @@ def test_only_the_clamp_treatment_clamps_the_tension(treatment, floor):
     tait = cfg.rest_density * cfg.sound_speed**2 / cfg.gamma * (0.98**cfg.gamma - 1.0)  # about -1.9 kPa
     expected = tait if floor is None else max(tait, floor)
     assert FluidSolver(cfg, [], [], stretched).pressures() == pytest.approx(expected, rel=1e-4)
+
+
+def test_the_unclamped_symmetric_sum_is_the_clamp_never_reached():
+    # the Tait tension at the integration's density floor (0.8 rho0) is about -0.8 rho0 c0^2 / gamma, well inside the
+    # clamp's largest allowed 1 MPa here, so the two treatments run the same substeps
+    runs = []
+    for kw in ({"tension_treatment": "symmetric"}, {"tension_treatment": "clamp", "max_tension": 1.0e6}):
+        cfg = FluidConfig(dim=2, spacing=DX, pressure_solver="wcsph", max_expected_speed=1.0, domain_min=(-0.3, -0.3, -0.3),
+                          domain_max=(0.3, 0.3, 0.3), **kw)
+        block = liquid_block((-0.02, -0.05, 0.0), (0.02, 0.05, 0.04), cfg)
+        solver = FluidSolver(cfg, [], [], ParticleSet(block.positions, block.velocities, np.full(len(block), 0.98 * cfg.rest_density)))
+        solver.advance(10 * STEP)
+        runs.append((solver.positions(), solver.pressures()))
+    assert cfg.rest_density * cfg.sound_speed**2 / cfg.gamma * 0.8 < 1.0e6
+    np.testing.assert_array_equal(runs[0][0], runs[1][0])
+    np.testing.assert_array_equal(runs[0][1], runs[1][1])

@@ -89,7 +89,8 @@ class FreeLiquidRule(Enum):
 class TensionTreatment(Enum):
     """How WCSPH's pressure gradient treats negative pressure (``cosim.fluid.wcsph.pressure_pair_factor``)."""
 
-    CLAMP = "clamp"  # symmetric sum p_i / rho_i^2 + p_j / rho_j^2 everywhere, tension clamped at max_tension
+    SYMMETRIC = "symmetric"  # Monaghan's symmetric sum p_i / rho_i^2 + p_j / rho_j^2 everywhere, the Tait tension unclamped
+    CLAMP = "clamp"  # the same sum, tension clamped at max_tension
     TIC = "tic"  # Sun et al. (2018)'s tensile-instability control (p_j - p_i where p_i < 0 away from the surface), no clamp
 
 
@@ -298,11 +299,12 @@ class FluidConfig:
                                  "the bound liquid carries, p = max(Tait, -max_tension): tension holds the "
                                  "continuity-density liquid together, but a film stretched at a rim can reach tens of "
                                  "kPa and fling its particles; 1 kPa is the hydrostatic pressure of 10 cm of water. "
-                                 "Not used by 'tic'.", "Pa", 0.0, 1.0e6)
+                                 "Used by 'clamp' only.", "Pa", 0.0, 1.0e6)
     tension_treatment: TensionTreatment = setting(TensionTreatment.CLAMP, WCSPH, "How the pressure gradient treats "
-                                                  "negative pressure: 'clamp' (Monaghan's symmetric sum m_j (p_i / "
-                                                  "rho_i^2 + p_j / rho_j^2) grad W for every pair, the tension "
-                                                  "clamped at max_tension) or 'tic' (Sun et al. 2018's tensile-"
+                                                  "negative pressure: 'symmetric' (Monaghan's symmetric sum m_j (p_i "
+                                                  "/ rho_i^2 + p_j / rho_j^2) grad W for every pair, the Tait tension "
+                                                  "as it is), 'clamp' (the same, the tension clamped at max_tension) "
+                                                  "or 'tic' (Sun et al. 2018's tensile-"
                                                   "instability control, no clamp: (m_j / (rho_i rho_j)) F_ij grad W "
                                                   "with F_ij = p_j + p_i where p_i >= 0 or particle i is in the "
                                                   "free-surface region, Marrone et al. 2010's indicator at or below "
@@ -430,7 +432,8 @@ class FluidConfig:
     @property
     def tension_limit(self) -> float:
         """Pa, the most tension WCSPH's equation of state gives: ``max_tension`` under the 'clamp' treatment; none
-        (infinite) under tensile-instability control, whose pressure gradient keeps tension from clumping particles."""
+        (infinite) under the plain symmetric sum, and under tensile-instability control, whose pressure gradient
+        keeps tension from clumping particles."""
         return self.max_tension if self.tension_treatment is TensionTreatment.CLAMP else math.inf
 
     # The settings left unset (None) stay unset in the fields and resolve here, for the solver and iteration in
