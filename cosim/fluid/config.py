@@ -399,7 +399,7 @@ class FluidConfig:
                     "fluid.artificial_viscosity_beta: needs Monaghan's alpha above 0 (the kernel's approach term is "
                     f"alpha times beta / alpha), got artificial_viscosity {self.alpha:g}"
                 )
-            if self.free_liquid and self.free_liquid_alpha != self.alpha:
+            if not self.one_alpha_for_all_liquid:
                 raise InputError(
                     "fluid.artificial_viscosity_beta: needs one alpha for all liquid (the kernel's approach term is "
                     "each pair's alpha times beta / alpha, so a free-liquid alpha would scale beta with it): set "
@@ -475,10 +475,15 @@ class FluidConfig:
         the approach term with each pair's alpha), otherwise none."""
         if self.artificial_viscosity_beta is not None:
             return self.artificial_viscosity_beta
-        one_alpha = not self.free_liquid or self.free_liquid_alpha == self.alpha
-        if self.pressure_solver is PressureSolver.WCSPH and self.alpha > 0.0 and one_alpha:
+        if self.pressure_solver is PressureSolver.WCSPH and self.alpha > 0.0 and self.one_alpha_for_all_liquid:
             return WCSPH_ARTIFICIAL_VISCOSITY_BETA
         return None
+
+    @property
+    def one_alpha_for_all_liquid(self) -> bool:
+        """Whether every pair takes the bulk's alpha: no free liquid, or free liquid at the bulk's alpha (what a
+        quadratic term beta needs, since the kernel scales its approach term with each pair's alpha)."""
+        return not self.free_liquid or self.free_liquid_alpha == self.alpha
 
     @property
     def signal_velocity_viscosity(self) -> bool:
