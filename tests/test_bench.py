@@ -149,9 +149,9 @@ def test_update_document_keeps_the_text_around_the_generated_block(tmp_path):
     assert text.startswith("# Benchmarks\n") and "intro" in text and text.rstrip().endswith("| table |")
 
 
-def _pour_raw(poured, landing, q, initial=1.0):
-    t = [0.0, 1.0, 2.0]
-    return {"status": "ok", "outcome": {"initial_volume": initial, "caught_volume": 0.8 * poured[-1]},
+def _pour_raw(poured, landing, q, initial=1.0, done=False):
+    t = [float(k) for k in range(len(poured))]
+    return {"status": "ok", "outcome": {"initial_volume": initial, "caught_volume": 0.8 * poured[-1], "pour_done": done},
             "series": {"t": t, "poured_volume": poured, "landing_measured_x": landing, "trajectory_time": t,
                        "joint_names": ["a/j"], "joint_positions": [[x] for x in q]}}
 
@@ -166,6 +166,18 @@ def test_pour_comparison_against_hand_computed_values():
     assert err["final_caught_error"] == pytest.approx(0.0)
     assert compare_pours(_pour_raw([0.0, 0.1, 0.2], [None] * 3, [0, 0, 0]), ref)["final_caught_error"] == pytest.approx(0.08)
     assert math.isnan(compare_pours(_pour_raw([0, 0, 0], [None] * 3, [0, 0, 0]), ref)["landing_error_m"])
+
+
+def test_a_pour_that_was_done_holds_its_volume_until_the_longer_run_ends():
+    ref = _pour_raw([0.0, 0.2, 0.3, 0.3, 0.4], [None] * 5, [0.0] * 5)  # the reference pours on to t = 4
+    early = _pour_raw([0.0, 0.3, 0.3], [None] * 3, [0.0] * 3, done=True)
+    # done at t = 2: its 0.3 holds, so t = 0..4 count: differences 0, 0.1, 0, 0, -0.1
+    assert compare_pours(early, ref)["poured_curve_error"] == pytest.approx(math.sqrt(0.02 / 5))
+    # the same run cut off by its time limit is compared over t = 0..2 only
+    cut = _pour_raw([0.0, 0.3, 0.3], [None] * 3, [0.0] * 3, done=False)
+    assert compare_pours(cut, ref)["poured_curve_error"] == pytest.approx(math.sqrt(0.01 / 3))
+    # and the other way round: a done reference that stopped first holds its volume against a longer run
+    assert compare_pours(ref, early)["poured_curve_error"] == pytest.approx(math.sqrt(0.02 / 5))
 
 
 def test_pour_scene_options_map_onto_the_scene_and_are_checked():

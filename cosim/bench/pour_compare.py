@@ -2,7 +2,11 @@
 simulated.
 
 - ``poured_curve_error``: RMS over the control steps of the poured volume's difference, divided by the
-  reference's initial volume (dimensionless; 0.01 = the curves differ by 1 % of the liquid on average).
+  reference's initial volume (dimensionless; 0.01 = the curves differ by 1 % of the liquid on average). A run whose
+  pour was done when it stopped (the early stop) holds its last poured volume until the other run ends: nothing
+  pours after the pour is done (the early-stop pair of :mod:`cosim.bench.plan` measures that), so two whole pours
+  that end at different times are compared over the longer one. A run cut off by its time limit is compared only
+  over the time it simulated.
 - ``landing_error_m``: m, difference of the median measured landing x (where the stream crosses the catcher's rim
   plane, ``series.csv``'s ``landing_measured_x``); NaN when either run had no stream.
 - ``joint_rms_rad``: rad, RMS over time and all joints of both arms of the joint position difference of the
@@ -25,6 +29,15 @@ def _common_grid(t_run: np.ndarray, t_ref: np.ndarray) -> np.ndarray:
     return t_ref[(t_ref >= t_run[0] - 1e-9) & (t_ref <= t_run[-1] + 1e-9)]
 
 
+def _poured_grid(run: dict, reference: dict) -> np.ndarray:
+    """s, the times the poured volumes are compared at: the longer run's samples, up to where the shorter one
+    stopped unless its pour was done (then its last volume holds)."""
+    runs = sorted((run, reference), key=lambda r: r["series"]["t"][-1])
+    short, long = (np.asarray(r["series"]["t"], float) for r in runs)
+    end = long[-1] if runs[0]["outcome"]["pour_done"] else short[-1]
+    return long[(long >= max(short[0], long[0]) - 1e-9) & (long <= end + 1e-9)]
+
+
 def _median_landing(series: dict) -> float:
     x = np.array([math.nan if v is None else v for v in series["landing_measured_x"]], dtype=float)
     x = x[np.isfinite(x)]
@@ -35,7 +48,7 @@ def compare_pours(run: dict, reference: dict) -> dict[str, float]:
     """The :data:`POUR_ERRORS` of ``run`` against ``reference`` (both raw results with status 'ok')."""
     a, b = run["series"], reference["series"]
     t_run, t_ref = np.asarray(a["t"], float), np.asarray(b["t"], float)
-    grid = _common_grid(t_run, t_ref)
+    grid = _poured_grid(run, reference)
     poured = np.interp(grid, t_run, a["poured_volume"]) - np.interp(grid, t_ref, b["poured_volume"])
     initial = float(reference["outcome"]["initial_volume"])
     if a["joint_names"] != b["joint_names"]:

@@ -169,7 +169,10 @@ def markdown(plan: BenchPlan, results: dict[BenchConfig, dict], rows: list[Row],
         fronts = {e: {id(r) for d in {r.config.device for r in case_rows} for r in front_members(rows, case, e, d)} for e in errors}
         out.append(f"\n### {case.value}\n")
         if case is BenchCase.POUR and plan.reference is not None:
-            out.append(f"Errors against the reference pour `{plan.reference.label}` over the first {plan.reference.length:g} s.\n")
+            ref = results.get(plan.reference) or {}
+            ended = f"; the reference simulated {ref['sim_s']:.2f} s" if ref.get("status") == "ok" else ""
+            out.append(f"Errors against the reference pour `{plan.reference.label}`, whole pours: each row ends when its pour is "
+                       f"done, at most {plan.reference.length:g} s{ended} (cosim.bench.pour_compare).\n")
         out.append("| configuration | particles | simulated s | wall s | wall s per simulated s | "
                    + " | ".join(ERROR_TITLES[e] for e in errors) + " |")
         out.append("|---" * (4 + len(errors) + 1) + "|")
