@@ -20,7 +20,7 @@ from cosim.coupling.settings import Coupling
 from cosim.errors import InputError
 from cosim.fluid.config import PressureSolver
 from cosim.fluid.solver import FluidInstabilityError
-from cosim.pour_scene import FluidSettings
+from cosim.pour_scene import FluidSettings, PourScene
 from cosim.validation import CASES
 
 
@@ -93,9 +93,25 @@ def test_real_smoke_rows_csv_and_markdown(tmp_path):
 def test_the_pour_reference_is_wcsph_and_every_solver_sweeps_the_pour_resolutions():
     plan = build_plan("full")
     assert plan.reference.pressure_solver is PressureSolver.WCSPH and plan.reference.particles_across == 48
-    pours = [c for c in plan.compared_pours() if c.kernel is plan.reference.kernel and c.cfl == plan.reference.cfl and not c.options]
+    pours = [c for c in plan.compared_pours() if c.kernel is plan.reference.kernel and c.cfl == plan.reference.cfl
+             and c.options == plan.reference.options]
     for solver in PressureSolver:  # both solvers at 16, 24 and 32 across, compared with the one reference
         assert {c.particles_across for c in pours if c.pressure_solver is solver} == {16, 24, 32}
+
+
+def test_every_pour_row_holds_the_default_scenes_cfs_head():
+    from cosim.pour_run import cfs_head_reference
+
+    plan = build_plan("full")
+    default = PourScene()
+    head = cfs_head_reference(default, default.vessels.pourer.inner_width / default.fluid.particles_across)
+    for cfg in (c for c in plan.rows if c.case is BenchCase.POUR):
+        scene = pour_scene(cfg)
+        spacing = scene.vessels.pourer.inner_width / scene.fluid.particles_across
+        assert cfs_head_reference(scene, spacing) == head, cfg.label  # the same commanded pour at every resolution
+    # without the options the reference would hold 3 of its own spacings, 2/3 of the default's head
+    bare = pour_scene(replace(plan.reference, options=()))
+    assert cfs_head_reference(bare, bare.vessels.pourer.inner_width / 48) == pytest.approx(head * 32 / 48)
 
 
 def test_every_case_has_dfsph_rows_at_other_density_tolerances_at_its_default_resolution():

@@ -6,7 +6,7 @@ resolution sweep (to compare the solvers at equal error); on every device presen
 fine reference (:data:`REFERENCE_ACROSS`, :data:`REFERENCE_SOLVER`) that its resolution and numerics rows are compared with, and the skip
 options: pairs of runs that differ only in what a scene may skip, the second doing the full work.
 
-Cost: the full plan is sized to finish cold in about half an hour on a 2-core CPU. The pour rows compared with the
+Cost: the full plan finishes cold in about 40 minutes on a 2-core CPU, a third of it the 48-across WCSPH reference. The pour rows compared with the
 reference run the whole pour (the early stop ends each when its pour is done, at most :data:`POUR_SECONDS`): a
 window that ends before the outflow would rank them by the onset of the outflow alone. The skip-option pairs, which
 compare two runs with each other, run :data:`SKIP_PAIR_SECONDS`.
@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 from cosim.bench.config import BenchCase, BenchConfig
 from cosim.fluid.config import KernelType, PressureSolver
 from cosim.fluid.runtime import cuda_available
-from cosim.pour_scene import STREAM_PARTICLES, FluidSettings
+from cosim.pour_scene import FluidSettings
 
 # s, max_duration of the pour rows compared with the reference: the whole pour, which the early stop ends when it is
 # done (the default scene at 24 to 48 across pours for 14 to 19 s); the bound only stops a pour that never finishes
@@ -107,8 +107,32 @@ def default_numerics(device: str = "cpu") -> dict:
             "device": device}
 
 
+def equal_head_options() -> tuple[tuple[str, float], ...]:
+    """Scene options that make every pour row hold the default scene's CFS head (m over the crest).
+
+    Left to itself a scene holds at least ``controller.stream_particles`` spacings over the crest
+    (:func:`cosim.pour_run.cfs_head_reference`): 17.9 mm at the default 32 across, 11.9 at the reference's 48 and
+    23.9 at 24. A weir's outflow goes as the head^(3/2), so each resolution would pour at its own rate (the 48-across
+    reference at 0.54 x the default's) and the rows would differ by the controller's set point, not by the
+    numerics. With these options every row holds the default's head and no floor: the same commanded pour. The
+    default row is the default scene's pour (the same head); rows coarser than the default hold fewer than
+    ``stream_particles`` spacings, a stream the weir case does not resolve, and their errors include that."""
+    from cosim.pour_run import cfs_head_reference
+    from cosim.pour_scene import PourScene
+
+    scene = PourScene()
+    head = cfs_head_reference(scene, scene.vessels.pourer.inner_width / scene.fluid.particles_across)
+    return (("controller.cfs.h_q_ref", head), ("controller.stream_particles", 0.0))
+
+
+def _case_options(case: BenchCase) -> tuple[tuple[str, float], ...]:
+    """Options every row of ``case`` carries (the pour's equal head; none for the validation cases)."""
+    return equal_head_options() if case is BenchCase.POUR else ()
+
+
 def _axis_rows(case: BenchCase, axes: CaseAxes, device: str) -> list[BenchConfig]:
-    base = BenchConfig(case, axes.axes_at or axes.resolutions[-1], axes.length, **default_numerics(device))
+    base = BenchConfig(case, axes.axes_at or axes.resolutions[-1], axes.length, options=_case_options(case),
+                       **default_numerics(device))
     rows = [replace(base, particles_across=n) for n in axes.resolutions]
     rows += [replace(base, kernel=k) for k in KernelType if k is not base.kernel]
     rows += [replace(base, cfl=c) for c in axes.cfl_levels if c != base.cfl]
@@ -122,19 +146,19 @@ def _axis_rows(case: BenchCase, axes: CaseAxes, device: str) -> list[BenchConfig
 
 def _skip_options(device: str) -> list[SkipOption]:
     d = default_numerics(device)
-    at = {n: BenchConfig(BenchCase.POUR, n, SKIP_PAIR_SECONDS, **d) for n in (16, 24)}
+    at = {n: BenchConfig(BenchCase.POUR, n, SKIP_PAIR_SECONDS, options=equal_head_options(), **d) for n in (16, 24)}
 
     def opt(cfg: BenchConfig, key: str, value) -> BenchConfig:
         return replace(cfg, options=cfg.options + ((key, value),))
 
-    # both at the 2-D CFS head, so that the pair differs only in the liquid's dimension, not in the controller's
-    # setting that follows it (pour_scene.STREAM_PARTICLES)
-    flat = opt(replace(at[16], length=DIM_PAIR_SECONDS), "controller.stream_particles", STREAM_PARTICLES[2])
+    # both at the default scene's CFS head (equal_head_options), so that the pair differs only in the liquid's
+    # dimension, not in the head floor that follows it (pour_scene.STREAM_PARTICLES)
+    flat = replace(at[16], length=DIM_PAIR_SECONDS)
     # the early-stop pair runs the whole pour (the run without the stop goes on to POUR_SECONDS; the default scene's
     # 60 s would cost 2.5 x more)
     full_stop = replace(at[24], length=POUR_SECONDS)
     return [
-        SkipOption("2-D liquid in the pour plane", f"fluid.dim = 2 (full: 3; both at controller.stream_particles = {STREAM_PARTICLES[2]:g})",
+        SkipOption("2-D liquid in the pour plane", "fluid.dim = 2 (full: 3; both at the default scene's CFS head)",
                    flat, replace(flat, dim=3)),
         SkipOption("SIM only when the fill needs it", "controller.sim.mode = auto (full: always)", at[24],
                    opt(at[24], "controller.sim.mode", "always")),
@@ -166,7 +190,8 @@ def build_plan(name: str = "full") -> BenchPlan:
     for case, case_axes in axes.items():
         for device in devices:
             rows += _axis_rows(case, case_axes, device)
-        defaults[case] = BenchConfig(case, case_axes.resolutions[-1], case_axes.length, **default_numerics())
+        defaults[case] = BenchConfig(case, case_axes.resolutions[-1], case_axes.length, options=_case_options(case),
+                                     **default_numerics())
     if BenchCase.POUR in axes:
         reference = replace(defaults[BenchCase.POUR], particles_across=REFERENCE_ACROSS, pressure_solver=REFERENCE_SOLVER)
         skips = _skip_options("cpu")

@@ -144,7 +144,8 @@ def _describe(cfg: BenchConfig, default: BenchConfig) -> str:
         a, b = getattr(cfg, name), getattr(default, name)
         if a != b:
             diffs.append(f"{name} {getattr(a, 'value', a)}")
-    diffs += [f"{k} = {v}" for k, v in cfg.options]
+    diffs += [f"{k} = {v}" for k, v in cfg.options if (k, v) not in default.options]
+    diffs += [f"{k} unset" for k, v in default.options if k not in dict(cfg.options)]
     if cfg.length != default.length:
         diffs.append(f"length {cfg.length:g}")
     return ", ".join(diffs) or "**default**"
@@ -171,8 +172,10 @@ def markdown(plan: BenchPlan, results: dict[BenchConfig, dict], rows: list[Row],
         if case is BenchCase.POUR and plan.reference is not None:
             ref = results.get(plan.reference) or {}
             ended = f"; the reference simulated {ref['sim_s']:.2f} s" if ref.get("status") == "ok" else ""
+            held = ", ".join(f"{k} = {v:g}" for k, v in plan.reference.options)
             out.append(f"Errors against the reference pour `{plan.reference.label}`, whole pours: each row ends when its pour is "
-                       f"done, at most {plan.reference.length:g} s{ended} (cosim.bench.pour_compare).\n")
+                       f"done, at most {plan.reference.length:g} s{ended} (cosim.bench.pour_compare). Every pour row holds "
+                       f"the default scene's CFS head ({held}; cosim.bench.plan.equal_head_options).\n")
         out.append("| configuration | particles | simulated s | wall s | wall s per simulated s | "
                    + " | ".join(ERROR_TITLES[e] for e in errors) + " |")
         out.append("|---" * (4 + len(errors) + 1) + "|")
