@@ -6,10 +6,12 @@ resolution sweep (to compare the solvers at equal error); on every device presen
 fine reference (:data:`REFERENCE_ACROSS`, :data:`REFERENCE_SOLVER`) that its resolution and numerics rows are compared with, and the skip
 options: pairs of runs that differ only in what a scene may skip, the second doing the full work.
 
-Cost: the full plan finishes cold in about 40 minutes on a 2-core CPU, a third of it the 48-across WCSPH reference. The pour rows compared with the
-reference run the whole pour (the early stop ends each when its pour is done, at most :data:`POUR_SECONDS`): a
-window that ends before the outflow would rank them by the onset of the outflow alone. The skip-option pairs, which
-compare two runs with each other, run :data:`SKIP_PAIR_SECONDS`.
+Cost: the full plan finishes cold in about 40 minutes on a 2-core CPU, a third of it the 48-across WCSPH
+reference. The pour rows compared with the reference run the whole pour (the early stop ends each when its pour is
+done, at most :data:`POUR_SECONDS`), every one at the default scene's CFS head (:func:`equal_head_options`): a window
+that ends before the outflow would rank them by the onset of the outflow alone, and a head that follows the
+resolution by the controller's set point. The skip-option pairs, which compare two runs with each other, run
+:data:`SKIP_PAIR_SECONDS`.
 """
 
 from __future__ import annotations
