@@ -97,3 +97,18 @@ def test_scenes_and_the_validation_cases_take_the_setting():
     planned = FluidSettings(viscous_time_step=ViscousTimeStep.PLANNED_APPROACH)
     assert planned.fluid_config(0.191).viscous_time_step is ViscousTimeStep.PLANNED_APPROACH
     assert "viscous_time_step" in NUMERICS_FIELDS
+
+
+def test_dfsph_cfl_takes_the_fastest_approach_to_a_wall_or_the_expected_speed_whichever_is_larger():
+    cfg = FluidConfig(dim=2, spacing=SPACING, max_expected_speed=EXPECTED_SPEED)
+    planner = _planner("measured_approach")
+    step = lambda signal: cfg.cfl * cfg.smoothing_length / signal  # noqa: E731
+    # slow liquid in a moving vessel: the jet's expected speed is the floor, the wall's speed is not added to it
+    assert planner.limits(0.3, 0.5, GRAVITY).advection == pytest.approx(step(EXPECTED_SPEED), rel=1e-12)
+    # a particle at the measured speed against the fastest wall, once that outruns the floor
+    assert planner.limits(1.0, 3.0, GRAVITY).advection == pytest.approx(step(4.0), rel=1e-12)
+    assert planner.limits(0.0, 4.0, GRAVITY).advection == pytest.approx(step(4.0), rel=1e-12)
+    # WCSPH's acoustic signal still adds the flow's and the wall's speed to c0
+    wcsph = FluidConfig(dim=2, spacing=SPACING, max_expected_speed=EXPECTED_SPEED, pressure_solver="wcsph")
+    acoustic = TimeStepPlanner(wcsph).limits(0.3, 0.5, GRAVITY).advection
+    assert acoustic == pytest.approx(wcsph.cfl * wcsph.smoothing_length / (wcsph.sound_speed + 0.8), rel=1e-12)

@@ -79,8 +79,10 @@ class TimeStepPlanner:
     def limits(self, wall_speed: float, max_speed: float, max_accel: float) -> TimeStepLimits:
         """Each criterion's dt (s) for the liquid whose last interval reached ``max_speed`` (m/s) and ``max_accel``
         (m/s^2) in vessels whose walls move at up to ``wall_speed`` (m/s): the CFL condition dt <= cfl h / signal,
-        with the signal speed acoustic for WCSPH (c0 + the flow's and the wall's speed) and the flow's alone for DFSPH
-        (at least ``max_expected_speed``: a jet forms within an interval), and the force criterion; with
+        with the signal speed acoustic for WCSPH (c0 + the flow's and the wall's speed) and for DFSPH the fastest
+        approach the last interval allows, a particle at ``max_speed`` against a wall at ``wall_speed``, but at least
+        ``max_expected_speed`` (a jet forms within an interval; the floor is the jet's own speed relative to the
+        vessel it lands in, not a speed to add the walls' to), and the force criterion; with
         ``adaptive_time_step`` off, the fixed step alone. Either way the viscous diffusion criterion
         dt <= 0.125 h^2 / (nu + nu_art) (Morris, Fox and Zhu 1997, "Modeling low Reynolds number incompressible flows
         using SPH", J. Comput. Phys. 136), nu_art (:meth:`artificial_kinematic_viscosity`) at the approach speed
@@ -100,7 +102,7 @@ class TimeStepPlanner:
             if self.acoustic:
                 signal = self.sound_speed + max_speed + wall_speed
             else:
-                signal = flow_speed + wall_speed
+                signal = max(self.max_expected_speed, max_speed + wall_speed)
             advection = self.cfl * h / max(signal, 1e-9)
             force = FORCE_CFL * math.sqrt(h / max(max_accel, 1e-9))
             approach_speed = max_speed if self.measured_approach else flow_speed
