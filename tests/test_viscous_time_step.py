@@ -105,7 +105,7 @@ def test_dfsph_cfl_takes_the_fastest_approach_to_a_wall_or_the_expected_speed_wh
     step = lambda signal: cfg.cfl * cfg.smoothing_length / signal  # noqa: E731
     # slow liquid in a moving vessel: the jet's expected speed is the floor, the wall's speed is not added to it
     assert planner.limits(0.3, 0.5, GRAVITY).advection == pytest.approx(step(EXPECTED_SPEED), rel=1e-12)
-    # a particle at the measured speed against the fastest wall, once that outruns the floor
+    # a particle at the liquid's largest speed against the fastest wall, once that outruns the floor
     assert planner.limits(1.0, 3.0, GRAVITY).advection == pytest.approx(step(4.0), rel=1e-12)
     assert planner.limits(0.0, 4.0, GRAVITY).advection == pytest.approx(step(4.0), rel=1e-12)
     # WCSPH's acoustic signal still adds the flow's and the wall's speed to c0
