@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from controllers.catcher import fall_time
-from cosim.bench.landing_budget import LANDING_FILE, PARTICLES_FILE, SERIES_FILE, TERMS, ballistic_x, budget, decompose
+from cosim.bench.landing_budget import (LANDING_FILE, PARTICLES_FILE, SERIES_FILE, TERMS, StreamParticles, ballistic_x, budget,
+                                        decompose, stream_scatter)
 from cosim.coupling.landing import BAND_SPACINGS, MIN_FALL_SPEED_FRACTION
 from cosim.io.pour_series import COLUMNS, write_series_csv
 
@@ -19,15 +20,15 @@ EVERY = 5  # control steps between two launched particles
 SPEEDS = (0.37, 0.43)  # m/s, launch speeds along x, alternating
 
 
-def synthetic_run(folder, drift: float) -> float:
-    """A stream of single particles launched from the middle of the probe's window, one every EVERY steps, and
+def synthetic_run(folder, drift: float, every: int = EVERY) -> float:
+    """A stream of single particles launched from the middle of the probe's window, one every ``every`` steps, and
     ``drift`` (m/s) added to each one's x velocity after its launch but not to what it reports (a force in flight
     that the ballistic prediction does not know). Writes series.csv and particles.npz; returns the fall time (s)."""
     x0, z0 = LIP[0] + 2.5 * DX, LIP[1]
     fall = fall_time(z0 - RIM_Z, 0.0, G)
     steps = 200
     t = PERIOD * np.arange(steps)
-    launches = np.arange(10, steps - 40, EVERY)
+    launches = np.arange(10, steps - 40, every)
     n = len(launches)
     state = np.zeros((steps, n, 4))
     active = np.zeros((steps, n), bool)
@@ -81,3 +82,19 @@ def test_a_ballistic_stream_has_no_flight_term(tmp_path) -> None:
     b = budget(decompose(tmp_path))
     assert abs(b["flight"]["median_mm"]) < 0.2  # the crossing interpolated linearly between steps
     assert b["spread"]["median_abs_mm"] < 1e-3
+
+
+def test_the_stream_scatter_is_the_launch_velocities_spread_and_the_landings_half_width(tmp_path) -> None:
+    # a particle spends at most 22.5 ms in the window past its launch point (1.5 DX at 0.4 m/s): launched every two
+    # steps, a step's window holds two neighbours at most, one at each speed, each 30 mm/s off their mean; they land
+    # +-(SPEEDS[1] - SPEEDS[0]) / 2 * fall = 8.6 mm either side of the stream's centre
+    fall = synthetic_run(tmp_path, drift=0.0, every=2)
+    scatter = stream_scatter(StreamParticles(tmp_path))
+    assert scatter["window_steps"] > 5 and scatter["window_particles"] == 2
+    assert scatter["launch_vx_rms_mm_s"] == pytest.approx(1e3 * (SPEEDS[1] - SPEEDS[0]) / 2, rel=1e-6)
+    assert scatter["footprint_crossings"] > 20
+    assert scatter["footprint_median_abs_mm"] == pytest.approx(1e3 * (SPEEDS[1] - SPEEDS[0]) / 2 * fall, abs=1.0)
+    one_at_a_time = tmp_path / "sparse"
+    one_at_a_time.mkdir()
+    synthetic_run(one_at_a_time, drift=0.0)
+    assert stream_scatter(StreamParticles(one_at_a_time))["window_steps"] == 0  # no step holds two: nothing to spread

@@ -30,7 +30,8 @@ into terms that add up to it exactly:
 Reported per term: its median, mean and the median |error| left when the term is removed (the error it costs).
 Beside them: the catcher's offset, the measured landing less vessel B's smoothed centre (not a part of the
 prediction's error: the metric compares two landing points), and two predictions that are not the controller's
-(:func:`reference_predictions`).
+(:func:`reference_predictions`), and how coherent the stream is (:func:`stream_scatter`: the spread of its launch
+v_x about the window's mean, its footprint at the rim plane).
 """
 
 from __future__ import annotations
@@ -189,7 +190,7 @@ def decompose(run: Path) -> dict:
             "catcher_offset": measured - (sp.home_x + float(s["smoothed_catcher_dx"][k])),
         })
     return {"samples": len(steps), "decomposed": len(rows), "skipped": skipped, "rows": rows,
-            "references": reference_predictions(sp, steps, predicted)}
+            "references": reference_predictions(sp, steps, predicted), "scatter": stream_scatter(sp)}
 
 
 def all_crossings(sp: StreamParticles) -> tuple[np.ndarray, np.ndarray]:
@@ -243,6 +244,43 @@ def reference_predictions(sp: StreamParticles, steps: np.ndarray, predicted: np.
     }
 
 
+def stream_scatter(sp: StreamParticles) -> dict:
+    """How coherent the stream is where the controller measures it and where it lands, over CFS (the flowing
+    steps, as the budget's samples):
+
+    ``launch_vx_rms_mm_s``: the root mean square over every particle in the probe's launch window at every control
+    step holding two or more of its v_x's deviation from that step's window mean (mm/s): the velocity noise the
+    controller's mean launch state averages over and a single particle lands with (a particle's landing moves by its
+    v_x deviation times the fall time; v_z is left out, as it varies across the window's height by gravity alone);
+    ``window_particles``: the median count in the window at those steps; ``footprint_median_abs_mm``: the median over every rim-plane
+    crossing of |x - the mean x of the other crossings within RATE_WINDOW / 2| (mm), the stream's half width where
+    it lands, the single-sample floor that ``stream_centre`` scores on the samples alone."""
+    s = sp.series
+    flowing = np.isfinite(s["landing_fall_time"]) & np.isin(s["phase"], ("cfs", "cfs_final"))
+    deviations, counts = [], []
+    for k in np.flatnonzero(flowing):
+        vx = sp.state[k, sp.in_window[k], 2]
+        if len(vx) >= 2:
+            deviations.append(vx - vx.mean())
+            counts.append(len(vx))
+    rms = math.sqrt(float(np.mean(np.concatenate(deviations) ** 2))) if deviations else math.nan
+    times, xs = all_crossings(sp)
+    cfs = np.interp(times, sp.t, flowing.astype(float)) > 0.5
+    offsets = []
+    for i in np.flatnonzero(cfs):
+        near = np.abs(times - times[i]) <= 0.5 * RATE_WINDOW
+        near[i] = False
+        if near.any():
+            offsets.append(xs[i] - xs[near].mean())
+    return {
+        "launch_vx_rms_mm_s": 1e3 * rms,
+        "window_steps": len(counts),
+        "window_particles": float(np.median(counts)) if counts else 0.0,
+        "footprint_median_abs_mm": 1e3 * float(np.median(np.abs(offsets))) if offsets else math.nan,
+        "footprint_crossings": len(offsets),
+    }
+
+
 def budget(decomposition: dict) -> dict:
     """Per term: median, mean (mm) and the median |error| (mm) left with that term removed; the error's own."""
     rows = decomposition["rows"]
@@ -257,6 +295,7 @@ def budget(decomposition: dict) -> dict:
         if term in TERMS:
             out[term]["without_mm"] = 1e3 * float(np.median(np.abs(error - v)))
     out["references"] = decomposition["references"]
+    out["scatter"] = decomposition["scatter"]
     return out
 
 
@@ -282,6 +321,11 @@ def report(b: dict) -> str:
               f"stream's centre known exactly: {r['stream_centre_median_abs_mm']:.2f} mm; launched from the crest and head: "
               f"{r['crest_head_median_abs_mm']:.2f} mm (mean {r['crest_head_mean_mm']:+.2f} mm); launch point "
               f"{r['launch_point_past_lip_mm'][0]:.1f} mm past the lip, {r['launch_point_past_lip_mm'][1]:+.1f} mm above it"]
+    sc = b["scatter"]
+    lines.append(f"the stream's scatter: launch v_x about the window's mean, rms {sc['launch_vx_rms_mm_s']:.1f} mm/s "
+                 f"({sc['window_steps']} steps, median "
+                 f"{sc['window_particles']:.0f} particles in the window); footprint at the rim plane, median "
+                 f"|x - centre| {sc['footprint_median_abs_mm']:.2f} mm ({sc['footprint_crossings']} crossings)")
     return "\n".join(lines)
 
 
