@@ -98,3 +98,15 @@ def test_the_stream_scatter_is_the_launch_velocities_spread_and_the_landings_hal
     one_at_a_time.mkdir()
     synthetic_run(one_at_a_time, drift=0.0)
     assert stream_scatter(StreamParticles(one_at_a_time))["window_steps"] == 0  # no step holds two: nothing to spread
+
+
+def test_a_particle_sample_after_the_series_last_row_is_left_out(tmp_path) -> None:
+    # a run cut off by its duration samples the particles after its last step, which no series row follows
+    synthetic_run(tmp_path, drift=0.0)
+    data = dict(np.load(tmp_path / PARTICLES_FILE))
+    complete = StreamParticles(tmp_path).state
+    data["t"] = np.append(data["t"], data["t"][-1] + PERIOD)
+    data["state"] = np.concatenate([data["state"], data["state"][-1:]])
+    data["active"] = np.concatenate([data["active"], data["active"][-1:]])
+    np.savez_compressed(tmp_path / PARTICLES_FILE, **data)
+    np.testing.assert_array_equal(StreamParticles(tmp_path).state, complete)

@@ -120,11 +120,14 @@ class StreamParticles:
         self.t = s["t"].astype(float)
         period = float(np.median(np.diff(self.t)))
         rows = np.rint(data["t"] / period).astype(int)  # series row of each particle sample
+        # a run cut off by its duration samples the particles after its last step, which no series row follows
+        logged = rows < len(self.t)
+        rows = rows[logged]
         n = data["state"].shape[1]
         self.state = np.full((len(self.t), n, 4), np.nan)
-        self.state[rows] = data["state"]
+        self.state[rows] = data["state"][logged]
         inactive = np.zeros((len(self.t), n), bool)
-        inactive[rows] = ~data["active"]
+        inactive[rows] = ~data["active"][logged]
         self.state[inactive] = np.nan
         self.dx, self.gravity = float(data["spacing"]), float(data["gravity"])
         self.home_x = float(data["catcher_home_x"])
