@@ -5,6 +5,7 @@ import json
 import pytest
 
 from cosim.cli.main import main
+from cosim.cli.validate import _parse_setting
 
 
 def test_json_contract_of_each_case(capsys, tmp_path):
@@ -68,8 +69,14 @@ def test_a_tank_rounded_to_whole_spacings_says_so(capsys):
 @pytest.mark.parametrize("argv", [["validate", "nope"], ["validate", "slosh", "--width", "-1"], ["validate", "--spacing", "nan"],
                                   ["validate", "hydrostatic", "--device", "tpu"], ["validate", "--density-tolerance", "-1"],
                                   ["validate", "slosh-plant", "--shape", "cylinder"], ["validate", "slosh-plant", "--spacing", "0.05"],
-                                  ["validate", "dam-break", "--gate-speed", "0"], ["validate", "dam-break", "--gate-speed", "inf"]])
+                                  ["validate", "dam-break", "--gate-speed", "0"], ["validate", "dam-break", "--gate-speed", "inf"],
+                                  ["validate", "hydrostatic", "--free-liquid", "maybe"]])
 def test_bad_input_exits_2_with_one_line(argv, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("cosim validate: error:")
+
+
+@pytest.mark.parametrize(("text", "value"), [("true", True), ("False", False), (" false ", False)])
+def test_a_switch_is_read_from_true_or_false(text, value):
+    assert _parse_setting("free_liquid", text) is value
