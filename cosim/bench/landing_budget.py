@@ -37,6 +37,7 @@ v_x about the window's mean, its footprint at the rim plane).
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import sys
@@ -146,6 +147,11 @@ class StreamParticles:
         min_speed = MIN_FALL_SPEED_FRACTION * np.sqrt(2.0 * self.gravity * np.maximum(s["lip_z"] - s["catcher_rim_z"], 0.0))
         self.in_band = (np.abs(z - rim) <= BAND_SPACINGS * self.dx) & (self.state[..., 3] < -min_speed[:, None])
 
+    @functools.cached_property
+    def crossings(self) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`all_crossings` of this run, found once for every statistic that reads them."""
+        return all_crossings(self)
+
     def launch_step(self, i: int, k: int) -> int | None:
         """The last step at or before ``k`` at which particle ``i`` was in the launch window (None: never)."""
         steps = np.flatnonzero(self.in_window[: k + 1, i])
@@ -225,7 +231,7 @@ def reference_predictions(sp: StreamParticles, steps: np.ndarray, predicted: np.
     position past the lip (median over the flowing steps, mm)."""
     s = sp.series
     measured = s["landing_measured_x"][steps]
-    times, xs = all_crossings(sp)
+    times, xs = sp.crossings
     centre = []
     for k in steps:
         near = (np.abs(times - sp.t[k]) <= 0.5 * RATE_WINDOW) & (np.abs(times - sp.t[k]) > 0.5 * (sp.t[1] - sp.t[0]))
@@ -267,7 +273,7 @@ def stream_scatter(sp: StreamParticles) -> dict:
             deviations.append(vx - vx.mean())
             counts.append(len(vx))
     rms = math.sqrt(float(np.mean(np.concatenate(deviations) ** 2))) if deviations else math.nan
-    times, xs = all_crossings(sp)
+    times, xs = sp.crossings
     cfs = np.interp(times, sp.t, flowing.astype(float)) > 0.5
     offsets = []
     for i in np.flatnonzero(cfs):
