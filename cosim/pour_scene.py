@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityIteration, DivergenceConstraint, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, ParticleShifting, PressureSolver, TensionTreatment, ViscousTimeStep, WallModel, WallPressure
+from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityDiffusionTerm, DensityIteration, DivergenceConstraint, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, ParticleShifting, PressureSolver, TensionTreatment, ViscousTimeStep, WallModel, WallPressure
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -90,6 +90,7 @@ class FluidSettings:
     max_tension: float = like(FluidConfig, "max_tension")
     tension_treatment: TensionTreatment = like(FluidConfig, "tension_treatment")
     density_diffusion: float = like(FluidConfig, "density_diffusion")
+    density_diffusion_term: DensityDiffusionTerm = like(FluidConfig, "density_diffusion_term")
     # ---- DFSPH
     density_iteration: DensityIteration = like(FluidConfig, "density_iteration")
     density_tolerance: float | None = like(FluidConfig, "density_tolerance")

@@ -36,7 +36,7 @@ DEFAULT_OUT = Path("recordings") / "validate"
 # and described from its declaration; not given, the default scene's value (`cosim scene --dump`)
 NUMERICS_OPTIONS = ("free_liquid", "density_iteration", "density_tolerance", "divergence_constraint", "wall_model", "wall_pressure", "initial_state", "free_liquid_rule",
                     "free_surface_threshold", "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity",
-                    "artificial_viscosity_beta", "max_tension", "tension_treatment", "particle_shifting", "shifting_coefficient", "viscous_time_step")
+                    "artificial_viscosity_beta", "max_tension", "tension_treatment", "density_diffusion_term", "particle_shifting", "shifting_coefficient", "viscous_time_step")
 
 
 def register(subparsers, summary: str) -> None:

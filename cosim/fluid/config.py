@@ -94,6 +94,13 @@ class TensionTreatment(Enum):
     TIC = "tic"  # Sun et al. (2018)'s tensile-instability control (p_j - p_i where p_i < 0 away from the surface), no clamp
 
 
+class DensityDiffusionTerm(Enum):
+    """The form of WCSPH's delta-SPH density diffusion (``cosim.fluid.wcsph.add_liquid_density_rate``)."""
+
+    ANTUONO = "antuono"  # 2 (rho_j - rho_i) less the renormalised gradients' linear part (Antuono et al. 2010)
+    FOURTAKAS = "fourtakas"  # 2 (rho_j - rho_i) less the pair's hydrostatic density difference (Fourtakas et al. 2019)
+
+
 class ParticleShifting(Enum):
     """Whether particles are shifted toward uniform spacing each substep (``cosim.fluid.shifting``)."""
 
@@ -312,6 +319,13 @@ class FluidConfig:
                                                   "does not clump particles). docs/tensile_control.md.")
     density_diffusion: float = setting(0.1, WCSPH, "delta of delta-SPH density diffusion (Antuono et al. 2010, "
                                        "renormalised density gradient).", "", 0.0, 1.0)
+    density_diffusion_term: DensityDiffusionTerm = setting(DensityDiffusionTerm.ANTUONO, WCSPH, "The density "
+                                                          "diffusion's pair term: 'antuono' (Antuono et al. 2010: "
+                                                          "2 (rho_j - rho_i) less the linear part the renormalised "
+                                                          "density gradients give) or 'fourtakas' (Fourtakas et al. "
+                                                          "2019: 2 (rho_j - rho_i) less the pair's hydrostatic density "
+                                                          "difference from the Tait equation, no gradient estimated). "
+                                                          "docs/density_diffusion.md.")
     # ---- DFSPH
     density_iteration: DensityIteration = setting(DensityIteration.GAUSS_SEIDEL, DFSPH, "How the density solve "
                                                   "iterates (the divergence solve is Jacobi): 'gauss_seidel' relaxes "

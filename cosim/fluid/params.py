@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import warp as wp
 
-from cosim.fluid.config import FluidConfig
+from cosim.fluid.config import DensityDiffusionTerm, FluidConfig
 from cosim.fluid.sph_kernels import KERNEL_IDS, kernel_sigma, lattice_gradient_square_sum, lattice_jacobi_gain, lattice_kernel_sum
 
 # DFSPH's Jacobi solves diverge once one step's gain (cosim.fluid.sph_kernels.lattice_jacobi_gain) exceeds about 4
@@ -23,7 +23,8 @@ class SPHParams:
     viscosity of pairs with free liquid (:attr:`FluidConfig.free_liquid_alpha`); ``viscosity_speed`` (m/s) and
     ``viscosity_approach_weight`` the c and beta of the artificial viscosity's velocity scale
     (``FluidConfig.viscosity_speed``); ``max_tension`` (Pa) the clamp of WCSPH's negative pressure (``FluidConfig.tension_limit``),
-    reached at ``tension_density`` (kg/m^3); ``eta2`` = 0.01 h^2 (m^2); then DFSPH's stopping rule (relative
+    reached at ``tension_density`` (kg/m^3); ``hydrostatic_diffusion`` 1 where WCSPH's density diffusion subtracts the
+    pair's hydrostatic density difference (``FluidConfig.density_diffusion_term`` 'fourtakas'); ``eta2`` = 0.01 h^2 (m^2); then DFSPH's stopping rule (relative
     tolerances and the iteration cap of each solve) and ``lattice_density``, the summation density of a resting
     lattice over rho0 (DFSPH and WCSPH's free liquid divide their summation density by it, so the liquid as seeded
     is at rest density) and ``lattice_factor_denominator``, sum_j |m grad W|^2 of a particle inside that lattice
@@ -51,6 +52,7 @@ class SPHParams:
     max_tension: float
     tension_density: float
     delta: float
+    hydrostatic_diffusion: int
     eta2: float
     gravity: wp.vec3
     n_vessels: int
@@ -90,6 +92,7 @@ def make_params(cfg: FluidConfig, n_vessels: int, atomic_replicas: int = 1, dens
     p.viscosity_approach_weight = cfg.viscosity_approach_weight
     p.max_tension = cfg.tension_limit
     p.delta = cfg.density_diffusion
+    p.hydrostatic_diffusion = int(cfg.density_diffusion_term is DensityDiffusionTerm.FOURTAKAS)
     p.eta2 = 0.01 * h * h
     p.gravity = wp.vec3(*cfg.gravity)
     p.n_vessels = n_vessels

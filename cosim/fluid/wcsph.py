@@ -346,15 +346,38 @@ def compute_forces(
 
 
 @wp.func
+def hydrostatic_density_difference(prm: SPHParams, r: wp.vec3) -> float:
+    """rho^H_i - rho^H_j (kg/m^3) of a liquid at rest under gravity g between particle i and particle j = i - r:
+    the Tait equation p = B ((rho / rho0)^gamma - 1) solved for the density at the hydrostatic pressure difference
+    rho0 g . r (Pa; positive where i lies deeper), rho0 ((1 + rho0 g . r / B)^(1/gamma) - 1)."""
+    return prm.rest_density * (wp.pow(1.0 + prm.rest_density * wp.dot(prm.gravity, r) / prm.eos_b, 1.0 / prm.gamma) - 1.0)
+
+
+@wp.func
 def add_liquid_density_rate(
     prm: SPHParams, dr: float, diffusion: float, rhoi: float, grad_i: wp.vec3, vi: wp.vec3, r: wp.vec3, r2: float, gw: wp.vec3,
     vj: wp.vec3, rhoj: float, grad_j: wp.vec3, mj: float,
 ) -> float:
     """The density rate sum ``dr`` (kg/m^3/s) with a liquid neighbour j's share added: continuity
     m_j v_ij . grad W, then delta-SPH diffusion ``diffusion`` (m_j / rho_j) psi_ij (``diffusion`` = delta h c0,
-    m^2/s), at the kicked velocities vi, vj (m/s); r = x_i - x_j (m), r2 = r . r, gw = grad_i W."""
+    m^2/s), at the kicked velocities vi, vj (m/s); r = x_i - x_j (m), r2 = r . r, gw = grad_i W. psi_ij:
+
+    - Antuono et al. (2010): 2 (rho_i - rho_j) r . grad W / (r^2 + eta^2) - (<grad rho>_i + <grad rho>_j) . grad W,
+      the renormalised gradients ``grad_i``, ``grad_j`` removing a linear density field's share;
+    - ``prm.hydrostatic_diffusion`` (Fourtakas, Dominguez, Vacondio & Rogers 2019, "Local uniform stencil (LUST)
+      boundary condition for arbitrary 3-D boundaries in parallel smoothed particle hydrodynamics (SPH) models",
+      Comput. Fluids 190): 2 (rho_i - rho_j - rho^H_ij) r . grad W / (r^2 + eta^2), where
+      rho^H_ij = rho0 ((1 + rho0 g . r / B)^(1/gamma) - 1) is the density difference the Tait equation gives a
+      resting liquid between the pair's heights (:func:`hydrostatic_density_difference`): only the dynamic density
+      diffuses, and no gradient is estimated: a resting column's hydrostatic profile is not diffused whatever the
+      support, also where a wall or the free surface cuts it and the renormalised gradient is only approximate
+      (docs/density_diffusion.md)."""
     dr += mj * wp.dot(vi - vj, gw)
-    psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + grad_j, gw)
+    psi = float(0.0)
+    if prm.hydrostatic_diffusion != 0:
+        psi = 2.0 * (rhoi - rhoj - hydrostatic_density_difference(prm, r)) * wp.dot(r, gw) / (r2 + prm.eta2)
+    else:
+        psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + grad_j, gw)
     return dr + diffusion * (mj / rhoj) * psi
 
 
