@@ -317,8 +317,8 @@ class FluidConfig:
                                                   "free-surface region, Marrone et al. 2010's indicator at or below "
                                                   "0.75, and p_j - p_i where p_i < 0 inside the liquid, so tension "
                                                   "does not clump particles). docs/tensile_control.md.")
-    density_diffusion: float = setting(0.1, WCSPH, "delta of delta-SPH density diffusion (Antuono et al. 2010, "
-                                       "renormalised density gradient).", "", 0.0, 1.0)
+    density_diffusion: float = setting(0.1, WCSPH, "delta of delta-SPH density diffusion, D = delta h c0 "
+                                       "sum_j V_j psi_ij (its pair term psi_ij: density_diffusion_term).", "", 0.0, 1.0)
     density_diffusion_term: DensityDiffusionTerm = setting(DensityDiffusionTerm.ANTUONO, WCSPH, "The density "
                                                           "diffusion's pair term: 'antuono' (Antuono et al. 2010: "
                                                           "2 (rho_j - rho_i) less the linear part the renormalised "
