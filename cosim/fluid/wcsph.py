@@ -253,7 +253,8 @@ def compute_forces(
 ):
     """Acceleration of each particle, the reaction it exerts on each vessel (per particle, reduced later) and its
     renormalised density gradient <grad rho>^L = L^-1 sum_j V_j (rho_j - rho_i) grad W, L = sum_j V_j (x_j - x_i)
-    (x) grad W (Antuono et al. 2010; liquid neighbours only; zero where L is too ill-conditioned to invert). Also
+    (x) grad W (Antuono et al. 2010; liquid neighbours only; zero where L is too ill-conditioned to invert, and under
+    ``FluidConfig.density_diffusion_term`` 'fourtakas', whose diffusion does not read it). Also
     the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``:
     grad_i W), in the order of the neighbour loop, which compute_density_rate sums over instead of searching the
     cells again (``record_pairs`` 0: none kept, compute_density_rate_walking walks them again); more than
@@ -284,6 +285,8 @@ def compute_forces(
     free_i = free[i]
     alpha_wall = wp.where(free_i != 0, prm.alpha_free, prm.alpha)
     a = wp.vec3(0.0)
+    # the renormalised density gradient is read only by Antuono et al.'s diffusion term
+    density_gradient = prm.hydrostatic_diffusion == 0
     moment = wp.mat33(0.0)
     gsum = wp.vec3(0.0)
     radius2 = prm.support * prm.support
@@ -305,9 +308,10 @@ def compute_forces(
             mj = mass[j]
             vij = vi - v[j]
             rhoj = rho[j]
-            vol = mj / rhoj
-            moment += renormalisation_term(vol, r, gw)
-            gsum += (vol * (rhoj - rhoi)) * gw
+            if density_gradient:
+                vol = mj / rhoj
+                moment += renormalisation_term(vol, r, gw)
+                gsum += (vol * (rhoj - rhoi)) * gw
             a -= mj * pressure_pair_factor(tic, own, rhoi, p[j], rhoj) * gw
             alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
             a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
@@ -336,11 +340,12 @@ def compute_forces(
         pair_count[i] = wp.min(count, capacity)
     a += prm.gravity
     acc[i] = a
-    if prm.dim == 2:
-        moment[1, 1] = 1.0
     grad = wp.vec3(0.0)
-    if wp.determinant(moment) > RENORMALISATION_MIN_DET:
-        grad = wp.inverse(moment) @ gsum
+    if density_gradient:
+        if prm.dim == 2:
+            moment[1, 1] = 1.0
+        if wp.determinant(moment) > RENORMALISATION_MIN_DET:
+            grad = wp.inverse(moment) @ gsum
     rho_grad[i] = grad
     wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_ACCEL, wp.length(a))
 
