@@ -1,7 +1,8 @@
 """WCSPH's delta-SPH density diffusion, pair by pair (``cosim.fluid.wcsph.add_liquid_density_rate``): the
 'fourtakas' term (``FluidConfig.density_diffusion_term``) diffuses only the density a pair holds beyond the Tait
-equation's hydrostatic difference between their heights; the 'antuono' term relies on the renormalised gradients
-for that, and without them diffuses the hydrostatic difference itself."""
+equation's hydrostatic difference between their heights, and of a particle expanded past the tension clamp only
+the density its pressure sees; the 'antuono' term relies on the renormalised gradients for the hydrostatic part,
+and without them diffuses the hydrostatic difference itself."""
 
 from __future__ import annotations
 
@@ -16,7 +17,7 @@ from cosim.fluid.sph_kernels import kernel_dw
 from cosim.fluid.wcsph import add_liquid_density_rate, hydrostatic_density_difference
 
 DX = 0.005  # m
-RHO_J = 1000.2  # kg/m^3, the upper particle's density
+RHO_J = 1001.0  # kg/m^3, the upper particle's density (compressed: every test's pair but the expanded one's lies above rho0)
 
 
 @wp.kernel
@@ -30,10 +31,12 @@ def _pair_rate(prm: SPHParams, r: wp.vec3, rho_i: float, rho_j: float, grad: wp.
     out[1] = hydrostatic_density_difference(prm, r)
 
 
-def _rate(term: str, below: float, rho_i: float, grad: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> tuple[float, float]:
+def _rate(
+    term: str, below: float, rho_i: float, grad: tuple[float, float, float] = (0.0, 0.0, 0.0), **settings: object
+) -> tuple[float, float]:
     """Particle i's density rate (kg/m^3/s) from a neighbour j at rest ``below`` m above it, and the pair's
-    hydrostatic density difference rho^H_i - rho^H_j (kg/m^3)."""
-    cfg = FluidConfig(dim=2, spacing=DX, pressure_solver="wcsph", max_expected_speed=1.0, density_diffusion_term=term)
+    hydrostatic density difference rho^H_i - rho^H_j (kg/m^3); ``settings``: more FluidConfig fields."""
+    cfg = FluidConfig(dim=2, spacing=DX, pressure_solver="wcsph", max_expected_speed=1.0, density_diffusion_term=term, **settings)
     out = wp.zeros(2, dtype=float, device="cpu")
     r = wp.vec3(0.0, 0.0, -below)  # r = x_i - x_j: i lies below j
     wp.launch(_pair_rate, 1, inputs=[make_params(cfg, 1), r, rho_i, RHO_J, wp.vec3(*grad), out], device="cpu")
@@ -75,3 +78,23 @@ def test_fourtakas_diffuses_the_dynamic_density_from_the_denser_particle(excess)
     # the same dynamic difference diffuses at the same rate as Antuono's term would with no density gradient
     level, _ = _rate("antuono", DX, RHO_J + excess)
     assert rate == pytest.approx(level, rel=1e-3)  # float32 densities: 6e-5 kg/m^3 of 0.5
+
+
+def test_without_tension_fourtakas_diffuses_an_expanded_particle_at_rho0():
+    """Below rho0 a particle without tension has no pressure: its deficit is a void, not a density to spread into
+    the liquid around it (whose pressure nothing would give back). The pair term reads max(rho, rho0)."""
+    at_rest_density, _ = _rate("fourtakas", DX, 1000.0, max_tension=0.0)
+    for expanded in (999.0, 990.0, 850.0):
+        rate, _ = _rate("fourtakas", DX, expanded, max_tension=0.0)
+        assert rate == at_rest_density
+    assert at_rest_density > 0.0  # i still takes the compressed neighbour's excess over rho0 (its dynamic density)
+
+
+def test_under_a_tension_clamp_fourtakas_reads_the_density_down_to_the_clamp():
+    cfg = FluidConfig(dim=2, spacing=DX, pressure_solver="wcsph", max_expected_speed=1.0, max_tension=1000.0)
+    rho_t = make_params(cfg, 1).tension_density  # kg/m^3, where the Tait pressure reaches -1 kPa
+    assert 980.0 < rho_t < 999.0
+    stretched, _ = _rate("fourtakas", DX, 999.0, max_tension=1000.0)
+    assert stretched > _rate("fourtakas", DX, 1000.0, max_tension=1000.0)[0]  # the tension it carries is diffused
+    past, _ = _rate("fourtakas", DX, rho_t - 5.0, max_tension=1000.0)
+    assert past == pytest.approx(_rate("fourtakas", DX, rho_t, max_tension=1000.0)[0], rel=1e-5)

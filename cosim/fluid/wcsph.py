@@ -371,16 +371,22 @@ def add_liquid_density_rate(
       the renormalised gradients ``grad_i``, ``grad_j`` removing a linear density field's share;
     - ``prm.hydrostatic_diffusion`` (Fourtakas, Dominguez, Vacondio & Rogers 2019, "Local uniform stencil (LUST)
       boundary condition for arbitrary 3-D boundaries in parallel smoothed particle hydrodynamics (SPH) models",
-      Comput. Fluids 190): 2 (rho_i - rho_j - rho^H_ij) r . grad W / (r^2 + eta^2), where
+      Comput. Fluids 190): 2 (rho~_i - rho~_j - rho^H_ij) r . grad W / (r^2 + eta^2), where
       rho^H_ij = rho0 ((1 + rho0 g . r / B)^(1/gamma) - 1) is the density difference the Tait equation gives a
       resting liquid between the pair's heights (:func:`hydrostatic_density_difference`): only the dynamic density
       diffuses, and no gradient is estimated: a resting column's hydrostatic profile is not diffused whatever the
-      support, also where a wall or the free surface cuts it and the renormalised gradient is only approximate
-      (docs/density_diffusion.md)."""
+      support, also where a wall or the free surface cuts it and the renormalised gradient is only approximate.
+      rho~ = max(rho, rho_t), rho_t the density at which the tension clamp binds (``prm.tension_density``; rho0
+      without tension, 0 under tensile-instability control): the density the pressure sees. Below rho_t a particle
+      is a void the pressure ignores; diffusing its deficit into the liquid around it would take pressure from
+      liquid that is not expanded, and without tension nothing gives it back: a caught pool's floor loses its
+      hydrostatic pressure and the liquid sinks into the wall (a departure from Fourtakas et al., who keep
+      tension; docs/density_diffusion.md)."""
     dr += mj * wp.dot(vi - vj, gw)
     psi = float(0.0)
     if prm.hydrostatic_diffusion != 0:
-        psi = 2.0 * (rhoi - rhoj - hydrostatic_density_difference(prm, r)) * wp.dot(r, gw) / (r2 + prm.eta2)
+        dynamic = wp.max(rhoi, prm.tension_density) - wp.max(rhoj, prm.tension_density) - hydrostatic_density_difference(prm, r)
+        psi = 2.0 * dynamic * wp.dot(r, gw) / (r2 + prm.eta2)
     else:
         psi = 2.0 * (rhoi - rhoj) * wp.dot(r, gw) / (r2 + prm.eta2) - wp.dot(grad_i + grad_j, gw)
     return dr + diffusion * (mj / rhoj) * psi
