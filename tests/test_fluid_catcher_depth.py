@@ -112,11 +112,11 @@ def test_caught_liquid_takes_the_tank_depth_stays_in_it_and_weighs_its_volume(so
     assert abs(caught.weight / caught.reference_weight - 1.0) <= WEIGHT_TOLERANCE, caught
 
 
-# WCSPH's default (one alpha with Monaghan's beta = 2) stands short beyond the tolerance: its interior packs closer
-# than the tank's lattice, as every WCSPH variant's does, and its top rows lie lower than the free-liquid alpha's,
-# which left loose free particles on top (docs/wcsph_knobs.md, "Where the height goes"). A known failure, reported
-# as one: strict, so that it reports when it starts passing.
-HEIGHT_XFAIL = {"wcsph": "WCSPH's default caught column stands short of V / (d w) (docs/wcsph_knobs.md)"}
+# WCSPH's default (no tension, Fourtakas et al.'s density diffusion read at the pressure's density; one alpha with
+# Monaghan's beta = 2) stands short beyond the tolerance, as the former default (the 1 kPa clamp) did: its interior
+# packs closer than the tank's lattice, as every WCSPH variant's does (docs/wcsph_knobs.md, "Where the height goes";
+# docs/density_diffusion.md). A known failure, reported as one: strict, so that it reports when it starts passing.
+HEIGHT_XFAIL = {"wcsph": "WCSPH's default caught column stands short of V / (d w) (docs/density_diffusion.md)"}
 
 
 @pytest.mark.parametrize(

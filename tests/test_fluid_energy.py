@@ -54,12 +54,14 @@ def test_a_lift_balances_the_walls_work_against_the_liquids_energy(solver_name):
 def test_liquid_momentum_changes_by_gravity_minus_the_walls_reaction_guard_impulses_included():
     # WCSPH on a coarse grid tilted at 2 rad/s: the guard (shared by both solvers) corrects particles at the walls
     # (counted below), so the balance holds only if its impulses are in the reaction wrench. (DFSPH's
-    # pressure-carrying walls keep its particles off the guard in this tilt, and so does WCSPH's default quadratic
-    # viscosity: the former free-liquid alpha 0.25, which turns it off, is set to keep the guard acting.)
+    # pressure-carrying walls keep its particles off the guard in this tilt, and so does WCSPH's default: its quadratic
+    # viscosity and, without tension, its hydrostatic density diffusion. The former free-liquid alpha 0.25, the 1 kPa
+    # tension clamp and Antuono et al.'s diffusion are set to keep the guard acting.)
     spec = seed_pouring_vessel()
     lo, hi = domain_around(spec, 0.0)
     cfg = FluidConfig(dim=2, spacing=spec.inner_width / 12, pressure_solver="wcsph", max_expected_speed=1.4,
-                      domain_min=lo, domain_max=hi, free_artificial_viscosity=0.25)
+                      domain_min=lo, domain_max=hi, free_artificial_viscosity=0.25, max_tension=1000.0,
+                      density_diffusion_term="antuono")
     pose_at = tilt_about_lip(spec, 2.0, math.pi / 2)
     solver = FluidSolver(cfg, [spec], [pose_at(0.0)], fill_vessel(spec, 0.5 * spec.inner_height, cfg), device="cpu")
     mass = cfg.rest_density * cfg.particle_volume

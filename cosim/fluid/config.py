@@ -302,11 +302,13 @@ class FluidConfig:
     # ---- WCSPH
     gamma: float = setting(7.0, WCSPH, "Tait exponent of the equation of state p = rho0 c0^2 / gamma ((rho / rho0)^gamma "
                            "- 1) (Camporredondo et al. 2019).", "", 1.0, 10.0)
-    max_tension: float = setting(1000.0, WCSPH, "tension_treatment 'clamp': the most tension (negative pressure) "
-                                 "the bound liquid carries, p = max(Tait, -max_tension): tension holds the "
-                                 "continuity-density liquid together, but a film stretched at a rim can reach tens of "
-                                 "kPa and fling its particles; 1 kPa is the hydrostatic pressure of 10 cm of water. "
-                                 "Used by 'clamp' only.", "Pa", 0.0, 1.0e6)
+    max_tension: float = setting(0.0, WCSPH, "tension_treatment 'clamp': the most tension (negative pressure) "
+                                 "the bound liquid carries, p = max(Tait, -max_tension). 0: none, the liquid only "
+                                 "pushes (as DFSPH's, and SPlisHSPlasH's WCSPH, whose density is floored at rho0): "
+                                 "tension pulls a stream's particles back as pairs part, which made WCSPH's stream "
+                                 "twice as noisy as DFSPH's (docs/landing.md). Without tension the density "
+                                 "diffusion must leave the hydrostatic profile alone (density_diffusion_term "
+                                 "'fourtakas', docs/density_diffusion.md). Used by 'clamp' only.", "Pa", 0.0, 1.0e6)
     tension_treatment: TensionTreatment = setting(TensionTreatment.CLAMP, WCSPH, "How the pressure gradient treats "
                                                   "negative pressure: 'symmetric' (Monaghan's symmetric sum m_j (p_i "
                                                   "/ rho_i^2 + p_j / rho_j^2) grad W for every pair, the Tait tension "
@@ -319,13 +321,14 @@ class FluidConfig:
                                                   "does not clump particles). docs/tensile_control.md.")
     density_diffusion: float = setting(0.1, WCSPH, "delta of delta-SPH density diffusion, D = delta h c0 "
                                        "sum_j V_j psi_ij (its pair term psi_ij: density_diffusion_term).", "", 0.0, 1.0)
-    density_diffusion_term: DensityDiffusionTerm = setting(DensityDiffusionTerm.ANTUONO, WCSPH, "The density "
+    density_diffusion_term: DensityDiffusionTerm = setting(DensityDiffusionTerm.FOURTAKAS, WCSPH, "The density "
                                                           "diffusion's pair term: 'antuono' (Antuono et al. 2010: "
                                                           "2 (rho_j - rho_i) less the linear part the renormalised "
                                                           "density gradients give) or 'fourtakas' (Fourtakas et al. "
                                                           "2019: 2 (rho_j - rho_i) less the pair's hydrostatic density "
-                                                          "difference from the Tait equation, no gradient estimated). "
-                                                          "docs/density_diffusion.md.")
+                                                          "difference from the Tait equation, no gradient estimated, "
+                                                          "each density read no lower than where the tension clamp "
+                                                          "binds). docs/density_diffusion.md.")
     # ---- DFSPH
     density_iteration: DensityIteration = setting(DensityIteration.GAUSS_SEIDEL, DFSPH, "How the density solve "
                                                   "iterates (the divergence solve is Jacobi): 'gauss_seidel' relaxes "

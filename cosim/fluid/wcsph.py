@@ -542,11 +542,10 @@ def integrate(
     x_old = x[i]
     vi = v[i] + h * acc[i]
     xi = x_old + h * vi
-    # Tension is kept (continuity WCSPH: it holds jets together and pulls loose particles back into the liquid);
-    # a floor at rho0 instead would ratchet: in an agitated bed every expansion is clipped and every collision
-    # compresses from there, so the density climbs and props the liquid up as a "gas". The safety floor below only
-    # stops the rare runaway expansion of a fragment whose support emptied (its density would otherwise fall
-    # without bound, even below zero).
+    # The density is not floored at rho0 (only the pressure, by max_tension): a floor would ratchet, in an agitated
+    # bed every expansion clipped and every collision compressing from there, so that the density climbs and props
+    # the liquid up as a "gas". The safety floor below only stops the rare runaway expansion of a fragment whose
+    # support emptied (its density would otherwise fall without bound, even below zero).
     rhoi = wp.max(rho[i] + h * drho[i], MIN_DENSITY_RATIO * prm.rest_density)
     if free[i] != 0:
         rhoi = rho[i]  # free liquid: the summation density, recomputed at the next substep's start
