@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig
+from cosim.fluid.config import FluidConfig, FreeLiquidRule
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
@@ -82,10 +82,12 @@ def test_energy_creating_configuration_stops_with_the_instability_error():
     # The stability matrix's silent configuration before the account existed: 3-D, 8 across, half full, tilted at
     # 5 rad/s from rest within one step; it finished with plausible densities and 0.43 M g L of created energy.
     # The energy came from the Tait liquid's tension: with it clamped at the default fluid.max_tension (1 kPa) the
-    # same run dissipates 0.24 M g L, so the tension is left unclamped here (1 MPa) to keep a creating run, and so is
-    # the viscosity of that run, the former free-liquid alpha 0.25 (WCSPH's default quadratic term dissipates it).
+    # same run dissipates 0.24 M g L, so the tension is left unclamped here (1 MPa) to keep a creating run, and so are
+    # the viscosity of that run, the former free-liquid alpha 0.25 (WCSPH's default quadratic term dissipates it), and
+    # its free-liquid rule, 'outside_vessels' (under 'free_surface' the splash's surface particles take their
+    # tension-free summation density, and the run creates too little to stop).
     config = StressConfig(Motion.TILT, 5.0, 0.5, 8, 1.0, 3, "wcsph")
-    cfg = replace(config.fluid_config(), max_tension=1.0e6, free_artificial_viscosity=0.25)
+    cfg = replace(config.fluid_config(), max_tension=1.0e6, free_artificial_viscosity=0.25, free_liquid_rule=FreeLiquidRule.OUTSIDE_VESSELS)
     run = run_scripted(config.spec(), config.fill_depth, cfg, config.pose_script(), 0.6)
     assert "created" in run.failure and "M g L of energy" in run.failure and "fluid.max_energy_creation" in run.failure
     assert run.solver.energy_account.created > run.solver.config.max_energy_creation

@@ -1,5 +1,6 @@
-"""Free liquid (WCSPH, ``FluidConfig.free_liquid``): liquid outside every vessel carries no tension and has a
-memoryless density, and liquid caught by a vessel packs like the liquid it joins."""
+"""Free liquid (WCSPH, ``FluidConfig.free_liquid``): liquid outside every vessel (the rule 'outside_vessels', set
+here where a test is about it; both solvers' default is 'free_surface', tests/test_free_surface.py) carries no
+tension and has a memoryless density, and liquid caught by a vessel packs like the liquid it joins."""
 
 import math
 
@@ -22,7 +23,8 @@ DURATION = 0.05  # s
 
 def _stretched_block(free_liquid: bool, max_tension: float) -> tuple[FluidSolver, ParticleSet]:
     cfg = FluidConfig(dim=2, spacing=0.005, pressure_solver="wcsph", max_expected_speed=1.0, free_liquid=free_liquid,
-                      max_tension=max_tension, domain_min=(-0.3, -0.1, -0.3), domain_max=(0.3, 0.1, 0.3))
+                      free_liquid_rule="outside_vessels", max_tension=max_tension, domain_min=(-0.3, -0.1, -0.3),
+                      domain_max=(0.3, 0.1, 0.3))
     block = liquid_block((-0.03, -0.05, 0.0), (0.03, 0.05, 0.06), cfg)
     v = np.zeros_like(block.positions)
     v[:, 0] = STRETCH_RATE * (block.positions[:, 0] - block.positions[:, 0].mean())
@@ -63,7 +65,7 @@ def _packed_block_kick(free_liquid: bool, density_of_the_packing: bool) -> float
     (``density_of_the_packing``) the summation density's 1.04 rho0: its largest velocity change beyond gravity in
     10 ms (m/s)."""
     cfg = FluidConfig(dim=2, spacing=0.005, pressure_solver="wcsph", max_expected_speed=1.0, free_liquid=free_liquid,
-                      domain_min=(-0.3, -0.1, -0.3), domain_max=(0.3, 0.1, 0.3))
+                      free_liquid_rule="outside_vessels", domain_min=(-0.3, -0.1, -0.3), domain_max=(0.3, 0.1, 0.3))
     block = liquid_block((-0.03, -0.05, 0.0), (0.03, 0.05, 0.06), cfg)
     centre = block.positions.mean(axis=0)
     density = cfg.rest_density * (PACKED_SCALE ** -cfg.dim if density_of_the_packing else 1.0)

@@ -179,10 +179,10 @@ def test_the_free_surface_rule_needs_no_vessel(rule, drop_is_free):
     assert not free[:-1].any()
 
 
-@pytest.mark.parametrize("solver, rule", [("dfsph", "free_surface"), ("wcsph", "outside_vessels")])
+@pytest.mark.parametrize("solver, rule", [("dfsph", "free_surface"), ("wcsph", "free_surface")])
 def test_an_unset_rule_is_the_pressure_solvers_own(solver, rule):
-    # DFSPH's default is the local rule, WCSPH's the geometric one: the drop inside the tank is free under DFSPH's
-    # and bound under WCSPH's, the pool bound under both; a rule that is set is the one in effect under either solver
+    # both solvers' default is the local rule: the drop inside the tank is free, the pool bound; a rule that is set
+    # is the one in effect under either solver
     cfg, free = _drop_over_a_pool(solver, None)
     assert cfg.free_liquid_rule is None and cfg.free_liquid_rule_in_effect.value == rule
     assert free[-1] == (rule == "free_surface")

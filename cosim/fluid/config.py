@@ -135,11 +135,11 @@ APPROACH_WEIGHT = 2.0
 # alpha is a viscosity about c0 / sqrt(g h) (~100) times as large on c0, so each scale has its own, chosen by the
 # validations (docs/artificial_viscosity.md).
 DEFAULT_ARTIFICIAL_VISCOSITY = {ArtificialViscosityScale.SOUND_SPEED: 0.01, ArtificialViscosityScale.SIGNAL_VELOCITY: 1.0}
-# The free-liquid rule when none is given (FluidConfig.free_liquid_rule), per pressure solver: every DFSPH validation
-# passes with the local free-surface indicator, which needs no knowledge of the scene; WCSPH's free fall needs a
-# threshold above a resting surface's indicator under it, so WCSPH keeps the vessels' inner volumes
-# (docs/free_surface.md).
-DEFAULT_FREE_LIQUID_RULE = {PressureSolver.DFSPH: FreeLiquidRule.FREE_SURFACE, PressureSolver.WCSPH: FreeLiquidRule.OUTSIDE_VESSELS}
+# The free-liquid rule when none is given (FluidConfig.free_liquid_rule), per pressure solver: every validation that
+# passes with the vessels' inner volumes passes with the local free-surface indicator, which needs no knowledge of
+# the scene, under either solver (WCSPH's free fall failed under it while WCSPH's liquid carried tension, which pulled
+# the stream's bound interior back; docs/free_surface.md).
+DEFAULT_FREE_LIQUID_RULE = {PressureSolver.DFSPH: FreeLiquidRule.FREE_SURFACE, PressureSolver.WCSPH: FreeLiquidRule.FREE_SURFACE}
 # Monaghan's alpha of pairs with free liquid under DFSPH's 'sound_speed' scale when none is given
 # (FluidConfig.free_artificial_viscosity): c0 does not grow with an impact, so without an approach term the free
 # liquid's impacts need their own, larger alpha (a value set on the pour, docs/artificial_viscosity.md). The signal
@@ -245,14 +245,13 @@ class FluidConfig:
         "bound again once packed (summation density >= rho0) where the rule no longer holds.", kind="choice",
         choices=FreeLiquidRule, none_means="the pressure solver's own, " + ", ".join(
             f"{r.value!r} for {s.value!r}" for s, r in DEFAULT_FREE_LIQUID_RULE.items()) + " (chosen on the validation "
-        "cases: WCSPH's free fall needs a threshold above a resting surface's indicator under 'free_surface')")
+        "cases)")
     free_surface_threshold: float = setting(0.4, PRESSURE, "free_liquid_rule 'free_surface': liquid whose indicator "
                                             "lambda is below this is at the free surface (about 1 inside the liquid, "
                                             "0.5 at a flat surface's top row, 0 for a lone particle; Marrone et al. "
                                             "2010: <= 0.2 certainly at the surface, <= 0.75 near it). 0.4, chosen on "
                                             "the validation cases: below a resting surface's 0.5, which DFSPH's "
-                                            "hydrostatic column needs bound; WCSPH's free fall needs 0.75 "
-                                            "(docs/free_surface.md).", "", 0.0, 1.0)
+                                            "hydrostatic column needs bound (docs/free_surface.md).", "", 0.0, 1.0)
     free_artificial_viscosity: float | None = setting(None, PRESSURE, "Monaghan's alpha of every pair with a free "
                                                       "particle (and of a free particle against walls): free liquid "
                                                       "has no tension, so this makes its impacts inelastic; alpha acts "
