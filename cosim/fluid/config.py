@@ -231,8 +231,9 @@ class FluidConfig:
                                 "liquid be free) as free once it has separated (summation density below rho0): WCSPH "
                                 "gives it a memoryless summation density clamped at rho0, so no tension pulls the "
                                 "stream back to the vessel it left "
-                                "(cosim.fluid.wcsph.update_free_liquid; false: the continuity density everywhere, whose "
-                                "tension lands the stream short of its free-fall parabola, `cosim validate free-fall`); "
+                                "(cosim.fluid.wcsph.update_free_liquid; false: the continuity density everywhere, which "
+                                "under a tension clamp lands the stream short of its free-fall parabola, `cosim "
+                                "validate free-fall`, and without tension keeps the voids a splash leaves); "
                                 "DFSPH holds it to its plain summation density (cosim.fluid.dfsph.bound_or_free_density). "
                                 "Either way its pairs use free_artificial_viscosity. Where liquid may become free: "
                                 "free_liquid_rule.")
