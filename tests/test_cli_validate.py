@@ -37,7 +37,8 @@ def test_gate_speed_reaches_the_dam_break(capsys):
     assert case["gate_lift"][:5] == pytest.approx([1.0 * t for t in case["t"][:5]])  # rising at 1 m/s from the release
     assert case["gate_lift"][-1] < case["t"][-1]  # then stopped clear of the liquid
     assert len(case["tip_height"]) == len(case["front"]) == len(case["t"])
-    assert case["lauber_hager_speed"] == pytest.approx((9.81 * 0.1 / 2) ** 0.5, rel=1e-3)  # sqrt(g a / 2), a = 0.1 m
+    assert case["height"] == pytest.approx(0.2)  # 2 a, the reference experiment's column, a = 0.1 m
+    assert case["lauber_hager_speed"] == pytest.approx((9.81 * 0.2 / 2) ** 0.5, rel=1e-3)  # sqrt(g H / 2)
 
 
 def test_table_output(capsys, tmp_path):
