@@ -135,11 +135,11 @@ APPROACH_WEIGHT = 2.0
 # alpha is a viscosity about c0 / sqrt(g h) (~100) times as large on c0, so each scale has its own, chosen by the
 # validations (docs/artificial_viscosity.md).
 DEFAULT_ARTIFICIAL_VISCOSITY = {ArtificialViscosityScale.SOUND_SPEED: 0.01, ArtificialViscosityScale.SIGNAL_VELOCITY: 1.0}
-# The free-liquid rule when none is given (FluidConfig.free_liquid_rule), per pressure solver: every validation that
-# passes with the vessels' inner volumes passes with the local free-surface indicator, which needs no knowledge of
-# the scene, under either solver (WCSPH's free fall failed under it while WCSPH's liquid carried tension, which pulled
-# the stream's bound interior back; docs/free_surface.md).
-DEFAULT_FREE_LIQUID_RULE = {PressureSolver.DFSPH: FreeLiquidRule.FREE_SURFACE, PressureSolver.WCSPH: FreeLiquidRule.FREE_SURFACE}
+# The free-liquid rule when none is given (FluidConfig.free_liquid_rule), under either pressure solver: every
+# validation that passes with the vessels' inner volumes passes with the local free-surface indicator, which needs no
+# knowledge of the scene (WCSPH's free fall failed under it while WCSPH's liquid carried tension, which pulled the
+# stream's bound interior back; docs/free_surface.md).
+DEFAULT_FREE_LIQUID_RULE = FreeLiquidRule.FREE_SURFACE
 # Monaghan's alpha of pairs with free liquid under DFSPH's 'sound_speed' scale when none is given
 # (FluidConfig.free_artificial_viscosity): c0 does not grow with an impact, so without an approach term the free
 # liquid's impacts need their own, larger alpha (a value set on the pour, docs/artificial_viscosity.md). The signal
@@ -244,9 +244,8 @@ class FluidConfig:
         "eigenvalue of the renormalisation matrix, below free_surface_threshold (cosim.fluid.free_surface; "
         "docs/free_surface.md). Either way the liquid must also have separated (summation density below rho0) and is "
         "bound again once packed (summation density >= rho0) where the rule no longer holds.", kind="choice",
-        choices=FreeLiquidRule, none_means="the pressure solver's own, " + ", ".join(
-            f"{r.value!r} for {s.value!r}" for s, r in DEFAULT_FREE_LIQUID_RULE.items()) + " (chosen on the validation "
-        "cases)")
+        choices=FreeLiquidRule, none_means=f"{DEFAULT_FREE_LIQUID_RULE.value!r} under either pressure solver (chosen on the "
+        "validation cases)")
     free_surface_threshold: float = setting(0.4, PRESSURE, "free_liquid_rule 'free_surface': liquid whose indicator "
                                             "lambda is below this is at the free surface (about 1 inside the liquid, "
                                             "0.5 at a flat surface's top row, 0 for a lone particle; Marrone et al. "
@@ -466,9 +465,8 @@ class FluidConfig:
 
     @property
     def free_liquid_rule_in_effect(self) -> FreeLiquidRule:
-        """Where liquid may become free: ``free_liquid_rule``, or where unset the pressure solver's own
-        (:data:`DEFAULT_FREE_LIQUID_RULE`)."""
-        return DEFAULT_FREE_LIQUID_RULE[self.pressure_solver] if self.free_liquid_rule is None else self.free_liquid_rule
+        """Where liquid may become free: ``free_liquid_rule``, or where unset :data:`DEFAULT_FREE_LIQUID_RULE`."""
+        return DEFAULT_FREE_LIQUID_RULE if self.free_liquid_rule is None else self.free_liquid_rule
 
     @property
     def density_solve_tolerance(self) -> float:
