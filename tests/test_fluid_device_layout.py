@@ -76,8 +76,9 @@ def test_the_cuda_layouts_give_the_cpu_layouts_state(dim, solver, layout):
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_wcsph_without_pair_tables_walks_the_neighbours_again_to_the_same_state(dim):
-    # the density rate sums the neighbours compute_forces walked, in the same order, from the cells instead of the
-    # tables: the same terms in the same order, so the same state to the bit and nothing allocated for the tables
+    # the force pass and the density rate sum the neighbours the substep's first walk (update_free_liquid) found,
+    # in the same order, from the cells instead of the tables: the same terms in the same order, so the same state to
+    # the bit and nothing allocated for the tables
     ref = _shaken_tank(dim, "wcsph", CPU_LAYOUT)
     walking = _shaken_tank(dim, "wcsph", replace(CPU_LAYOUT, pair_tables=False))
     assert walking.step.scratch.pairs.index.shape == (1, 1) and ref.step.scratch.pairs.index.shape[0] == ref.n_particles

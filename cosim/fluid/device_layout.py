@@ -16,11 +16,12 @@ sequential chunks and integrate's atomics on one diagnostics row.
   and read through each particle's first slot (``cosim.fluid.pair_slots``): on the CPU packed, the lists of each
   block of 16 particles one after the other, so a pass reads one stream per block rather than a mostly empty row
   per particle.
-- Pair tables at all (WCSPH, whose density rate is the tables' only reader): the force pass writes them and the
-  density rate reads them back once; without them (``pair_tables`` False) the density rate walks the cells again,
-  the neighbours on the fly from the cell ranges as DualSPHysics does, and the same sums come out in the same
-  order. Every device keeps them: on CUDA the second walk costs more than the tables' writes and reads
-  (``python -m cosim.bench.kernel_profile --pair-layouts columns none``; the figures are in docs/benchmarks.md).
+- Pair tables at all (WCSPH): the substep's first walk (``update_free_liquid``) writes them and the force pass
+  and the density rate read them back; without them (``pair_tables`` False) those two walk the cells again, the
+  neighbours on the fly from the cell ranges as DualSPHysics does, and the same sums come out in the same order.
+  Every device keeps them: on CUDA a second walk cost more than the tables' writes and reads when the force pass
+  wrote them (``python -m cosim.bench.kernel_profile --pair-layouts columns none``; the figures are in
+  docs/benchmarks.md); on the CPU the force pass is cheaper over the tables than walking (docs/performance.md).
 - The wall wrench (a sum over every particle per vessel, in a fixed order): on the CPU :data:`WRENCH_CHUNKS`
   contiguous chunks; on CUDA levels of chunks of :data:`REDUCTION_ITEMS` interleaved items (chunk c sums items c,
   c + chunks, ...: consecutive threads read consecutive addresses), until few enough partial sums remain.
@@ -52,9 +53,9 @@ class DeviceLayout:
     CUDA launch does not do) instead of a row per particle. interleaved_reduction: the
     wrench reduced in interleaved levels (CUDA) instead of contiguous chunks. atomic_replicas: copies of each
     accumulator (diagnostics row, solve statistics) the particles spread their atomics over. pair_tables: WCSPH's
-    density rate sums over the pair tables its force pass writes; False: it walks the cells again and computes the
-    kernel gradients anew (no tables written, read or allocated; DFSPH's solve reads its tables many times a
-    substep and always keeps them)."""
+    force pass and density rate sum over the pair tables its first walk writes; False: each walks the cells again
+    and computes the kernel gradients anew (no tables written, read or allocated; DFSPH's solve reads its tables
+    many times a substep and always keeps them)."""
 
     pairs_by_column: bool
     pairs_packed: bool

@@ -12,16 +12,19 @@ update_free_liquid: free liquid (``FluidConfig.free_liquid``): a particle outsid
   Monaghan's quadratic term beta w damping every approaching pair: impacts are inelastic wherever they happen). The same
   neighbour walk measures each particle's free-surface indicator where the 'free_surface' rule or the
   tensile-instability control needs it.
+The substep's pair list (each neighbour and its kernel gradient, in loop order), where the device layout keeps pair
+  tables (``cosim.fluid.device_layout.DeviceLayout.pair_tables``): recorded by the first pass that walks every
+  particle (update_free_liquid under the 'free_surface' rule or the tensile-instability control, else
+  compute_forces); the later passes sum over it instead of searching the cells again (the same sums in the same
+  order: identical results). Under the 'outside_vessels' rule update_free_liquid walks only the liquid outside the
+  vessels, and recording there would cost every particle a walk the force pass makes anyway.
 compute_forces: per particle, over fluid and wall neighbours,
   - the acceleration: symmetric pressure gradient (or, by ``FluidConfig.tension_treatment`` 'tic', Sun et al.
     2018's tensile-instability control: :func:`pressure_pair_factor`), the dummy wall particles entering like liquid
     particles of mass rho0 V_w with their extrapolated pressure (Adami et al. 2012, see ``cosim.fluid.boundary``); Monaghan
     (1992) artificial viscosity and Morris et al. (1997) laminar viscosity (no-slip against the walls); gravity;
   - the reaction on each vessel: -m a_ib summed per particle, and its moment about the vessel's centre of mass,
-    stored per particle so they can be reduced in a fixed order (deterministic on every device);
-  - the substep's pair list (each neighbour and its kernel gradient, in loop order), which the density rate sums
-    over instead of searching the cells a second time (the same sums in the same order: identical results), where
-    the device layout keeps pair tables (``cosim.fluid.device_layout.DeviceLayout.pair_tables``).
+    stored per particle so they can be reduced in a fixed order (deterministic on every device).
 compute_density_rate: continuity equation (liquid and wall particles) evaluated with the kicked velocities, plus
   delta-SPH diffusion with the renormalised density gradient of Antuono et al. (2010), so a resting column keeps
   its hydrostatic density profile and loose liquid exchanges nothing. Summed over the pair list, or
@@ -66,6 +69,13 @@ MIN_DENSITY_RATIO = wp.constant(0.8)
 # Tensile-instability control's free-surface region: Marrone et al. (2010)'s indicator lambda at or below 0.75, the
 # region their scan test examines (a flat surface's top row 0.5, its second row 0.84, the interior 1).
 TIC_SURFACE_REGION = wp.constant(0.75)
+# Who walks the cells for the substep's pair list (compute_forces' ``pairs``): nobody (a layout without pair tables:
+# compute_forces and compute_density_rate_walking each walk); compute_forces, which records the list as it walks;
+# update_free_liquid, where it walks every particle anyway (the 'free_surface' rule, the tensile-instability
+# control), so that compute_forces reads the list instead of walking a second time.
+PAIRS_WALKED = wp.constant(0)
+PAIRS_RECORDED_BY_FORCES = wp.constant(1)
+PAIRS_RECORDED_BY_FREE_LIQUID = wp.constant(2)
 
 
 @wp.func
@@ -139,12 +149,19 @@ def update_free_liquid(
     nb: Neighborhood,
     active: wp.array(dtype=wp.int32),
     mass: wp.array(dtype=float),
+    row: wp.array(dtype=wp.int32),
+    capacity: int,
+    record_pairs: int,
     # State in/out
     free: wp.array(dtype=wp.int32),
     rho: wp.array(dtype=float),
     p: wp.array(dtype=float),
     # Out
     indicator: wp.array(dtype=float),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_grad: wp.array2d(dtype=wp.vec3),
+    diag_i: wp.array2d(dtype=wp.int32),
 ):
     """Free liquid: a particle where the rule ``mode`` lets liquid be free (outside every vessel's inner volume:
     the falling stream, spray, a splash above a rim; or at the free surface, its indicator below ``threshold``,
@@ -157,17 +174,26 @@ def update_free_liquid(
     the vessel it left). It becomes bound when its summation density reaches rho0; the continuity equation then
     continues from that density, so the pressure is continuous and the caught liquid keeps no memory of the loose
     packing it arrived in. ``measure_surface`` 1 (the tensile-instability control needs it): every particle's
-    indicator is measured and stored, whatever the rule."""
+    indicator is measured and stored, whatever the rule.
+
+    ``record_pairs`` 1 (a device layout with pair tables, and a rule or control that walks every particle here): this
+    is the substep's one neighbour walk: it also records every particle's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code
+    :func:`wall_pair`; ``pair_grad``: grad_i W), in the order of the neighbour loop, which compute_forces and
+    compute_density_rate then sum over (the particles do not move until integrate); more than ``capacity``
+    neighbours count as an overflow, an instability."""
     i = wp.tid()
+    if record_pairs != 0:
+        pair_count[i] = 0
     if active[i] == 0:
         return
     xi = nb.x[i]
-    stays_bound = False
+    stays_bound = mode == FREE_LIQUID_OFF  # no free liquid: every particle stays bound
     if mode == FREE_OUTSIDE_VESSELS and free[i] == 0:
         stays_bound = inside_any_vessel(prm, vessels, motions, xi)  # bound liquid inside a vessel stays bound
-    if stays_bound and measure_surface == 0:
+    if stays_bound and measure_surface == 0 and record_pairs == 0:
         return
     surface = mode == FREE_AT_SURFACE or measure_surface != 0
+    count = int(0)
     density = mass[i] * kernel_w(0.0, prm.inv_h, prm.sigma, prm.kernel)
     moment = wp.mat33(0.0)
     radius2 = prm.support * prm.support
@@ -182,9 +208,16 @@ def update_free_liquid(
             r = xi - nb.x[j]
             r2 = wp.dot(r, r)
             mj = mass[j]
-            density += summation_term(prm, mj, r2)
-            if surface:
-                moment += renormalisation_term(mj / prm.rest_density, r, kernel_gradient(prm, r, r2))
+            if not stays_bound:
+                density += summation_term(prm, mj, r2)
+            if surface or record_pairs != 0:
+                gw = kernel_gradient(prm, r, r2)
+                if surface:
+                    moment += renormalisation_term(mj / prm.rest_density, r, gw)
+                if record_pairs != 0 and count < capacity:
+                    pair_index[i, count] = j
+                    pair_grad[i, count] = gw
+            count += 1
             j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
         wall_end = nb.b_cell_end[cell]
         item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
@@ -193,16 +226,27 @@ def update_free_liquid(
             r = xi - nb.bx[b]
             r2 = wp.dot(r, r)
             mb = wall_mass(prm, b_volume, b)
-            density += summation_term(prm, mb, r2)
-            if surface:
-                moment += renormalisation_term(mb / prm.rest_density, r, kernel_gradient(prm, r, r2))
+            if not stays_bound:
+                density += summation_term(prm, mb, r2)
+            if surface or record_pairs != 0:
+                gw = kernel_gradient(prm, r, r2)
+                if surface:
+                    moment += renormalisation_term(mb / prm.rest_density, r, gw)
+                if record_pairs != 0 and count < capacity:
+                    pair_index[i, count] = wall_pair(b)
+                    pair_grad[i, count] = gw
+            count += 1
             item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
+    if record_pairs != 0:
+        pair_count[i] = wp.min(count, capacity)
+        if count > capacity:
+            wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     density = density / prm.lattice_density
     lam = float(0.0)
     if surface:
         lam = surface_indicator(prm.dim, moment)
         indicator[i] = lam
-    if stays_bound or mode == FREE_LIQUID_OFF:
+    if stays_bound:
         return
     state = next_free_state(free[i], exposed_liquid(prm, vessels, motions, mode, xi, lam, threshold), density, prm.rest_density)
     if free[i] == 0 and state == 0:
@@ -213,6 +257,49 @@ def update_free_liquid(
     rhoi = wp.max(density, prm.rest_density)
     rho[i] = rhoi
     p[i] = tait_pressure(prm, rhoi)
+
+
+@wp.struct
+class ForceSums:
+    """What compute_forces sums over particle i's neighbours: its acceleration ``a`` (m/s^2) and, for the
+    renormalised density gradient, ``moment`` = sum_j V_j (x_j - x_i) (x) grad W (dimensionless) and ``gsum`` =
+    sum_j V_j (rho_j - rho_i) grad W (kg/m^4)."""
+
+    a: wp.vec3
+    moment: wp.mat33
+    gsum: wp.vec3
+
+
+@wp.func
+def add_liquid_pair(
+    prm: SPHParams, sums: ForceSums, density_gradient: bool, tic: int, own: float, free_i: int, vi: wp.vec3, rhoi: float,
+    r: wp.vec3, r2: float, gw: wp.vec3, mj: float, vj: wp.vec3, rhoj: float, pj: float, free_j: int,
+) -> ForceSums:
+    """``sums`` with liquid neighbour j's share added (r = x_i - x_j, m; r2 = r . r; gw = grad_i W): the
+    pressure term (:func:`pressure_pair_factor`), Monaghan's and the laminar viscosity (the free liquid's alpha where
+    either particle is free) and, where ``density_gradient``, the renormalised density gradient's sums."""
+    out = sums
+    if density_gradient:
+        vol = mj / rhoj
+        out.moment = sums.moment + renormalisation_term(vol, r, gw)
+        out.gsum = sums.gsum + (vol * (rhoj - rhoi)) * gw
+    a = sums.a - mj * pressure_pair_factor(tic, own, rhoi, pj, rhoj) * gw
+    alpha = wp.where(free_i != 0 or free_j != 0, prm.alpha_free, prm.alpha)
+    vij = vi - vj
+    out.a = a + viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
+    return out
+
+
+@wp.func
+def wall_pair_acceleration(
+    prm: SPHParams, tic: int, own_wall: float, alpha_wall: float, vi: wp.vec3, rhoi: float, r: wp.vec3, r2: float, gw: wp.vec3,
+    mb: float, pb: float, rhob: float, vb: wp.vec3, vb_noslip: wp.vec3,
+) -> wp.vec3:
+    """Particle i's acceleration (m/s^2) from wall particle b (mass ``mb``, extrapolated pressure ``pb`` and density
+    ``rhob``, velocity ``vb`` and no-slip velocity ``vb_noslip``): its pressure term with i's own pressure clamped
+    at 0 (``own_wall``: walls only push) and its viscous terms."""
+    ab = -(mb * pressure_pair_factor(tic, own_wall, rhoi, pb, rhob)) * gw
+    return ab + viscous_pair(prm, alpha_wall, mb, r, r2, gw, vi - vb, vi - vb_noslip, rhoi, rhob)
 
 
 @item_kernel
@@ -237,7 +324,10 @@ def compute_forces(
     b_v_noslip: wp.array(dtype=wp.vec3),
     row: wp.array(dtype=wp.int32),
     capacity: int,
-    record_pairs: int,
+    pairs: int,
+    pair_count: wp.array(dtype=wp.int32),
+    pair_index: wp.array2d(dtype=wp.int32),
+    pair_grad: wp.array2d(dtype=wp.vec3),
     tic: int,
     indicator: wp.array(dtype=float),
     # Out
@@ -245,33 +335,31 @@ def compute_forces(
     rho_grad: wp.array(dtype=wp.vec3),
     wall_force: wp.array2d(dtype=wp.vec3),
     wall_torque: wp.array2d(dtype=wp.vec3),
-    pair_count: wp.array(dtype=wp.int32),
-    pair_index: wp.array2d(dtype=wp.int32),
-    pair_grad: wp.array2d(dtype=wp.vec3),
     diag_f: wp.array2d(dtype=float),
     diag_i: wp.array2d(dtype=wp.int32),
 ):
     """Acceleration of each particle, the reaction it exerts on each vessel (per particle, reduced later) and its
     renormalised density gradient <grad rho>^L = L^-1 sum_j V_j (rho_j - rho_i) grad W, L = sum_j V_j (x_j - x_i)
     (x) grad W (Antuono et al. 2010; liquid neighbours only; zero where L is too ill-conditioned to invert, and under
-    ``FluidConfig.density_diffusion_term`` 'fourtakas', whose diffusion does not read it). Also
-    the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``:
-    grad_i W), in the order of the neighbour loop, which compute_density_rate sums over instead of searching the
-    cells again (``record_pairs`` 0: none kept, compute_density_rate_walking walks them again); more than
-    ``capacity`` neighbours count as an overflow, an instability, either way. ``tic`` 1: the pressure
+    ``FluidConfig.density_diffusion_term`` 'fourtakas', whose diffusion does not read it). ``pairs``
+    :data:`PAIRS_RECORDED_BY_FREE_LIQUID`: summed over the pair list update_free_liquid recorded in this substep (the
+    same neighbours in the same order as a walk finds them: the same sums); otherwise over the neighbours walked from
+    the cell ranges, more than ``capacity`` of them counted as an overflow, an instability, and under
+    :data:`PAIRS_RECORDED_BY_FORCES` recorded as the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or
+    wall code :func:`wall_pair`; ``pair_grad``: grad_i W), in the order of the loop, for compute_density_rate. ``tic`` 1: the pressure
     terms with Sun et al. (2018)'s tensile-instability control (:func:`pressure_pair_factor`), ``indicator`` each
     particle's free-surface indicator (read only then)."""
     i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
         wall_torque[k, i] = wp.vec3(0.0)
-    if record_pairs != 0:
+    record = pairs == PAIRS_RECORDED_BY_FORCES
+    if record:
         pair_count[i] = 0
     if active[i] == 0:
         acc[i] = wp.vec3(0.0)
         rho_grad[i] = wp.vec3(0.0)
         return
-    count = int(0)
     xi = nb.x[i]
     vi = v[i]
     rhoi = rho[i]
@@ -284,68 +372,73 @@ def compute_forces(
     own_wall = wp.max(own, 0.0)
     free_i = free[i]
     alpha_wall = wp.where(free_i != 0, prm.alpha_free, prm.alpha)
-    a = wp.vec3(0.0)
     # the renormalised density gradient is read only by Antuono et al.'s diffusion term
     density_gradient = prm.hydrostatic_diffusion == 0
-    moment = wp.mat33(0.0)
-    gsum = wp.vec3(0.0)
-    radius2 = prm.support * prm.support
-    cells = neighbor_cells(nb.spec, xi)
-    for k in range(cells.count):
-        cell = reachable_cell(nb, cells, k, xi, radius2)
-        if cell < 0:
-            continue
-        liquid_end = nb.cell_end[cell]
-        j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xi, radius2, COINCIDENT_R2)
-        while j < liquid_end:
-            r = xi - nb.x[j]
-            r2 = wp.dot(r, r)
-            gw = kernel_gradient(prm, r, r2)
-            if record_pairs != 0 and count < capacity:
-                pair_index[i, count] = j
-                pair_grad[i, count] = gw
-            count += 1
-            mj = mass[j]
-            vij = vi - v[j]
-            rhoj = rho[j]
-            if density_gradient:
-                vol = mj / rhoj
-                moment += renormalisation_term(vol, r, gw)
-                gsum += (vol * (rhoj - rhoi)) * gw
-            a -= mj * pressure_pair_factor(tic, own, rhoi, p[j], rhoj) * gw
-            alpha = wp.where(free_i != 0 or free[j] != 0, prm.alpha_free, prm.alpha)
-            a += viscous_pair(prm, alpha, mj, r, r2, gw, vij, vij, rhoi, rhoj)
-            j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
-        wall_end = nb.b_cell_end[cell]
-        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
-        while item < wall_end:
-            b = nb.b_order[item]
-            r = xi - nb.bx[b]
-            r2 = wp.dot(r, r)
-            gw = kernel_gradient(prm, r, r2)
-            if record_pairs != 0 and count < capacity:
-                pair_index[i, count] = wall_pair(b)
-                pair_grad[i, count] = gw
-            count += 1
-            mb = wall_mass(prm, b_volume, b)
-            rhob = b_rho[b]
-            ab = -(mb * pressure_pair_factor(tic, own_wall, rhoi, b_p[b], rhob)) * gw
-            ab += viscous_pair(prm, alpha_wall, mb, r, r2, gw, vi - bv[b], vi - b_v_noslip[b], rhoi, rhob)
-            a += ab
-            add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
-            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
-    if count > capacity:
-        wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
-    if record_pairs != 0:
-        pair_count[i] = wp.min(count, capacity)
-    a += prm.gravity
+    sums = ForceSums()
+    sums.a = wp.vec3(0.0)
+    sums.moment = wp.mat33(0.0)
+    sums.gsum = wp.vec3(0.0)
+    if pairs == PAIRS_RECORDED_BY_FREE_LIQUID:
+        for k in range(pair_count[i]):
+            code = pair_index[i, k]
+            gw = pair_grad[i, k]
+            if code >= 0:
+                r = xi - nb.x[code]
+                sums = add_liquid_pair(prm, sums, density_gradient, tic, own, free_i, vi, rhoi, r, wp.dot(r, r), gw, mass[code], v[code], rho[code], p[code], free[code])
+            else:
+                b = pair_wall(code)
+                r = xi - nb.bx[b]
+                ab = wall_pair_acceleration(prm, tic, own_wall, alpha_wall, vi, rhoi, r, wp.dot(r, r), gw, wall_mass(prm, b_volume, b), b_p[b], b_rho[b], bv[b], b_v_noslip[b])
+                sums.a = sums.a + ab
+                add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
+    else:
+        count = int(0)
+        radius2 = prm.support * prm.support
+        cells = neighbor_cells(nb.spec, xi)
+        for k in range(cells.count):
+            cell = reachable_cell(nb, cells, k, xi, radius2)
+            if cell < 0:
+                continue
+            liquid_end = nb.cell_end[cell]
+            j = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xi, radius2, COINCIDENT_R2)
+            while j < liquid_end:
+                r = xi - nb.x[j]
+                r2 = wp.dot(r, r)
+                gw = kernel_gradient(prm, r, r2)
+                if record and count < capacity:
+                    pair_index[i, count] = j
+                    pair_grad[i, count] = gw
+                sums = add_liquid_pair(prm, sums, density_gradient, tic, own, free_i, vi, rhoi, r, r2, gw, mass[j], v[j], rho[j], p[j], free[j])
+                count += 1
+                j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
+            wall_end = nb.b_cell_end[cell]
+            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+            while item < wall_end:
+                b = nb.b_order[item]
+                r = xi - nb.bx[b]
+                r2 = wp.dot(r, r)
+                gw = kernel_gradient(prm, r, r2)
+                if record and count < capacity:
+                    pair_index[i, count] = wall_pair(b)
+                    pair_grad[i, count] = gw
+                ab = wall_pair_acceleration(prm, tic, own_wall, alpha_wall, vi, rhoi, r, r2, gw, wall_mass(prm, b_volume, b), b_p[b], b_rho[b], bv[b], b_v_noslip[b])
+                sums.a = sums.a + ab
+                add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
+                count += 1
+                item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
+        if count > capacity:
+            wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
+        if record:
+            pair_count[i] = wp.min(count, capacity)
+    a = sums.a + prm.gravity
     acc[i] = a
     grad = wp.vec3(0.0)
     if density_gradient:
+        moment = sums.moment
         if prm.dim == 2:
             moment[1, 1] = 1.0
         if wp.determinant(moment) > RENORMALISATION_MIN_DET:
-            grad = wp.inverse(moment) @ gsum
+            grad = wp.inverse(moment) @ sums.gsum
     rho_grad[i] = grad
     wp.atomic_max(diag_f, diag_slot(prm, row[0], i), DIAG_MAX_ACCEL, wp.length(a))
 
@@ -424,7 +517,7 @@ def compute_density_rate(
     sees the velocity it is integrated with), plus delta-SPH diffusion (Antuono et al. 2010):
     delta h c0 sum_j V_j [2 (rho_i - rho_j) r_ij . grad W / (r^2 + eta^2) - (<grad rho>_i + <grad rho>_j) . grad W],
     which vanishes for any linear density field (a resting column) and conserves mass between pairs. Sums over
-    compute_forces' pair list, in its order (the neighbours have not moved since)."""
+    the substep's pair list, in its order (the neighbours have not moved since)."""
     i = wp.tid()
     if active[i] == 0:
         drho[i] = 0.0
@@ -468,7 +561,7 @@ def compute_density_rate_walking(
 ):
     """compute_density_rate's sum over the neighbours walked again from the cell ranges (the neighbours
     compute_forces walked, in its order; nothing read from pair tables): a layout without pair tables trades their
-    writes and reads for a second walk and the kernel gradients computed again."""
+    writes and reads for more walks and the kernel gradients computed again."""
     i = wp.tid()
     if active[i] == 0:
         drho[i] = 0.0

@@ -1,10 +1,12 @@
 """The weakly compressible SPH substep (the kernels and their physics: ``cosim.fluid.wcsph``).
 
     start_substep: move_vessels; place_wall_particles; find_neighbors; reorder_particles (``cosim.fluid.substep``)
-    update_free_liquid      free liquid takes its summation density (``FluidConfig.free_liquid``); each
-                            particle's free-surface indicator where the rule or the tensile-instability control uses it
+    update_free_liquid      free liquid takes its summation density (``FluidConfig.free_liquid``); each particle's
+                            free-surface indicator where the rule or the tensile-instability control uses it, and
+                            then the substep's pair list (:func:`pair_recording`)
     extrapolate_wall_state  the wall particles' pressure, density and no-slip velocity from the liquid around them
-    compute_forces          pressure, viscous and wall forces; the substep's pair list; the density gradient
+    compute_forces          pressure, viscous and wall forces; the density gradient; the pair list where
+                            update_free_liquid did not record it
     compute_density_rate    continuity with delta-SPH diffusion, over the pair list (or over the neighbours walked
                             again, where the device layout keeps no pair tables)
     integrate               symplectic Euler, the equation of state, the wall guard, diagnostics
@@ -20,7 +22,7 @@ from cosim.fluid import boundary as bd
 from cosim.fluid import wcsph
 from cosim.fluid.device_layout import pair_table
 from cosim.fluid.config import FluidConfig, TensionTreatment
-from cosim.fluid.free_surface import free_liquid_mode
+from cosim.fluid.free_surface import FREE_AT_SURFACE, free_liquid_mode
 from cosim.fluid.launch import launch_now
 from cosim.fluid.model import FluidModel, FluidState
 from cosim.fluid.program import Recorder
@@ -46,23 +48,38 @@ class WCSPHScratch:
         self.b_v_noslip = wp.zeros(nb, dtype=wp.vec3, device=d)
 
 
+def pair_recording(cfg: FluidConfig, sh: SubstepScratch) -> int:
+    """Which pass records the substep's pair list (the kernels' int, ``cosim.fluid.wcsph.PAIRS_*``): none without pair
+    tables; update_free_liquid where it walks every particle (the 'free_surface' rule or the tensile-instability
+    control); else compute_forces."""
+    if not sh.layout.pair_tables:
+        return int(wcsph.PAIRS_WALKED)
+    if tension_control(cfg) or free_liquid_mode(cfg) == FREE_AT_SURFACE:
+        return int(wcsph.PAIRS_RECORDED_BY_FREE_LIQUID)
+    return int(wcsph.PAIRS_RECORDED_BY_FORCES)
+
+
 def tension_control(cfg: FluidConfig) -> int:
     """1 where the pressure gradient has Sun et al. (2018)'s tensile-instability control
     (``FluidConfig.tension_treatment`` 'tic'), else 0 (the kernels' int)."""
     return int(cfg.tension_treatment is TensionTreatment.TIC)
 
 
-def update_free_liquid(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch) -> None:
+def update_free_liquid(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: WCSPHScratch) -> None:
     """Free liquid (outside every vessel or at the free surface, by ``FluidConfig.free_liquid_rule``, and separated;
     or not yet packed again) takes the tension-free summation density (``cosim.fluid.wcsph.update_free_liquid``);
-    under tensile-instability control every particle's free-surface indicator is measured in the same walk."""
+    under tensile-instability control every particle's free-surface indicator is measured in the same walk. Where
+    that walk covers every particle and the layout keeps pair tables, it records the substep's pair list
+    (:func:`pair_recording`)."""
     tic = tension_control(m.config)
     if not m.config.free_liquid and not tic:
         return
+    record_pairs = pair_recording(m.config, sh) == wcsph.PAIRS_RECORDED_BY_FREE_LIQUID
     rec.launch(
         wcsph.update_free_liquid, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, mode=free_liquid_mode(m.config),
-        threshold=m.config.free_surface_threshold, measure_surface=tic, motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active, mass=st.mass, free=st.free,
-        rho=st.rho, p=st.p, indicator=sh.free_surface,
+        threshold=m.config.free_surface_threshold, measure_surface=tic, motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active, mass=st.mass,
+        row=sh.row, capacity=sh.pair_capacity, record_pairs=int(record_pairs), free=st.free, rho=st.rho, p=st.p, indicator=sh.free_surface,
+        pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, diag_i=sh.diagnostics.lane_i,
     )
 
 
@@ -78,14 +95,14 @@ def extrapolate_wall_state(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
 
 
 def compute_forces(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: WCSPHScratch) -> None:
-    """Each particle's acceleration, its reaction on the vessels, its density gradient and the substep's pair list."""
+    """Each particle's acceleration, its reaction on the vessels and its density gradient, over the pair list
+    update_free_liquid recorded or the neighbours walked (recording the list where the layout keeps pair tables)."""
     rec.launch(
         wcsph.compute_forces, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, b_vessel=m.b_vessel,
         motions=sh.motions, nb=sh.neighborhood(m, st), v=st.v, rho=st.rho, p=st.p, active=st.active, free=st.free, mass=st.mass,
-        bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip, row=sh.row, capacity=sh.pair_capacity, record_pairs=int(sh.layout.pair_tables),
-        tic=tension_control(m.config), indicator=sh.free_surface, acc=sc.acc, rho_grad=sc.rho_grad, wall_force=sh.wall_force, wall_torque=sh.wall_torque,
-        pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad,
-        diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
+        bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip, row=sh.row, capacity=sh.pair_capacity, pairs=pair_recording(m.config, sh),
+        pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, tic=tension_control(m.config), indicator=sh.free_surface,
+        acc=sc.acc, rho_grad=sc.rho_grad, wall_force=sh.wall_force, wall_torque=sh.wall_torque, diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
     )
 
 
@@ -139,7 +156,7 @@ class WCSPHStep:
         """One substep: the liquid ``src`` reordered into ``st`` and advanced there."""
         m, sh, sc = self.model, self.shared, self.scratch
         start_substep(rec, m, src, st, sh)
-        update_free_liquid(rec, m, st, sh)
+        update_free_liquid(rec, m, st, sh, sc)
         extrapolate_wall_state(rec, m, st, sh, sc)
         compute_forces(rec, m, st, sh, sc)
         compute_density_rate(rec, m, st, sh, sc)
