@@ -176,11 +176,11 @@ def update_free_liquid(
     packing it arrived in. ``measure_surface`` 1 (the tensile-instability control needs it): every particle's
     indicator is measured and stored, whatever the rule.
 
-    ``record_pairs`` 1 (a device layout with pair tables, and a rule or control that walks every particle here): this
-    is the substep's one neighbour walk: it also records every particle's pair list (``pair_index[i, k]``: neighbour j >= 0 or wall code
-    :func:`wall_pair`; ``pair_grad``: grad_i W), in the order of the neighbour loop, which compute_forces and
-    compute_density_rate then sum over (the particles do not move until integrate); more than ``capacity``
-    neighbours count as an overflow, an instability."""
+    ``record_pairs`` 1 (a device layout with pair tables, and a rule or control that walks every particle here):
+    this is the substep's one neighbour walk: it also records every particle's pair list (``pair_index[i, k]``:
+    neighbour j >= 0 or wall code :func:`wall_pair`; ``pair_grad``: grad_i W), in the order of the neighbour loop,
+    which compute_forces and compute_density_rate then sum over (the particles do not move until integrate); more
+    than ``capacity`` neighbours count as an overflow, an instability."""
     i = wp.tid()
     if record_pairs != 0:
         pair_count[i] = 0
@@ -384,11 +384,15 @@ def compute_forces(
             gw = pair_grad[i, k]
             if code >= 0:
                 r = xi - nb.x[code]
-                sums = add_liquid_pair(prm, sums, density_gradient, tic, own, free_i, vi, rhoi, r, wp.dot(r, r), gw, mass[code], v[code], rho[code], p[code], free[code])
+                sums = add_liquid_pair(
+                    prm, sums, density_gradient, tic, own, free_i, vi, rhoi, r, wp.dot(r, r), gw, mass[code], v[code], rho[code], p[code], free[code],
+                )
             else:
                 b = pair_wall(code)
                 r = xi - nb.bx[b]
-                ab = wall_pair_acceleration(prm, tic, own_wall, alpha_wall, vi, rhoi, r, wp.dot(r, r), gw, wall_mass(prm, b_volume, b), b_p[b], b_rho[b], bv[b], b_v_noslip[b])
+                ab = wall_pair_acceleration(
+                    prm, tic, own_wall, alpha_wall, vi, rhoi, r, wp.dot(r, r), gw, wall_mass(prm, b_volume, b), b_p[b], b_rho[b], bv[b], b_v_noslip[b],
+                )
                 sums.a = sums.a + ab
                 add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
     else:
@@ -421,7 +425,9 @@ def compute_forces(
                 if record and count < capacity:
                     pair_index[i, count] = wall_pair(b)
                     pair_grad[i, count] = gw
-                ab = wall_pair_acceleration(prm, tic, own_wall, alpha_wall, vi, rhoi, r, r2, gw, wall_mass(prm, b_volume, b), b_p[b], b_rho[b], bv[b], b_v_noslip[b])
+                ab = wall_pair_acceleration(
+                    prm, tic, own_wall, alpha_wall, vi, rhoi, r, r2, gw, wall_mass(prm, b_volume, b), b_p[b], b_rho[b], bv[b], b_v_noslip[b],
+                )
                 sums.a = sums.a + ab
                 add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
                 count += 1
