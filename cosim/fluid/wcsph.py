@@ -346,9 +346,9 @@ def compute_forces(
     same neighbours in the same order as a walk finds them: the same sums); otherwise over the neighbours walked from
     the cell ranges, more than ``capacity`` of them counted as an overflow, an instability, and under
     :data:`PAIRS_RECORDED_BY_FORCES` recorded as the substep's pair list (``pair_index[i, k]``: neighbour j >= 0 or
-    wall code :func:`wall_pair`; ``pair_grad``: grad_i W), in the order of the loop, for compute_density_rate. ``tic`` 1: the pressure
-    terms with Sun et al. (2018)'s tensile-instability control (:func:`pressure_pair_factor`), ``indicator`` each
-    particle's free-surface indicator (read only then)."""
+    wall code :func:`wall_pair`; ``pair_grad``: grad_i W), in the order of the loop, for compute_density_rate.
+    ``tic`` 1: the pressure terms with Sun et al. (2018)'s tensile-instability control (:func:`pressure_pair_factor`),
+    ``indicator`` each particle's free-surface indicator (read only then)."""
     i = wp.tid()
     for k in range(prm.n_vessels):
         wall_force[k, i] = wp.vec3(0.0)
