@@ -34,10 +34,10 @@ def test_reduction_levels_sum_every_item_once(n, interleaved):
     assert len(items) <= (REDUCTION_ITEMS if interleaved else WRENCH_CHUNKS)
 
 
-def _shaken_tank(dim: int, solver: str, layout):
+def _shaken_tank(dim: int, solver: str, layout, **numerics):
     tank = VesselSpec(name="tank", inner_width=0.1, inner_depth=0.1, inner_height=0.15)
     cfg = FluidConfig(dim=dim, spacing=0.1 / (20 if dim == 2 else 8), pressure_solver=solver, max_expected_speed=1.5,
-                      domain_min=(-0.15, -0.15, -0.05), domain_max=(0.15, 0.15, 0.25))
+                      domain_min=(-0.15, -0.15, -0.05), domain_max=(0.15, 0.15, 0.25), **numerics)
     fluid = FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, 0.06, cfg), layout=layout)
     for k in range(1, 6):
         fluid.set_vessel_poses([Pose((0.005 * math.sin(k), 0.0, 0.0), rotation_y(0.05 * k))])
@@ -74,13 +74,20 @@ def test_the_cuda_layouts_give_the_cpu_layouts_state(dim, solver, layout):
             assert np.array_equal(a[key], b[key]), key
 
 
+@pytest.mark.parametrize(
+    "numerics",
+    [{}, {"free_liquid_rule": "outside_vessels"}, {"tension_treatment": "tic"}],
+    # who records the pair list (cosim.fluid.wcsph_step.pair_recording): the first walk under the free-surface rule
+    # and under the tensile-instability control, the force pass under 'outside_vessels'
+    ids=["recorded-by-first-walk", "recorded-by-force-pass", "tic-recorded-by-first-walk"],
+)
 @pytest.mark.parametrize("dim", [2, 3])
-def test_wcsph_without_pair_tables_walks_the_neighbours_again_to_the_same_state(dim):
-    # the force pass and the density rate sum the neighbours the substep's first walk (update_free_liquid) found,
-    # in the same order, from the cells instead of the tables: the same terms in the same order, so the same state to
-    # the bit and nothing allocated for the tables
-    ref = _shaken_tank(dim, "wcsph", CPU_LAYOUT)
-    walking = _shaken_tank(dim, "wcsph", replace(CPU_LAYOUT, pair_tables=False))
+def test_wcsph_without_pair_tables_walks_the_neighbours_again_to_the_same_state(dim, numerics):
+    # without tables the force pass and the density rate walk the cells for the neighbours the pass that records the
+    # list found, in the same order: the same terms in the same order, so the same state to the bit and nothing
+    # allocated for the tables
+    ref = _shaken_tank(dim, "wcsph", CPU_LAYOUT, **numerics)
+    walking = _shaken_tank(dim, "wcsph", replace(CPU_LAYOUT, pair_tables=False), **numerics)
     assert walking.step.scratch.pairs.index.shape == (1, 1) and ref.step.scratch.pairs.index.shape[0] == ref.n_particles
     assert np.array_equal(ref.positions(), walking.positions())
     assert np.array_equal(ref.state.v.numpy(), walking.state.v.numpy())
