@@ -174,7 +174,7 @@ def update_free_liquid(
     the vessel it left). It becomes bound when its summation density reaches rho0; the continuity equation then
     continues from that density, so the pressure is continuous and the caught liquid keeps no memory of the loose
     packing it arrived in. ``measure_surface`` 1 (the tensile-instability control needs it): every particle's
-    indicator is measured and stored, whatever the rule.
+    indicator is computed and stored, whatever the rule.
 
     ``record_pairs`` 1 (a device layout with pair tables, and a rule or control that walks every particle here):
     this is the substep's one neighbour walk: it also records every particle's pair list (``pair_index[i, k]``:

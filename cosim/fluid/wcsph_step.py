@@ -68,7 +68,7 @@ def tension_control(cfg: FluidConfig) -> int:
 def update_free_liquid(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: WCSPHScratch) -> None:
     """Free liquid (outside every vessel or at the free surface, by ``FluidConfig.free_liquid_rule``, and separated;
     or not yet packed again) takes the tension-free summation density (``cosim.fluid.wcsph.update_free_liquid``);
-    under tensile-instability control every particle's free-surface indicator is measured in the same walk. Where
+    under tensile-instability control every particle's free-surface indicator is computed in the same walk. Where
     that walk covers every particle and the layout keeps pair tables, it records the substep's pair list
     (:func:`pair_recording`)."""
     tic = tension_control(m.config)
