@@ -50,6 +50,13 @@ def kernel_values(kernel: KernelType, r: np.ndarray, h: float, dim: int) -> np.n
     return kernel_sigma(kernel, h, dim) * _kernel_shape(kernel, np.asarray(r, dtype=float) / h)
 
 
+def kernel_derivatives(kernel: KernelType, r: np.ndarray, h: float, dim: int) -> np.ndarray:
+    """dW/dr (1/m^(dim+1)) at distances ``r`` (m) for smoothing length ``h`` (m); 0 beyond the support 2h. The
+    gradient of W(x - x_b) with respect to x is dW/dr (x - x_b) / r."""
+    r = np.asarray(r, dtype=float)
+    return np.where(r < 2.0 * h, kernel_sigma(kernel, h, dim) * _kernel_slope(kernel, r / h, h), 0.0)
+
+
 def _kernel_shape(kernel: KernelType, q: np.ndarray) -> np.ndarray:
     """W / sigma at q = r / h; 0 beyond q = 2."""
     if kernel is KernelType.CUBIC_SPLINE:
