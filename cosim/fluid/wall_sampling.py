@@ -71,10 +71,11 @@ def one_layer_depth(kernel: KernelType, smoothing_ratio: float, dim: int) -> flo
     lattice's own depth dx/2 that is 0.88-0.89 G_ref (Wendland C2, h = 1.5 dx), so the first row's summation
     density rises away from the wall, and a solve that holds it to rho0 (DFSPH) or a pressure force on it (WCSPH)
     pushes that row into the wall. Here delta is the depth at which both hold, G_1 / S_1 = G_ref / S_ref (the
-    zeroth and first moments of the missing support matched at the first row; the volume then about 1.26 dx^dim):
-    0.623 dx in 2-D and 0.605 dx in 3-D for that kernel and ratio, found by scipy.optimize.brentq between the
-    covering walls' first two layers. The rows behind the first, which the covering walls reach with their first
-    layer only, then sum a little short of them (a third of a per cent of rho0 mid-face) instead of over."""
+    zeroth and first moments of the missing support matched at the first row; the volume then 1.31 dx^2 in 2-D,
+    1.27 dx^3 in 3-D): 0.623 dx in 2-D and 0.605 dx in 3-D for that kernel and ratio, found by
+    scipy.optimize.brentq between the covering walls' first two layers. The rows behind the first, which the
+    covering walls reach with their first layer only, then sum a little short of them (0.4 % of rho0 mid-face)
+    instead of over."""
     from scipy.optimize import brentq
 
     covering = tuple(k + 0.5 for k in range(wall_layers(1.0, 2.0 * smoothing_ratio)))
