@@ -354,7 +354,7 @@ class FluidConfig:
     divergence_tolerance: float = setting(0.001, DFSPH, "The divergence solve stops when the average density rate "
                                           "times dt, over rho0, is below this (Bender & Koschier's 0.1 % per step).",
                                           "", 0.0, 0.05, lo_open=True)
-    wall_pressure: WallPressure = setting(WallPressure.SOLVED_LAYER, DFSPH, "How the walls carry pressure: "
+    wall_pressure: WallPressure = setting(WallPressure.SOLVED_REST_SUM, DFSPH, "How the walls carry pressure: "
                                          "'solved_layer' (the wall layer facing the liquid is held to rest density "
                                          "with a stiffness of its own, solved with the liquid's; a wall thinner than "
                                          "the kernel support, whose particles sum short of rho0 with liquid resting "
