@@ -77,11 +77,27 @@ class PourPlan:
     wall_time: float
 
     def summary(self) -> str:
-        """One line: the particle counts, the resolution and the estimate, e.g. for the progress output."""
+        """Two lines: the particle counts, the resolution and the estimate, e.g. for the progress output; then the
+        pourer's walls as the liquid sees them (:meth:`walls`)."""
         cfg = self.fluid
         return (f"{self.particles:,} liquid particles ({cfg.dim}-D, spacing {cfg.spacing * 1e3:.2f} mm), "
                 f"{self.wall_particles:,} wall particles, {self.memory_bytes / 1e9:.2g} GB of pair tables and grids; "
-                f"estimated wall time at most {_duration(self.wall_time)} ({self.substeps:,} substeps)")
+                f"estimated wall time at most {_duration(self.wall_time)} ({self.substeps:,} substeps)\n{self.walls()}")
+
+    def walls(self) -> str:
+        """One line: how the pourer's walls are filled (:func:`cosim.fluid.wall_sampling.wall_model_for`) and, where
+        the dummy layers reach past its outer face, how far outside the real lip the liquid's lip lies."""
+        from cosim.fluid.wall_sampling import numerical_wall_thickness, wall_model_for
+        from cosim.robots.scene_config import ArmRole
+
+        pourer = self.robots.arms[ArmRole.POUR].vessel
+        model = wall_model_for(pourer, self.fluid).value
+        past = numerical_wall_thickness(pourer, self.fluid) - pourer.wall_thickness
+        if past <= 0.0:
+            return f"walls: {model}, the pourer's own {pourer.wall_thickness * 1e3:.1f} mm: the liquid leaves from its real lip"
+        return (f"walls: {model}, {(pourer.wall_thickness + past) * 1e3:.1f} mm of dummy layers for the pourer's "
+                f"{pourer.wall_thickness * 1e3:.1f} mm wall: the liquid's lip lies {past * 1e3:.1f} mm outside the real one "
+                "(fluid.wall_model, docs/walls.md)")
 
 
 def _duration(seconds: float) -> str:

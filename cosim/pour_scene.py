@@ -68,7 +68,7 @@ class FluidSettings:
                                     "spacing dx = B / particles_across.", "", 8, 400)
     smoothing_ratio: float = like(FluidConfig, "smoothing_ratio")
     kernel: KernelType = like(FluidConfig, "kernel")
-    wall_model: WallModel = like(FluidConfig, "wall_model")
+    wall_model: WallModel | None = like(FluidConfig, "wall_model")
     # ---- material
     rest_density: float = like(FluidConfig, "rest_density")
     kinematic_viscosity: float = like(FluidConfig, "kinematic_viscosity")

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig
+from cosim.fluid.config import FluidConfig, WallModel
 from cosim.fluid.seeding import MIN_FILL_LAYERS, fill_layers, fill_vessel
 from cosim.fluid.wall_sampling import sample_vessel_walls
 from cosim.vessel import VesselShape, VesselSpec
@@ -35,11 +35,11 @@ def test_too_few_particles_across_the_depth_in_3d_is_refused() -> None:
 @pytest.mark.parametrize("across", [16, 24])
 def test_cylinder_liquid_fills_the_disc_to_the_wall(across) -> None:
     """The 3-D cup's liquid holds pi R^2 times its layers at dx^3 a particle, and its outer ring lies dx/2 inside
-    the wall all round, dx from the wall's first dummy layer (at R + dx/2), as a box's lattice does. A square
-    lattice cut to the disc held 10-15 % less and left a stair-stepped gap to the wall."""
+    the wall all round, dx from the covering walls' first dummy layer (at R + dx/2), as a box's lattice does. A
+    square lattice cut to the disc held 10-15 % less and left a stair-stepped gap to the wall."""
     radius = 0.0955
     cup = VesselSpec(shape=VesselShape.CYLINDER, inner_width=2 * radius, inner_height=0.26)
-    cfg = FluidConfig(dim=3, spacing=2 * radius / across)
+    cfg = FluidConfig(dim=3, spacing=2 * radius / across, wall_model=WallModel.KERNEL_LAYERS)
     dx = cfg.spacing
     x = fill_vessel(cup, 0.1591, cfg).positions
     layers = fill_layers(cup, 0.1591, dx)

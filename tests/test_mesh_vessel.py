@@ -16,7 +16,7 @@ import trimesh
 import warp as wp
 
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig
+from cosim.fluid.config import FluidConfig, WallModel
 from cosim.fluid.mesh_boundary import mesh_guard
 from cosim.fluid.mesh_sampling import MeshQueries, warp_mesh
 from cosim.fluid.seeding import fill_vessel
@@ -169,7 +169,7 @@ def test_the_box_mesh_gives_the_box_liquid_and_walls():
     mesh_liquid, box_liquid = fill_vessel(beaker(), 0.07, cfg), fill_vessel(BEAKER_BOX, 0.07, cfg)
     np.testing.assert_array_equal(mesh_liquid.positions, box_liquid.positions)
     for dim in (2, 3):
-        cfg_dim = FluidConfig(dim=dim, spacing=cfg.spacing)
+        cfg_dim = FluidConfig(dim=dim, spacing=cfg.spacing, wall_model=WallModel.KERNEL_LAYERS)
         walls, volumes = sample_vessel_walls(beaker(), cfg_dim)
         box_walls, _ = sample_vessel_walls(BEAKER_BOX, cfg_dim)
         assert np.all(volumes == cfg.spacing**dim)

@@ -88,5 +88,7 @@ def test_pour_prints_the_checks_particle_count_and_estimate_before_its_first_ste
     assert main(["pour", str(scene), "--out", str(tmp_path / "run")]) == 0
     poured = capsys.readouterr().err.strip().splitlines()
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
-    assert len(checked) == 1 and poured[0] == checked[0]
+    assert len(checked) == 2 and poured[:2] == checked
+    # 8 across: the 5 mm wall holds no layer at dx / 2 = 11.9 mm, so its walls cover the support past the real lip
+    assert checked[1].startswith("walls: kernel_layers, 71.6 mm of dummy layers for the pourer's 5.0 mm wall")
     assert checked[0].startswith(f"{summary['particles']} liquid particles (2-D")  # exact for a box in 2-D

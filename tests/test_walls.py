@@ -16,7 +16,8 @@ from cosim.fluid.mesh_sampling import classify
 from cosim.fluid.sph_kernels import kernel_values
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.sph_kernels import kernel_derivatives
-from cosim.fluid.wall_sampling import numerical_wall_thickness, one_layer_depth, sample_vessel_walls, slab_particles
+from cosim.fluid.wall_sampling import (holds_a_layer, numerical_wall_thickness, one_layer_depth, sample_vessel_walls, slab_particles,
+                                       wall_model_for)
 from cosim.mesh_vessel import load_vessel_mesh
 from cosim.pour_scene import FluidSettings
 from cosim.vessel import VesselShape, VesselSpec, mesh_vessel_spec, seed_pouring_vessel
@@ -112,7 +113,7 @@ def test_the_crest_is_the_real_lip(dim):
     # one spacing of the real lip (the layers of kernel_layers reach 3 dx = 17.9 mm out at this resolution)
     assert lip_wall[:, 2].max() == pytest.approx(h - 0.5 * (h / round(h / cfg.spacing)), abs=1e-12)
     assert b + t - cfg.spacing < lip_wall[:, 0].max() <= b + t
-    layers = FluidConfig(dim=dim, spacing=cfg.spacing)
+    layers = FluidConfig(dim=dim, spacing=cfg.spacing, wall_model=WallModel.KERNEL_LAYERS)
     assert numerical_wall_thickness(POURER, layers) == pytest.approx(3 * cfg.spacing)
     assert sample_vessel_walls(POURER, layers)[0][:, 0].max() > b + 2 * cfg.spacing
 
@@ -180,6 +181,27 @@ def test_a_mesh_wall_too_thin_for_one_layer_is_refused():
     cfg = FluidConfig(dim=2, spacing=0.08 / 12, wall_model=REAL)  # 6.7 mm: the 3 mm wall holds no layer at dx / 2
     with pytest.raises(InputError, match="fluid.wall_model: the pourer vessel's wall"):
         sample_vessel_walls(spec, cfg)
+
+
+def test_unset_the_wall_model_is_the_vessels_own_under_dfsph_and_covers_the_support_under_wcsph():
+    """Where a wall holds a layer, DFSPH's default walls are the vessel's own, the same particles and volumes as
+    'real_thickness' set; WCSPH's, a wall holding no layer (thinner than dx / 2) and a mesh vessel's cover the
+    support; a wall model that is set holds for every vessel."""
+    dfsph, wcsph = FluidConfig(dim=2, spacing=0.191 / 32), FluidConfig(dim=2, spacing=0.191 / 32, pressure_solver="wcsph")
+    assert dfsph.wall_model is None and wall_model_for(POURER, dfsph) is REAL
+    default, confined = sample_vessel_walls(POURER, dfsph), sample_vessel_walls(POURER, real(POURER, 32, 2))
+    np.testing.assert_array_equal(default[0], confined[0])
+    np.testing.assert_array_equal(default[1], confined[1])
+    assert wall_model_for(POURER, wcsph) is WallModel.KERNEL_LAYERS
+    assert numerical_wall_thickness(POURER, wcsph) == pytest.approx(3 * wcsph.spacing)
+    coarse = FluidConfig(dim=3, spacing=0.191 / 16)  # dx / 2 = 6.0 mm against the 5 mm wall
+    assert not holds_a_layer(POURER, coarse.spacing) and holds_a_layer(POURER, 0.01)
+    assert wall_model_for(POURER, coarse) is WallModel.KERNEL_LAYERS
+    assert len(sample_vessel_walls(POURER, coarse)[0]) > 0
+    beaker = mesh_vessel_spec("pourer", load_vessel_mesh(BEAKER), 1180.0)
+    assert wall_model_for(beaker, FluidConfig(dim=2, spacing=0.08 / 24)) is WallModel.KERNEL_LAYERS
+    assert wall_model_for(POURER, FluidConfig(dim=2, spacing=0.191 / 32, wall_model="kernel_layers")) is WallModel.KERNEL_LAYERS
+    assert wall_model_for(beaker, FluidConfig(dim=2, spacing=0.08 / 24, wall_model="real_thickness")) is REAL
 
 
 def test_the_scene_sets_the_wall_model_and_refuses_another():

@@ -140,6 +140,13 @@ DEFAULT_ARTIFICIAL_VISCOSITY = {ArtificialViscosityScale.SOUND_SPEED: 0.01, Arti
 # knowledge of the scene (WCSPH's free fall failed under it while WCSPH's liquid carried tension, which pulled the
 # stream's bound interior back; docs/free_surface.md).
 DEFAULT_FREE_LIQUID_RULE = FreeLiquidRule.FREE_SURFACE
+# The wall model when none is given (FluidConfig.wall_model), per pressure solver: DFSPH with the vessel's own walls
+# ('real_thickness', with wall_pressure 'solved_rest_sum') passes every validation case the covering layers pass, in
+# 2-D and 3-D, and puts the lip where the vessel has it; WCSPH's resting cases stop with them (its continuity density
+# does not see the liquid piling into the corners of a one-layer wall), so it keeps 'kernel_layers' (docs/walls.md).
+# A wall that holds no particle layer at the spacing (thinner than dx / 2) and a mesh vessel's wall (not validated
+# confined) get 'kernel_layers' under either solver (cosim.fluid.wall_sampling.wall_model_for).
+DEFAULT_WALL_MODEL = {PressureSolver.DFSPH: WallModel.REAL_THICKNESS, PressureSolver.WCSPH: WallModel.KERNEL_LAYERS}
 # Monaghan's alpha of pairs with free liquid under DFSPH's 'sound_speed' scale when none is given
 # (FluidConfig.free_artificial_viscosity): c0 does not grow with an impact, so without an approach term the free
 # liquid's impacts need their own, larger alpha (a value set on the pour, docs/artificial_viscosity.md). The signal
@@ -177,12 +184,13 @@ class FluidConfig:
     kernel: KernelType = setting(KernelType.WENDLAND_C2, DISCRETISATION, "SPH smoothing kernel, compact support 2h: "
                                  "Wendland (1995) C2 (no pairing instability at large neighbour counts) or Monaghan "
                                  "(1992)'s cubic spline.")
-    wall_model: WallModel = setting(WallModel.KERNEL_LAYERS, DISCRETISATION, "How the walls are filled with dummy "
-                                    "particles: 'kernel_layers' (ceil(2h / dx) layers behind every wetted face, so a "
-                                    "wall thinner than that reaches past its outer face and the pour lip with it) or "
-                                    "'real_thickness' (layers confined to the vessel's own wall, their volumes fitted "
-                                    "to make up the kernel support missing behind a thin wall; the lip is the real "
-                                    "one, docs/walls.md).")
+    wall_model: WallModel | None = setting(
+        None, DISCRETISATION, "How the walls are filled with dummy particles: 'kernel_layers' (ceil(2h / dx) layers "
+        "behind every wetted face, so a wall thinner than that reaches past its outer face and the pour lip with it) "
+        "or 'real_thickness' (layers confined to the vessel's own wall, their volumes fitted to make up the kernel "
+        "support missing behind a thin wall; the lip is the real one, docs/walls.md).", kind="choice",
+        choices=WallModel, none_means="'real_thickness' under DFSPH, 'kernel_layers' under WCSPH; 'kernel_layers' for "
+        "a wall thinner than dx / 2 and a mesh vessel's (chosen on the validation cases)")
     depth_2d: float = setting(0.1, DISCRETISATION, "2-D: the liquid's thickness across the pour plane as seeded (the "
                               "pourer's depth); a particle stands for the 3-D volume dx^2 depth_2d, spread over the depth "
                               "of any other vessel it enters (cosim.fluid.model). Volumes and wrenches reported outside "

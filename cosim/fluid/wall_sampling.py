@@ -32,7 +32,7 @@ from dataclasses import replace
 import numpy as np
 
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig, KernelType, WallModel
+from cosim.fluid.config import DEFAULT_WALL_MODEL, FluidConfig, KernelType, WallModel
 from cosim.fluid.mesh_sampling import mesh_wetted_layer, sample_mesh_walls
 from cosim.fluid.sph_kernels import kernel_derivatives, kernel_values, lattice_kernel_sum
 from cosim.vessel import VesselSpec
@@ -84,10 +84,29 @@ def one_layer_depth(kernel: KernelType, smoothing_ratio: float, dim: int) -> flo
     return float(brentq(mismatch, 0.5, 1.5))
 
 
+def holds_a_layer(spec: VesselSpec, spacing: float) -> bool:
+    """Whether ``spec``'s wall holds a layer of the liquid's lattice continued behind its inner faces: the first
+    layer's centres lie dx/2 deep, so the wall must be at least ``spacing`` (m) / 2 thick."""
+    return spec.wall_thickness * (1.0 + 1e-9) >= 0.5 * spacing
+
+
+def wall_model_for(spec: VesselSpec, cfg: FluidConfig) -> WallModel:
+    """How ``spec``'s walls are filled: ``cfg.wall_model`` where set; where unset the pressure solver's own
+    (:data:`cosim.fluid.config.DEFAULT_WALL_MODEL`), except that a wall holding no layer at the spacing
+    (:func:`holds_a_layer`) and a mesh vessel's wall, whose confined sampling is not validated, get
+    ``kernel_layers``."""
+    if cfg.wall_model is not None:
+        return cfg.wall_model
+    model = DEFAULT_WALL_MODEL[cfg.pressure_solver]
+    if model is WallModel.REAL_THICKNESS and (spec.is_mesh or not holds_a_layer(spec, cfg.spacing)):
+        return WallModel.KERNEL_LAYERS
+    return model
+
+
 def numerical_wall_thickness(spec: VesselSpec, cfg: FluidConfig) -> float:
     """Wall thickness (m) the liquid sees: the vessel's own, or under ``kernel_layers`` the dummy layers' if those
     are thicker."""
-    if cfg.wall_model is WallModel.REAL_THICKNESS:
+    if wall_model_for(spec, cfg) is WallModel.REAL_THICKNESS:
         return spec.wall_thickness
     return max(spec.wall_thickness, wall_layers(cfg.spacing, cfg.support_radius) * cfg.spacing)
 
@@ -235,7 +254,7 @@ def slab_particles(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.n
     vessel's own thickness); under ``real_thickness`` only the particles inside the vessel's own wall are kept."""
     h = spec.inner_height
     spacing, dim = cfg.spacing, cfg.dim
-    confined = cfg.wall_model is WallModel.REAL_THICKNESS
+    confined = wall_model_for(spec, cfg) is WallModel.REAL_THICKNESS
     if spec.is_mesh:
         return sample_mesh_walls(spec, spacing, numerical_wall_thickness(spec, cfg), dim, confined=confined)
     t = numerical_wall_thickness(spec, replace(cfg, wall_model=WallModel.KERNEL_LAYERS))

@@ -26,7 +26,7 @@ from importlib import resources
 
 import numpy as np
 
-from cosim.fluid.config import GRAVITY
+from cosim.fluid.config import GRAVITY, WallModel
 from cosim.fluid.seeding import liquid_block
 from cosim.fluid.solver import FluidSolver
 from cosim.frames import Pose
@@ -125,7 +125,8 @@ def run(p: Params) -> CaseResult:
     )
     vessels, poses, gate = [tank], [Pose()], None
     if p.gate_speed is not None:
-        gate = lifted_gate(wall, a, height, depth, p.dim, numerical_wall_thickness(tank, cfg), p.gate_speed)
+        covering = numerical_wall_thickness(tank, dataclasses.replace(cfg, wall_model=WallModel.KERNEL_LAYERS))
+        gate = lifted_gate(wall, a, height, depth, p.dim, covering, p.gate_speed)
         vessels.append(gate.spec)
         poses.append(gate.pose(0.0))
         top = max(tank.inner_height, gate.top) + margin  # the gate's ceiling stays in the domain at full travel

@@ -9,10 +9,11 @@ falls the column's height H: the slowest such gate rises at H / t_o = sqrt(g H /
 The gate is a rigid vessel wall that the solver moves (:class:`cosim.fluid.solver.FluidSolver` moves every vessel to
 the pose given for the end of each interval): a box vessel turned upside down (rotated by pi about +y), so that its
 -x wall, whose inner face looks at -x, stands on the tank floor against the column's +x face, and its floor is a
-ceiling above the liquid. Its interior spans the column and one numerical wall thickness t (the dummy layers,
-:func:`cosim.fluid.wall_sampling.numerical_wall_thickness`) beyond the tank's closed wall, so that its other wall
-stands behind the tank's wall layers, out of every liquid particle's kernel support; its ceiling is likewise t above
-the column. The gate rises at constant speed from t = 0 until its lower edge is t above the column's top, clear of
+ceiling above the liquid. Its walls are t thick, t the kernel-covering layers' thickness (``kernel_layers``'
+:func:`cosim.fluid.wall_sampling.numerical_wall_thickness`, at least the tank walls' under either wall model), so
+that they cover the kernel support whatever the wall model. Its interior spans the column and t beyond the tank's
+closed wall, so that its other wall stands behind the tank's wall layers, out of every liquid particle's kernel
+support; its ceiling is likewise t above the column. The gate rises at constant speed from t = 0 until its lower edge is t above the column's top, clear of
 the liquid, and stays there. In 3-D its depth is the tank's plus t on each side, so that its side walls stand behind
 the tank's; in 2-D it is the tank's depth (the liquid's mass per depth is unchanged inside it).
 """
@@ -66,12 +67,14 @@ def lifted_gate(wall_x: float, column_width: float, column_height: float, depth:
                 speed: float) -> LiftedGate:
     """The gate against a column ``column_width`` x ``column_height`` (m) that stands on z = 0 against the tank's
     closed wall at x = ``wall_x`` (the tank ``depth`` m deep), lifted at ``speed`` (m/s); ``wall_thickness`` (m) is
-    the numerical wall thickness of both the tank's walls and the gate's (the same dummy layers; module doc)."""
+    the gate's own wall thickness, at least the tank walls' numerical thickness so that its back wall clears them
+    (module doc): a plate as thick as the kernel-covering layers is filled by them under either wall model."""
     check_positive("gate_speed", speed, "m/s", MAX_GATE_SPEED)
     t = wall_thickness
     inner_width = column_width + t  # from the gate's face back to behind the tank's wall layers
     inner_height = column_height + t  # the ceiling a support above the column
-    spec = VesselSpec(name="gate", inner_width=inner_width, inner_depth=depth if dim == 2 else depth + 2.0 * t, inner_height=inner_height)
+    spec = VesselSpec(name="gate", inner_width=inner_width, inner_depth=depth if dim == 2 else depth + 2.0 * t,
+                      inner_height=inner_height, wall_thickness=t)
     face_x = wall_x + column_width
     # Turned by pi about +y, the frame's local x = +b (the +x wall's inner face) maps to world x = origin - b,
     # local x = -b (the -x wall's inner face, the gate) to origin + b, and local z to -z: the rim at origin_z - height.
