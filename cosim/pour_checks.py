@@ -84,15 +84,27 @@ class PourPlan:
                 f"{self.wall_particles:,} wall particles, {self.memory_bytes / 1e9:.2g} GB of pair tables and grids; "
                 f"estimated wall time at most {_duration(self.wall_time)} ({self.substeps:,} substeps)\n{self.walls()}")
 
-    def walls(self) -> str:
-        """One line: how the pourer's walls are filled (:func:`cosim.fluid.wall_sampling.wall_model_for`) and, where
-        the dummy layers reach past its outer face, how far outside the real lip the liquid's lip lies."""
+    def wall_report(self) -> dict[str, dict[str, str | float]]:
+        """Per vessel (by its name, e.g. ``pourer``): how its walls are filled (``wall_model``,
+        :func:`cosim.fluid.wall_sampling.wall_model_for`) and ``lip_outside_real_m``, how far (m) the dummy layers
+        reach past its outer face, and the liquid's lip with them past the real one (0 for the vessel's own walls)."""
         from cosim.fluid.wall_sampling import numerical_wall_thickness, wall_model_for
+
+        report = {}
+        for arm in self.robots.arms.values():
+            vessel = arm.vessel
+            report[vessel.name] = {"wall_model": wall_model_for(vessel, self.fluid).value,
+                                  "lip_outside_real_m": numerical_wall_thickness(vessel, self.fluid) - vessel.wall_thickness}
+        return report
+
+    def walls(self) -> str:
+        """One line: how the pourer's walls are filled and, where the dummy layers reach past its outer face, how
+        far outside the real lip the liquid's lip lies (:meth:`wall_report`)."""
         from cosim.robots.scene_config import ArmRole
 
         pourer = self.robots.arms[ArmRole.POUR].vessel
-        model = wall_model_for(pourer, self.fluid).value
-        past = numerical_wall_thickness(pourer, self.fluid) - pourer.wall_thickness
+        report = self.wall_report()[pourer.name]
+        model, past = report["wall_model"], report["lip_outside_real_m"]
         if past <= 0.0:
             return f"walls: {model}, the pourer's own {pourer.wall_thickness * 1e3:.1f} mm: the liquid leaves from its real lip"
         return (f"walls: {model}, {(pourer.wall_thickness + past) * 1e3:.1f} mm of dummy layers for the pourer's "

@@ -240,6 +240,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
             fluid_substeps_one_thread=pour.fluid.lanes.substeps_one_thread,
             dim=pour.fluid.config.dim,
             particle_spacing=pour.fluid.config.spacing,
+            walls=plan.wall_report(),
             cfs_head_reference=pour.controller.config.cfs.h_q_ref,
             trajectory={
                 "duration": float(trajectory.time[-1]),

@@ -91,4 +91,5 @@ def test_pour_prints_the_checks_particle_count_and_estimate_before_its_first_ste
     assert len(checked) == 2 and poured[:2] == checked
     # 8 across: the 5 mm wall holds no layer at dx / 2 = 11.9 mm, so its walls cover the support past the real lip
     assert checked[1].startswith("walls: kernel_layers, 71.6 mm of dummy layers for the pourer's 5.0 mm wall")
+    assert summary["walls"]["pourer"] == {"wall_model": "kernel_layers", "lip_outside_real_m": pytest.approx(3 * 0.191 / 8 - 0.005)}
     assert checked[0].startswith(f"{summary['particles']} liquid particles (2-D")  # exact for a box in 2-D
