@@ -13,9 +13,10 @@ ceiling above the liquid. Its walls are t thick, t the kernel-covering layers' t
 :func:`cosim.fluid.wall_sampling.numerical_wall_thickness`, at least the tank walls' under either wall model), so
 that they cover the kernel support whatever the wall model. Its interior spans the column and t beyond the tank's
 closed wall, so that its other wall stands behind the tank's wall layers, out of every liquid particle's kernel
-support; its ceiling is likewise t above the column. The gate rises at constant speed from t = 0 until its lower edge is t above the column's top, clear of
-the liquid, and stays there. In 3-D its depth is the tank's plus t on each side, so that its side walls stand behind
-the tank's; in 2-D it is the tank's depth (the liquid's mass per depth is unchanged inside it).
+support; its ceiling is likewise t above the column. The gate rises at constant speed from t = 0 until its lower
+edge is t above the column's top, clear of the liquid, and stays there. In 3-D its depth is the tank's plus t on
+each side, so that its side walls stand behind the tank's; in 2-D it is the tank's depth (the liquid's mass per
+depth is unchanged inside it).
 """
 
 from __future__ import annotations
