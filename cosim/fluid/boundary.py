@@ -23,7 +23,7 @@ import warp as wp
 
 from cosim.fluid.lanes import item_kernel
 from cosim.fluid.mesh_boundary import SHAPE_MESH, mesh_guard, mesh_inside
-from cosim.fluid.neighbors import Neighborhood, neighbor_cells, next_liquid_neighbor, reachable_cell
+from cosim.fluid.neighbors import Neighborhood, neighbor_cells, next_liquid_neighbor, reachable_cell, wall_seen
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -140,10 +140,13 @@ def extrapolate_wall_state(
     b_rho: wp.array(dtype=float),
     b_v_noslip: wp.array(dtype=wp.vec3),
 ):
-    """Pressure, density and no-slip velocity of each dummy wall particle from the liquid around it."""
+    """Pressure, density and no-slip velocity of each dummy wall particle from the liquid around it that sees it
+    (:func:`cosim.fluid.neighbors.wall_seen`)."""
     b = wp.tid()
     xb = nb.bx[b]
-    m = motions[b_vessel[b]]
+    vessel = b_vessel[b]
+    side = nb.b_side[b]
+    m = motions[vessel]
     arm = xb - m.p_now
     a_wall = m.lin_acc + wp.cross(m.ang_acc, arm) + wp.cross(m.ang_vel, wp.cross(m.ang_vel, arm))
     sum_w = float(0.0)
@@ -159,13 +162,14 @@ def extrapolate_wall_state(
         liquid_end = nb.cell_end[cell]  # the liquid only, however near
         f = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xb, radius2, 0.0)
         while f < liquid_end:
-            r = xb - nb.x[f]
-            r2 = wp.dot(r, r)
-            w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-            sum_w += w
-            sum_pw += p[f] * w
-            sum_rho_r += (rho[f] * w) * r
-            sum_v += w * v[f]
+            if wall_seen(side, vessel, nb.inside[f]):  # only the liquid that sees this particle
+                r = xb - nb.x[f]
+                r2 = wp.dot(r, r)
+                w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
+                sum_w += w
+                sum_pw += p[f] * w
+                sum_rho_r += (rho[f] * w) * r
+                sum_v += w * v[f]
             f = next_liquid_neighbor(nb.x, f + 1, liquid_end, xb, radius2, 0.0)
     pw = float(0.0)
     v_noslip = bv[b]

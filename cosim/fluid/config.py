@@ -32,6 +32,7 @@ class WallModel(Enum):
 
     KERNEL_LAYERS = "kernel_layers"  # ceil(2h / dx) layers behind every wetted face, past a thinner wall's outer face
     REAL_THICKNESS = "real_thickness"  # layers inside the vessel's own wall, volumes compensating the missing support
+    SIDED = "sided"  # the covering layers seen from inside the vessel, the real_thickness wall from outside (WCSPH)
 
 
 class WallPressure(Enum):
@@ -188,7 +189,8 @@ class FluidConfig:
         None, DISCRETISATION, "How the walls are filled with dummy particles: 'kernel_layers' (ceil(2h / dx) layers "
         "behind every wetted face, so a wall thinner than that reaches past its outer face and the pour lip with it) "
         "or 'real_thickness' (layers confined to the vessel's own wall, their volumes fitted to make up the kernel "
-        "support missing behind a thin wall; the lip is the real one, docs/walls.md).", kind="choice",
+        "support missing behind a thin wall; the lip is the real one) or 'sided' (WCSPH only: liquid inside the vessel "
+        "sees the covering layers, liquid outside it, over the rim included, the 'real_thickness' wall; docs/walls.md).", kind="choice",
         choices=WallModel, none_means="'real_thickness' under DFSPH, 'kernel_layers' under WCSPH; 'kernel_layers' for "
         "a wall thinner than dx / 2 and a mesh vessel's (chosen on the validation cases)")
     depth_2d: float = setting(0.1, DISCRETISATION, "2-D: the liquid's thickness across the pour plane as seeded (the "
@@ -430,6 +432,9 @@ class FluidConfig:
                     f"fluid.free_artificial_viscosity to the bulk's {self.alpha:g} (it is {self.free_liquid_alpha:g}) or "
                     "free_liquid = false"
                 )
+        if self.wall_model is WallModel.SIDED and self.pressure_solver is not PressureSolver.WCSPH:
+            raise InputError("fluid.wall_model: 'sided' is for pressure_solver 'wcsph' (DFSPH's wall constraint sums each "
+                             f"wall particle's whole support), got pressure_solver '{self.pressure_solver.value}'")
         for axis in range(3):
             if self.domain_max[axis] - self.domain_min[axis] < 4.0 * self.support_radius:
                 raise InputError(

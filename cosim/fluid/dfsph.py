@@ -94,7 +94,7 @@ from cosim.fluid.diagnostics import (
 )
 from cosim.fluid.free_surface import FREE_AT_SURFACE, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
-from cosim.fluid.neighbors import COINCIDENT_R2, GridSpec, Neighborhood, neighbor_cells, next_liquid_neighbor, next_wall_neighbor, reachable_cell
+from cosim.fluid.neighbors import COINCIDENT_R2, GridSpec, Neighborhood, neighbor_cells, next_liquid_neighbor, next_wall_neighbor, reachable_cell, SEES_EVERY_WALL
 from cosim.fluid.pair_slots import PairSlots, close_pair_row, open_pair_row
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
@@ -303,7 +303,7 @@ def compute_density_factor(
             count += 1
             j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
         wall_end = nb.b_cell_end[cell]
-        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, nb.b_cell_start[cell], wall_end, xi, SEES_EVERY_WALL, radius2, COINCIDENT_R2)
         while item < wall_end:
             b = nb.b_order[item]
             r = xi - nb.bx[b]
@@ -321,7 +321,7 @@ def compute_density_factor(
                 pair_grad[slot] = gw
                 pair_mass_grad[slot] = gm
             count += 1
-            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
+            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, item + 1, wall_end, xi, SEES_EVERY_WALL, radius2, COINCIDENT_R2)
     if count > capacity:
         wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
     pair_count[i] = wp.min(count, capacity)
@@ -601,13 +601,13 @@ def compute_wall_density_factor(
             count += 1
             j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xb, radius2, COINCIDENT_R2)
         wall_end = nb.b_cell_end[cell]
-        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xb, radius2, COINCIDENT_R2)
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, nb.b_cell_start[cell], wall_end, xb, SEES_EVERY_WALL, radius2, COINCIDENT_R2)
         while item < wall_end:
             other = nb.b_order[item]
             r = xb - nb.bx[other]
             r2 = wp.dot(r, r)
             density += summation_term(prm, wall_mass(prm, b_volume, other), r2)
-            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xb, radius2, COINCIDENT_R2)
+            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, item + 1, wall_end, xb, SEES_EVERY_WALL, radius2, COINCIDENT_R2)
     if count == 0:
         return
     if count > capacity:

@@ -25,7 +25,7 @@ from cosim.fluid.config import FluidConfig, WallPressure
 from cosim.fluid.memory import check_memory
 from cosim.fluid.neighbors import CellGrid
 from cosim.fluid.params import SPHParams, make_params
-from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls, wall_rest_offsets, wetted_layer
+from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls, wall_rest_offsets, wall_sides, wetted_layer
 from cosim.vessel import VesselSpec
 
 
@@ -41,6 +41,10 @@ class FluidModel:
     b_volume: (Nb,) float, volume of each wall particle (m^dim; its mass is rho0 times this).
     b_wetted: (Nb,) int32, 1 for the wall particles of the layer facing the liquid
     (:func:`cosim.fluid.wall_sampling.wetted_layer`; DFSPH holds them to rest density too).
+    b_side: (Nb,) int32, which liquid sees each wall particle (:func:`cosim.fluid.wall_sampling.wall_sides`: all of
+    it, or under ``wall_model = "sided"`` only the liquid inside its vessel, or only the liquid outside).
+    one_sided_walls: whether some wall particle is seen from one side only (the substeps then mark which vessels
+    hold each liquid particle, :func:`cosim.fluid.sph_common.mark_inside_vessels`).
     b_rest_offset: (Nb,) float, kg/m^3, added to a wall particle's summation density where DFSPH holds the layer
     to its rest sum (``FluidConfig.wall_pressure`` 'solved_rest_sum': :func:`cosim.fluid.wall_sampling.wall_rest_offsets`);
     zeros otherwise.
@@ -61,6 +65,8 @@ class FluidModel:
     b_vessel: wp.array
     b_volume: wp.array
     b_wetted: wp.array
+    b_side: wp.array
+    one_sided_walls: bool
     b_rest_offset: wp.array
     b_reach: np.ndarray
     wall_thickness: np.ndarray
@@ -132,7 +138,8 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
     check_memory(cfg, n_particles, len(b_local), wp.get_device(device))
     b_volume = np.concatenate([w[1] for w in walls]) if walls else np.zeros(0)
     b_wetted = np.concatenate([wetted_layer(s, w[0], cfg.spacing, cfg.dim) for s, w in zip(specs, walls)]) if walls else np.zeros(0, bool)
-    rest_sum = cfg.wall_pressure is WallPressure.SOLVED_REST_SUM
+    b_side = np.concatenate([wall_sides(s, cfg) for s in specs]) if specs else np.zeros(0, np.int32)
+    rest_sum = cfg.wall_pressure is WallPressure.SOLVED_REST_SUM and not b_side.any()  # DFSPH's; 'sided' is WCSPH's
     b_rest_offset = np.concatenate([wall_rest_offsets(s, cfg, *w) if rest_sum else np.zeros(len(w[0])) for s, w in zip(specs, walls)]) if walls else np.zeros(0)
     b_vessel = np.concatenate([np.full(len(s), k, dtype=np.int32) for k, s in enumerate(samples)]) if samples else np.zeros(0, np.int32)
     reach = np.array([np.linalg.norm(s, axis=1).max() for s in samples]) if samples else np.zeros(0)
@@ -150,6 +157,8 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
         b_vessel=wp.array(b_vessel, dtype=wp.int32, device=device),
         b_volume=wp.array(b_volume.astype(np.float32), dtype=float, device=device),
         b_wetted=wp.array(b_wetted.astype(np.int32), dtype=wp.int32, device=device),
+        b_side=wp.array(b_side, dtype=wp.int32, device=device),
+        one_sided_walls=bool(b_side.any()),
         b_rest_offset=wp.array(b_rest_offset.astype(np.float32), dtype=float, device=device),
         b_reach=reach,
         wall_thickness=thickness,

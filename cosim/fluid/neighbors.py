@@ -28,11 +28,11 @@ Every SPH sum over neighbours walks the same cells in the same order, written ou
             ...
             j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
         wall_end = nb.b_cell_end[cell]                                  # then the cell's wall particles
-        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
-        while item < wall_end:
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, nb.b_cell_start[cell], wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
+        while item < wall_end:                                          # those the particle sees (wall_seen)
             b = nb.b_order[item]
             ...
-            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
+            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, item + 1, wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
 
 (a body must not ``continue``: the loop advances at its end). So every kernel adds its terms in one order, cell
 by cell, in each the liquid before the walls. Each cell's candidates are scanned by a tight loop of their own
@@ -158,7 +158,9 @@ class Neighborhood:
     """The liquid and the wall particles sorted into one cell grid ``spec``, as the neighbour loops read them: the
     liquid in cell order (``x``, m; ``cell_start``/``cell_end``: each cell's range of it), the wall particles by
     indirection (``b_order``: their indices in cell order; ``b_cell_start``/``b_cell_end``: each cell's range of
-    ``b_order``; ``bx``, m)."""
+    ``b_order``; ``bx``, m), with which liquid sees each (``b_side``, ``b_vessel``: :func:`wall_seen`) and, for
+    each liquid particle in cell order, the vessels whose inner volume holds it (``inside``, bit v for vessel v;
+    written only where a wall is seen from one side, :func:`mark_inside_vessels`)."""
 
     spec: GridSpec
     cell_start: wp.array(dtype=wp.int32)
@@ -168,6 +170,9 @@ class Neighborhood:
     b_cell_start: wp.array(dtype=wp.int32)
     b_cell_end: wp.array(dtype=wp.int32)
     bx: wp.array(dtype=wp.vec3)
+    b_side: wp.array(dtype=wp.int32)
+    b_vessel: wp.array(dtype=wp.int32)
+    inside: wp.array(dtype=wp.int32)
 
 
 # Below this squared distance (m^2) a point is taken to be at x itself (the particle whose neighbours are summed),
@@ -207,16 +212,41 @@ def next_liquid_neighbor(points: wp.array(dtype=wp.vec3), item: int, end: int, x
     return end
 
 
+# Which liquid sees a wall particle (Neighborhood.b_side; cosim.fluid.wall_sampling.wall_sides): all of it, only the
+# liquid inside the particle's vessel, only the liquid outside it
+SEEN_ALWAYS = wp.constant(0)
+SEEN_FROM_INSIDE = wp.constant(1)
+SEEN_FROM_OUTSIDE = wp.constant(2)
+# The ``inside`` of a point that sees every wall particle (a wall particle's own sums, a solver without sided walls)
+SEES_EVERY_WALL = wp.constant(-1)
+
+
 @wp.func
-def next_wall_neighbor(order: wp.array(dtype=wp.int32), points: wp.array(dtype=wp.vec3), item: int, end: int, x: wp.vec3, radius2: float, min_r2: float) -> int:
+def wall_seen(side: int, vessel: int, inside: int) -> bool:
+    """Whether a point whose ``inside`` holds bit v for each vessel v whose inner volume holds it (or is
+    :data:`SEES_EVERY_WALL`) sees a wall particle of vessel ``vessel`` seen from ``side``."""
+    if inside < 0 or side == SEEN_ALWAYS:
+        return True
+    within = (inside >> vessel) & 1
+    return (within == 1) == (side == SEEN_FROM_INSIDE)
+
+
+@wp.func
+def next_wall_neighbor(
+    order: wp.array(dtype=wp.int32), points: wp.array(dtype=wp.vec3), sides: wp.array(dtype=wp.int32), vessel_of: wp.array(dtype=wp.int32),
+    item: int, end: int, x: wp.vec3, inside: int, radius2: float, min_r2: float,
+) -> int:
     """The first item of ``order`` (``Neighborhood.b_order``) from ``item`` on, before ``end`` (a cell's range of it),
-    whose wall particle in ``points`` (``Neighborhood.bx``) is a neighbour of ``x`` (:func:`within_support`); ``end``
-    where none is."""
+    whose wall particle in ``points`` (``Neighborhood.bx``) is a neighbour of ``x`` (:func:`within_support`) that a
+    point with ``inside`` sees (:func:`wall_seen`, ``sides`` and ``vessel_of`` the Neighborhood's); ``end`` where
+    none is."""
     j = item
     while j < end:
-        r = x - points[order[j]]
+        b = order[j]
+        r = x - points[b]
         if within_support(wp.dot(r, r), radius2, min_r2):
-            return j
+            if wall_seen(sides[b], vessel_of[b], inside):
+                return j
         j += 1
     return end
 
@@ -347,9 +377,10 @@ class CellGrid:
             op()
 
 
-def neighborhood(grid: CellGrid, x: wp.array, wall_grid: CellGrid, bx: wp.array) -> Neighborhood:
-    """The :class:`Neighborhood` of the liquid at ``x`` (in the cell order of ``grid``) and of the wall particles
-    at ``bx`` (sorted by ``wall_grid``, which must have the same cells)."""
+def neighborhood(grid: CellGrid, x: wp.array, wall_grid: CellGrid, bx: wp.array, b_side: wp.array, b_vessel: wp.array, inside: wp.array) -> Neighborhood:
+    """The :class:`Neighborhood` of the liquid at ``x`` (in the cell order of ``grid``; ``inside`` its vessels) and
+    of the wall particles at ``bx`` (sorted by ``wall_grid``, which must have the same cells; ``b_side``,
+    ``b_vessel``: which liquid sees each)."""
     nb = Neighborhood()
     nb.spec = grid.spec
     nb.cell_start = grid.cell_start
@@ -359,4 +390,7 @@ def neighborhood(grid: CellGrid, x: wp.array, wall_grid: CellGrid, bx: wp.array)
     nb.b_cell_start = wall_grid.cell_start
     nb.b_cell_end = wall_grid.cell_end
     nb.bx = bx
+    nb.b_side = b_side
+    nb.b_vessel = b_vessel
+    nb.inside = inside
     return nb

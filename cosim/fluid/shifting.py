@@ -155,14 +155,14 @@ def measure_concentration(
             gradient += concentration_gradient_term(prm, w_spacing, volume, r2, gw)
             j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
         wall_end = nb.b_cell_end[cell]
-        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, nb.b_cell_start[cell], wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
         while item < wall_end:
             b = nb.b_order[item]
             r = xi - nb.bx[b]
             r2 = wp.dot(r, r)
             volume = wall_mass(prm, b_volume, b) / prm.rest_density
             gradient += concentration_gradient_term(prm, w_spacing, volume, r2, kernel_gradient(prm, r, r2))
-            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
+            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, item + 1, wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
     lam = surface_indicator(prm.dim, moment)
     n = wp.vec3(0.0)
     if lam >= SURFACE_REGION:

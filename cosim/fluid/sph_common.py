@@ -48,6 +48,22 @@ def inside_any_vessel(prm: SPHParams, vessels: wp.array(dtype=VesselGeometry), m
     return False
 
 
+@item_kernel
+def mark_inside_vessels(
+    prm: SPHParams, vessels: wp.array(dtype=VesselGeometry), motions: wp.array(dtype=VesselMotion), x: wp.array(dtype=wp.vec3),
+    inside: wp.array(dtype=wp.int32),
+):
+    """Bit k of ``inside[i]`` set where liquid particle i lies in vessel k's inner volume (below its rim) at the
+    substep's start pose: the side of a 'sided' wall it sees (:func:`cosim.fluid.neighbors.wall_seen`)."""
+    i = wp.tid()
+    mask = int(0)
+    for k in range(prm.n_vessels):
+        m = motions[k]
+        if inside_vessel(wp.transpose(m.r_now) @ (x[i] - m.p_now), vessels[k], prm.dim) != 0:
+            mask = mask | (1 << k)
+    inside[i] = mask
+
+
 @wp.func
 def next_free_state(free_now: int, exposed: bool, summation: float, rest_density: float) -> int:
     """The free-liquid rule both solvers share (``FluidConfig.free_liquid``): 1 free, 0 bound. Bound liquid becomes

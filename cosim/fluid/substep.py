@@ -7,6 +7,7 @@ A substep of either solver (``cosim.fluid.wcsph_step``, ``cosim.fluid.dfsph_step
       place_wall_particles  the dummy wall particles at the start pose, with the wall's velocity
       find_neighbors        the cell lists of the wall particles (by indirection) and of the liquid (sorted)
       reorder_particles     the liquid's state gathered into cell order, into the other buffer
+      mark_inside           which vessels hold each particle, where a wall is seen from one side only
       shift_particles       particle shifting, where configured (``cosim.fluid.shifting``)
     ...                     the pressure solver's stages, ending in its integrate (wall guard, diagnostics)
     end_substep
@@ -32,7 +33,7 @@ from cosim.fluid.model import FluidModel, FluidState
 from cosim.fluid.neighbors import Neighborhood, neighborhood
 from cosim.fluid.program import Recorder
 from cosim.fluid.shifting import ShiftingScratch, shift_particles, shifting_on
-from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, next_substep, pair_capacity, sum_wall_wrench_chunks
+from cosim.fluid.sph_common import accumulate_wall_wrench, gather_particles, mark_inside_vessels, next_substep, pair_capacity, sum_wall_wrench_chunks
 from cosim.frames import Pose
 
 GUARD_MARGIN = 0.01  # the guard puts a particle this many dx outside the wall face it crossed
@@ -48,7 +49,9 @@ class SubstepScratch:
     force_sum, torque_sum: (V,) their sums over the interval (reduced in a fixed order through ``partial_wrench``);
     pair_capacity: entries of each particle's pair list; free_surface: (N,) each particle's free-surface indicator
     at its last substep's start, in that substep's particle order (written under ``FluidConfig.free_liquid_rule``
-    'free_surface' only; ``cosim.fluid.free_surface``); shifting: the particle shift's arrays, None where
+    'free_surface' only; ``cosim.fluid.free_surface``); inside: (N,) int32, the vessels whose inner volume holds each
+    particle (bit k for vessel k, in the substep's particle order; written only where the model has walls seen from
+    one side, zero otherwise); shifting: the particle shift's arrays, None where
     ``FluidConfig.particle_shifting`` is 'off' (``cosim.fluid.shifting``); diagnostics: the substeps' rows, per lane.
     """
 
@@ -80,6 +83,7 @@ class SubstepScratch:
         self._wrench_views = (self.force_sum.numpy(), self.torque_sum.numpy()) if d.is_cpu else None  # shared memory
         self._counter_views = (self.row.numpy(), *self._wrench_views) if d.is_cpu else None  # cleared every interval
         self.free_surface = wp.zeros(n, dtype=float, device=d)
+        self.inside = wp.zeros(n, dtype=wp.int32, device=d)
         self.shifting = ShiftingScratch(model) if shifting_on(model.config) else None
         self.diagnostics = DiagnosticBuffers(lanes.count, layout.atomic_replicas, nv, d)
 
@@ -117,7 +121,7 @@ class SubstepScratch:
     def neighborhood(self, model: FluidModel, st: FluidState) -> Neighborhood:
         """The liquid of ``st`` and the wall particles in the model's cell grids, as the neighbour loops read them
         (``cosim.fluid.neighbors``)."""
-        return neighborhood(model.grid, st.x, model.b_grid, self.bx)
+        return neighborhood(model.grid, st.x, model.b_grid, self.bx, model.b_side, model.b_vessel, self.inside)
 
     def guard_args(self, model: FluidModel) -> dict:
         """The arguments both solvers' integrate kernels take for the shared end of a particle's substep
@@ -170,6 +174,12 @@ def reorder_particles(rec: Recorder, m: FluidModel, src: FluidState, dst: FluidS
     )
 
 
+def mark_inside(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch) -> None:
+    """Which vessels hold each liquid particle of ``st`` (in cell order), where a wall is seen from one side only."""
+    if m.one_sided_walls:
+        rec.launch(mark_inside_vessels, m.n_particles, prm=m.params, vessels=m.vessels, motions=sh.motions, x=st.x, inside=sh.inside)
+
+
 def reduce_wrenches(rec: Recorder, m: FluidModel, sh: SubstepScratch) -> None:
     """Each vessel's force and torque from its particles summed in a fixed order (the same on every device and
     for any lane count, ``cosim.fluid.device_layout``) and added to the interval's sums."""
@@ -199,6 +209,7 @@ def start_substep(rec: Recorder, m: FluidModel, src: FluidState, dst: FluidState
     place_wall_particles(rec, m, sh)
     find_neighbors(rec, m, src, sh)
     reorder_particles(rec, m, src, dst)
+    mark_inside(rec, m, dst, sh)
     shift_particles(rec, m, dst, sh)
 
 

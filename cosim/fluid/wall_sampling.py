@@ -17,6 +17,12 @@ The walls hold layers of dummy particles (Adami, Hu & Adams 2012), filled one of
   the wall is thinner), so that the fitted layer also gives the liquid's first row the covering walls' kernel
   gradient; along the faces it stays on the lattice. A mesh wall keeps the lattice's depth.
 
+- ``sided`` (WCSPH): both sets, each seen from one side of the vessel (:func:`wall_sides`): the liquid inside the
+  vessel's inner volume sees the ``kernel_layers`` particles, the liquid outside it (over the rim, in the stream,
+  on the outer faces) the ``real_thickness`` ones, as fixed ghost particles are seen only from the liquid's side of
+  a wall (Marrone et al. 2011, "delta-SPH model for simulating violent impact flows", CMAME 200). The liquid at rest
+  in the vessel is held as by covering walls; the crest and the outer faces it leaves over are the vessel's own.
+
 Layers sit below the rim, so liquid flowing over the rim sees the wall beneath it. In 2-D only the section in the
 pour plane (local y = 0) is filled: the floor and the +x / -x walls; a cylinder's section is that of a box of width
 2R. Each particle carries its own volume (m^dim): the slab volume divided by the number of particles in it, close
@@ -34,6 +40,7 @@ import numpy as np
 from cosim.errors import InputError
 from cosim.fluid.config import DEFAULT_WALL_MODEL, FluidConfig, KernelType, WallModel
 from cosim.fluid.mesh_sampling import mesh_wetted_layer, sample_mesh_walls
+from cosim.fluid.neighbors import SEEN_ALWAYS, SEEN_FROM_INSIDE, SEEN_FROM_OUTSIDE
 from cosim.fluid.sph_kernels import kernel_derivatives, kernel_values, lattice_kernel_sum
 from cosim.vessel import VesselSpec
 
@@ -94,19 +101,21 @@ def wall_model_for(spec: VesselSpec, cfg: FluidConfig) -> WallModel:
     """How ``spec``'s walls are filled: ``cfg.wall_model`` where set; where unset the pressure solver's own
     (:data:`cosim.fluid.config.DEFAULT_WALL_MODEL`), except that a wall holding no layer at the spacing
     (:func:`holds_a_layer`) and a mesh vessel's wall, whose confined sampling is not validated, get
-    ``kernel_layers``."""
-    if cfg.wall_model is not None:
-        return cfg.wall_model
-    model = DEFAULT_WALL_MODEL[cfg.pressure_solver]
-    if model is WallModel.REAL_THICKNESS and (spec.is_mesh or not holds_a_layer(spec, cfg.spacing)):
-        return WallModel.KERNEL_LAYERS
+    ``kernel_layers``; so does such a wall under ``sided``, set or not."""
+    model = cfg.wall_model
+    if model is None:
+        model = DEFAULT_WALL_MODEL[cfg.pressure_solver]
+        if model is WallModel.REAL_THICKNESS and (spec.is_mesh or not holds_a_layer(spec, cfg.spacing)):
+            return WallModel.KERNEL_LAYERS
+    if model is WallModel.SIDED and (spec.is_mesh or not holds_a_layer(spec, cfg.spacing)):
+        return WallModel.KERNEL_LAYERS  # no own wall to see from outside (or, for a mesh, no inner volume test)
     return model
 
 
 def numerical_wall_thickness(spec: VesselSpec, cfg: FluidConfig) -> float:
     """Wall thickness (m) the liquid sees: the vessel's own, or under ``kernel_layers`` the dummy layers' if those
-    are thicker."""
-    if wall_model_for(spec, cfg) is WallModel.REAL_THICKNESS:
+    are thicker (under ``sided`` the vessel's own: the covering layers beyond it are seen only from inside)."""
+    if wall_model_for(spec, cfg) in (WallModel.REAL_THICKNESS, WallModel.SIDED):
         return spec.wall_thickness
     return max(spec.wall_thickness, wall_layers(cfg.spacing, cfg.support_radius) * cfg.spacing)
 
@@ -322,8 +331,12 @@ def covers_support(spec: VesselSpec, cfg: FluidConfig) -> bool:
 
 def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
     """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim), for ``cfg``'s spacing,
-    kernel support, dimension and wall model; a thin wall's volumes fitted (:func:`fit_wall_volumes`). Raises
+    kernel support, dimension and wall model; a thin wall's volumes fitted (:func:`fit_wall_volumes`); under
+    ``sided`` the ``kernel_layers`` particles, then the ``real_thickness`` ones (:func:`wall_sides`). Raises
     InputError for a wall too thin to hold a layer."""
+    if wall_model_for(spec, cfg) is WallModel.SIDED:
+        sets = [sample_vessel_walls(spec, replace(cfg, wall_model=model)) for model in SIDED_SETS]
+        return np.concatenate([p for p, _ in sets]), np.concatenate([v for _, v in sets])
     points, volumes = slab_particles(spec, cfg)
     if len(points) == 0:
         raise InputError(f"fluid.wall_model: the {spec.name} vessel's wall ({spec.wall_thickness:.4g} m) holds no "
@@ -332,6 +345,22 @@ def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray,
     if covers_support(spec, cfg):
         return points, volumes
     return points, fit_wall_volumes(spec, cfg, points, volumes)
+
+
+# The two sets of a 'sided' wall, in the order sample_vessel_walls concatenates them, and the liquid each is seen by
+SIDED_SETS = (WallModel.KERNEL_LAYERS, WallModel.REAL_THICKNESS)
+SIDED_SEEN_FROM = (SEEN_FROM_INSIDE, SEEN_FROM_OUTSIDE)
+
+
+def wall_sides(spec: VesselSpec, cfg: FluidConfig) -> np.ndarray:
+    """(n,) int32, for each particle of :func:`sample_vessel_walls`, which liquid sees it
+    (:func:`cosim.fluid.neighbors.wall_seen`): under ``sided`` the covering layers only the liquid inside the
+    vessel's inner volume (``SEEN_FROM_INSIDE``), the vessel's own wall only the liquid outside it
+    (``SEEN_FROM_OUTSIDE``); every particle of the other models all liquid (``SEEN_ALWAYS``)."""
+    if wall_model_for(spec, cfg) is not WallModel.SIDED:
+        return np.full(len(slab_particles(spec, cfg)[0]), SEEN_ALWAYS, dtype=np.int32)
+    counts = [len(slab_particles(spec, replace(cfg, wall_model=model))[0]) for model in SIDED_SETS]
+    return np.repeat(np.array(SIDED_SEEN_FROM, dtype=np.int32), counts)
 
 
 def wall_rest_offsets(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, volumes: np.ndarray) -> np.ndarray:

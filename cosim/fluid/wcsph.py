@@ -220,7 +220,7 @@ def update_free_liquid(
             count += 1
             j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
         wall_end = nb.b_cell_end[cell]
-        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, nb.b_cell_start[cell], wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
         while item < wall_end:
             b = nb.b_order[item]
             r = xi - nb.bx[b]
@@ -236,7 +236,7 @@ def update_free_liquid(
                     pair_index[i, count] = wall_pair(b)
                     pair_grad[i, count] = gw
             count += 1
-            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
+            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, item + 1, wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
     if record_pairs != 0:
         pair_count[i] = wp.min(count, capacity)
         if count > capacity:
@@ -416,7 +416,7 @@ def compute_forces(
                 count += 1
                 j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
             wall_end = nb.b_cell_end[cell]
-            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, nb.b_cell_start[cell], wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
             while item < wall_end:
                 b = nb.b_order[item]
                 r = xi - nb.bx[b]
@@ -431,7 +431,7 @@ def compute_forces(
                 sums.a = sums.a + ab
                 add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
                 count += 1
-                item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
+                item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, item + 1, wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
         if count > capacity:
             wp.atomic_add(diag_i, diag_slot(prm, row[0], i), DIAG_PAIR_OVERFLOW, 1)
         if record:
@@ -594,13 +594,13 @@ def compute_density_rate_walking(
             dr = add_liquid_density_rate(prm, dr, diffusion, rhoi, grad_i, vi, r, r2, gw, v[j] + h * acc[j], rho[j], rho_grad[j], mass[j])
             j = next_liquid_neighbor(nb.x, j + 1, liquid_end, xi, radius2, COINCIDENT_R2)
         wall_end = nb.b_cell_end[cell]
-        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_cell_start[cell], wall_end, xi, radius2, COINCIDENT_R2)
+        item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, nb.b_cell_start[cell], wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
         while item < wall_end:
             b = nb.b_order[item]
             r = xi - nb.bx[b]
             r2 = wp.dot(r, r)
             dr += wall_density_rate(prm, b_volume[b], vi, bv[b], kernel_gradient(prm, r, r2))
-            item = next_wall_neighbor(nb.b_order, nb.bx, item + 1, wall_end, xi, radius2, COINCIDENT_R2)
+            item = next_wall_neighbor(nb.b_order, nb.bx, nb.b_side, nb.b_vessel, item + 1, wall_end, xi, nb.inside[i], radius2, COINCIDENT_R2)
     drho[i] = dr
 
 

@@ -1,0 +1,94 @@
+"""WCSPH's 'sided' walls (``fluid.wall_model = "sided"``, cosim.fluid.wall_sampling): both the covering layers and
+the vessel's own wall, the first seen only by the liquid inside the vessel, the second only by the liquid outside
+it (cosim.fluid.neighbors.wall_seen). So the liquid inside moves exactly as with ``kernel_layers`` and the liquid
+outside exactly as with ``real_thickness``, the crest it leaves over included."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from cosim.errors import InputError
+from cosim.fluid.config import FluidConfig, WallModel
+from cosim.fluid.neighbors import SEEN_ALWAYS, SEEN_FROM_INSIDE, SEEN_FROM_OUTSIDE
+from cosim.fluid.seeding import ParticleSet, fill_vessel
+from cosim.fluid.solver import FluidSolver
+from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls, wall_model_for, wall_sides
+from cosim.frames import Pose
+from cosim.vessel import VesselSpec, seed_pouring_vessel
+
+POURER = seed_pouring_vessel()
+TANK = VesselSpec(name="tank", inner_width=0.06, inner_depth=0.1, inner_height=0.06, wall_thickness=0.004)
+DX = 0.005
+
+
+def wcsph(model: WallModel, dim: int = 2, spacing: float = DX) -> FluidConfig:
+    return FluidConfig(dim=dim, spacing=spacing, pressure_solver="wcsph", wall_model=model, max_expected_speed=1.0,
+                       domain_min=(-0.15, -0.1, -0.05), domain_max=(0.15, 0.1, 0.15))
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_sided_walls_are_the_covering_layers_then_the_vessels_own(dim):
+    cfg = wcsph(WallModel.SIDED, dim, POURER.inner_width / 20)
+    points, volumes = sample_vessel_walls(POURER, cfg)
+    cover = sample_vessel_walls(POURER, replace(cfg, wall_model=WallModel.KERNEL_LAYERS))
+    own = sample_vessel_walls(POURER, replace(cfg, wall_model=WallModel.REAL_THICKNESS))
+    assert np.array_equal(points, np.concatenate([cover[0], own[0]]))
+    assert np.array_equal(volumes, np.concatenate([cover[1], own[1]]))
+    sides = wall_sides(POURER, cfg)
+    assert sides.tolist() == [SEEN_FROM_INSIDE] * len(cover[0]) + [SEEN_FROM_OUTSIDE] * len(own[0])
+    # the guard and the controller's lip: the vessel's own wall
+    assert numerical_wall_thickness(POURER, cfg) == POURER.wall_thickness
+
+
+def test_other_wall_models_are_seen_by_all_liquid():
+    for model in (WallModel.KERNEL_LAYERS, WallModel.REAL_THICKNESS):
+        cfg = wcsph(model)
+        assert (wall_sides(TANK, cfg) == SEEN_ALWAYS).all()
+        assert len(wall_sides(TANK, cfg)) == len(sample_vessel_walls(TANK, cfg)[0])
+
+
+def test_a_wall_too_thin_for_a_layer_gets_the_covering_layers():
+    thin = replace(TANK, wall_thickness=0.4 * DX)
+    assert wall_model_for(thin, wcsph(WallModel.SIDED)) is WallModel.KERNEL_LAYERS
+    assert (wall_sides(thin, wcsph(WallModel.SIDED)) == SEEN_ALWAYS).all()
+
+
+def test_sided_walls_are_refused_under_dfsph():
+    with pytest.raises(InputError, match="fluid.wall_model: 'sided' is for pressure_solver 'wcsph'"):
+        FluidConfig(pressure_solver="dfsph", wall_model="sided")
+
+
+def _run(cfg: FluidConfig, particles: ParticleSet, duration: float = 0.02) -> FluidSolver:
+    solver = FluidSolver(cfg, [TANK], [Pose()], particles, device="cpu")
+    solver.advance(duration)
+    return solver
+
+
+def test_liquid_inside_moves_as_with_the_covering_layers():
+    """A resting tank: every particle inside sees the covering layers only, the same particles in the same order,
+    so the run is the kernel_layers run to the bit (its wall reaction too)."""
+    liquid = fill_vessel(TANK, 0.04, wcsph(WallModel.KERNEL_LAYERS))
+    sided, covering = (_run(wcsph(model), liquid) for model in (WallModel.SIDED, WallModel.KERNEL_LAYERS))
+    assert np.array_equal(sided.positions(), covering.positions())
+    assert np.array_equal(sided.velocities(), covering.velocities())
+    assert np.array_equal(sided.vessel_wrenches(), covering.vessel_wrenches())
+
+
+def test_liquid_outside_moves_as_with_the_vessels_own_wall():
+    """Drops beside the outer face and on the rim (outside the inner volume; the covering layers would hold them
+    inside their slab) see the vessel's own wall only: the real_thickness run to the bit, and the wall does act on
+    them (the run differs from the drops' without a vessel)."""
+    cfg = wcsph(WallModel.SIDED)
+    b, t, h = 0.5 * TANK.inner_width, TANK.wall_thickness, TANK.inner_height
+    drops = np.array([[b + t + 0.6 * DX, 0.0, 0.5 * h], [b + t + 0.6 * DX, 0.0, 0.5 * h + DX],
+                      [-b - 0.5 * t, 0.0, h + 0.7 * DX], [-b - 0.5 * t + DX, 0.0, h + 0.7 * DX]])
+    particles = ParticleSet(drops, np.zeros_like(drops), np.full(len(drops), cfg.rest_density))
+    sided, own = (_run(wcsph(model), particles) for model in (WallModel.SIDED, WallModel.REAL_THICKNESS))
+    alone = FluidSolver(cfg, [], [], particles, device="cpu")
+    alone.advance(0.02)
+    assert np.array_equal(sided.positions(), own.positions())
+    assert np.array_equal(sided.vessel_wrenches(), own.vessel_wrenches())
+    assert np.abs(sided.velocities() - alone.velocities()).max() > 1e-3
