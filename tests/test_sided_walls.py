@@ -92,3 +92,18 @@ def test_liquid_outside_moves_as_with_the_vessels_own_wall():
     assert np.array_equal(sided.positions(), own.positions())
     assert np.array_equal(sided.vessel_wrenches(), own.vessel_wrenches())
     assert np.abs(sided.velocities() - alone.velocities()).max() > 1e-3
+
+
+def test_sided_walls_give_the_same_bits_on_two_lanes():
+    """The marks of which vessel holds each particle are written by every lane for its share and read across
+    shares (a wall particle's extrapolated state sums any liquid around it): two lanes give one lane's bits."""
+    cfg = wcsph(WallModel.SIDED)
+    liquid = fill_vessel(TANK, 0.04, cfg)
+    b, t, h = 0.5 * TANK.inner_width, TANK.wall_thickness, TANK.inner_height
+    drops = np.array([[b + t + 0.6 * DX, 0.0, 0.5 * h], [-b - 0.5 * t, 0.0, h + 0.7 * DX]])
+    positions = np.concatenate([liquid.positions, drops])
+    particles = ParticleSet(positions, np.zeros_like(positions), np.full(len(positions), cfg.rest_density))
+    one, two = (_run(replace(cfg, cpu_threads=threads), particles) for threads in (1, 2))
+    assert two.lanes.count == 2
+    assert np.array_equal(one.positions(), two.positions())
+    assert np.array_equal(one.vessel_wrenches(), two.vessel_wrenches())
