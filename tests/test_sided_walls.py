@@ -107,3 +107,13 @@ def test_sided_walls_give_the_same_bits_on_two_lanes():
     assert two.lanes.count == 2
     assert np.array_equal(one.positions(), two.positions())
     assert np.array_equal(one.vessel_wrenches(), two.vessel_wrenches())
+
+
+def test_sided_walls_refuse_more_vessels_than_a_mark_holds():
+    from cosim.fluid.model import MAX_SIDED_VESSELS
+
+    cfg = wcsph(WallModel.SIDED)
+    tanks = [TANK] * (MAX_SIDED_VESSELS + 1)
+    poses = [Pose((0.0, 0.0, 0.0))] * len(tanks)
+    with pytest.raises(InputError, match=f"fluid.wall_model: 'sided' walls need at most {MAX_SIDED_VESSELS} vessels"):
+        FluidSolver(cfg, tanks, poses, fill_vessel(TANK, 0.02, cfg), device="cpu")

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
+from cosim.errors import InputError
 from cosim.fluid.boundary import SHAPE_BOX, SHAPE_CYLINDER, VesselGeometry
 from cosim.fluid.mesh_boundary import SHAPE_MESH
 from cosim.fluid.mesh_sampling import cavity_bounds, warp_mesh
@@ -27,6 +28,11 @@ from cosim.fluid.neighbors import CellGrid
 from cosim.fluid.params import SPHParams, make_params
 from cosim.fluid.wall_sampling import numerical_wall_thickness, sample_vessel_walls, wall_rest_offsets, wall_sides, wetted_layer
 from cosim.vessel import VesselSpec
+
+
+# Vessels a scene with 'sided' walls may hold: each liquid particle's vessels are the bits of one int32
+# (cosim.fluid.sph_common.mark_inside_vessels)
+MAX_SIDED_VESSELS = 31
 
 
 @dataclass
@@ -139,6 +145,9 @@ def build_model(cfg: FluidConfig, specs: tuple[VesselSpec, ...], n_particles: in
     b_volume = np.concatenate([w[1] for w in walls]) if walls else np.zeros(0)
     b_wetted = np.concatenate([wetted_layer(s, w[0], cfg.spacing, cfg.dim) for s, w in zip(specs, walls)]) if walls else np.zeros(0, bool)
     b_side = np.concatenate([wall_sides(s, cfg) for s in specs]) if specs else np.zeros(0, np.int32)
+    if b_side.any() and len(specs) > MAX_SIDED_VESSELS:
+        raise InputError(f"fluid.wall_model: 'sided' walls need at most {MAX_SIDED_VESSELS} vessels (a bit each in a "
+                         f"particle's mark), got {len(specs)}")
     rest_sum = cfg.wall_pressure is WallPressure.SOLVED_REST_SUM and not b_side.any()  # DFSPH's; 'sided' is WCSPH's
     b_rest_offset = np.concatenate([wall_rest_offsets(s, cfg, *w) if rest_sum else np.zeros(len(w[0])) for s, w in zip(specs, walls)]) if walls else np.zeros(0)
     b_vessel = np.concatenate([np.full(len(s), k, dtype=np.int32) for k, s in enumerate(samples)]) if samples else np.zeros(0, np.int32)
