@@ -39,11 +39,17 @@ def pair_capacity(dim: int, smoothing_ratio: float) -> int:
 
 
 @wp.func
+def inside_vessel_now(prm: SPHParams, geo: VesselGeometry, m: VesselMotion, x: wp.vec3) -> bool:
+    """Whether the world point x is in the inner volume (below the rim) of the vessel ``geo`` at its pose at the
+    substep's start (``m.r_now``, ``m.p_now``)."""
+    return inside_vessel(wp.transpose(m.r_now) @ (x - m.p_now), geo, prm.dim) != 0
+
+
+@wp.func
 def inside_any_vessel(prm: SPHParams, vessels: wp.array(dtype=VesselGeometry), motions: wp.array(dtype=VesselMotion), x: wp.vec3) -> bool:
     """Whether x is in some vessel's inner volume (below its rim) at the substep's start pose."""
     for k in range(prm.n_vessels):
-        m = motions[k]
-        if inside_vessel(wp.transpose(m.r_now) @ (x - m.p_now), vessels[k], prm.dim) != 0:
+        if inside_vessel_now(prm, vessels[k], motions[k], x):
             return True
     return False
 
@@ -58,8 +64,7 @@ def mark_inside_vessels(
     i = wp.tid()
     mask = int(0)
     for k in range(prm.n_vessels):
-        m = motions[k]
-        if inside_vessel(wp.transpose(m.r_now) @ (x[i] - m.p_now), vessels[k], prm.dim) != 0:
+        if inside_vessel_now(prm, vessels[k], motions[k], x[i]):
             mask = mask | (1 << k)
     inside[i] = mask
 
