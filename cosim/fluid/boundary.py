@@ -7,7 +7,10 @@ p(tau) = p0 + v tau, R(tau) = exp([w] tau) R0. The dummy wall particles ride on 
 v + w x (x_b - p). Their pressure is extrapolated from the liquid each substep (Adami, Hu & Adams 2012):
 p_w = (sum_f p_f W_wf + (g - a_w) . sum_f rho_f (x_w - x_f) W_wf) / sum_f W_wf, clamped at 0 so walls never
 pull on the liquid, with a_w the wall's acceleration; and a no-slip velocity 2 v_wall - (sum_f v_f W_wf /
-sum_f W_wf) is extrapolated for the viscous terms.
+sum_f W_wf) is extrapolated for the viscous terms. A wall particle of a vessel's own wall under ``wall_model =
+"sided"`` (seen by the liquid outside the vessel) has liquid on two faces: the cavity's side (the liquid inside and
+the liquid over the rim on that side) and the outer faces; it carries one state per face, each extrapolated from the
+liquid on that face (:func:`on_inner_face`), as a wall's particles see one side of it (Marrone et al. 2011).
 
 The non-penetration guard (:func:`guard_vessel`) runs after every position update: a particle whose path from its
 old position (in the vessel frame at the old pose) to its new one (in the frame at the new pose) enters the wall
@@ -23,7 +26,7 @@ import warp as wp
 
 from cosim.fluid.lanes import item_kernel
 from cosim.fluid.mesh_boundary import SHAPE_MESH, mesh_guard, mesh_inside
-from cosim.fluid.neighbors import Neighborhood, neighbor_cells, next_liquid_neighbor, reachable_cell, wall_seen
+from cosim.fluid.neighbors import SEEN_FROM_OUTSIDE, Neighborhood, neighbor_cells, next_liquid_neighbor, reachable_cell, wall_seen
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_kernels import kernel_w
 
@@ -123,10 +126,77 @@ def place_wall_particles(
     v[b] = m.lin_vel + wp.cross(m.ang_vel, arm)
 
 
+@wp.struct
+class WallStateSums:
+    """The sums of one wall particle's extrapolation over the liquid around it (Adami, Hu & Adams 2012): sum_f W_wf,
+    sum_f p_f W_wf (Pa), sum_f rho_f (x_w - x_f) W_wf (kg/m^2), sum_f v_f W_wf (m/s)."""
+
+    w: float
+    pw: float
+    rho_r: wp.vec3
+    v: wp.vec3
+
+
+@wp.func
+def add_to_wall_state(sums: WallStateSums, w: float, p: float, rho: float, r: wp.vec3, v: wp.vec3) -> WallStateSums:
+    """``sums`` with liquid particle f added: its kernel weight w, pressure p, density rho, x_w - x_f = r, velocity v."""
+    out = WallStateSums()
+    out.w = sums.w + w
+    out.pw = sums.pw + p * w
+    out.rho_r = sums.rho_r + (rho * w) * r
+    out.v = sums.v + w * v
+    return out
+
+
+@wp.func
+def write_wall_state(
+    prm: SPHParams, sums: WallStateSums, g_rel: wp.vec3, v_wall: wp.vec3, b: int,
+    b_p: wp.array(dtype=float), b_rho: wp.array(dtype=float), b_v_noslip: wp.array(dtype=wp.vec3),
+):
+    """Wall particle b's pressure (Pa, clamped at 0), density (kg/m^3, the equation of state's) and no-slip velocity
+    (m/s) from its sums; ``g_rel`` the gravity less the wall's acceleration, ``v_wall`` the wall's velocity there.
+    With no liquid around it: pressure 0, the wall's velocity."""
+    pw = float(0.0)
+    v_noslip = v_wall
+    if sums.w > 0.0:
+        pw = wp.max((sums.pw + wp.dot(g_rel, sums.rho_r)) / sums.w, 0.0)
+        v_noslip = 2.0 * v_wall - sums.v / sums.w
+    b_p[b] = pw
+    b_rho[b] = prm.rest_density * wp.pow(1.0 + pw / prm.eos_b, 1.0 / prm.gamma)
+    b_v_noslip[b] = v_noslip
+
+
+@wp.func
+def cavity_distance(q: wp.vec3, geo: VesselGeometry, dim: int) -> float:
+    """m, the distance of the vessel-frame point q from the vessel's cavity continued upward past its rim (its inner
+    section, over the floor, at any height): 0 inside it, the depth into the walls or the distance past their outer
+    faces outside. A box or cylinder (in 2-D a cylinder is a box section)."""
+    below = wp.max(-q[2], 0.0)
+    across = float(0.0)
+    if geo.shape == SHAPE_CYLINDER and dim == 3:
+        across = wp.max(wp.sqrt(q[0] * q[0] + q[1] * q[1]) - geo.half_width, 0.0)
+    else:
+        across = wp.max(wp.abs(q[0]) - geo.half_width, 0.0)
+        if dim == 3:
+            beside = wp.max(wp.abs(q[1]) - geo.half_depth, 0.0)
+            across = wp.sqrt(across * across + beside * beside)
+    return wp.sqrt(across * across + below * below)
+
+
+@wp.func
+def on_inner_face(prm: SPHParams, geo: VesselGeometry, m: VesselMotion, x: wp.vec3) -> bool:
+    """Whether the world point x is on the cavity's side of the vessel's own wall: nearer the cavity continued past
+    the rim (:func:`cavity_distance`) than the wall is thick, as the liquid inside and the liquid
+    over the rim and the crest are; otherwise it is beyond the wall's outer faces. The vessel at its pose at the
+    substep's start."""
+    return cavity_distance(wp.transpose(m.r_now) @ (x - m.p_now), geo, prm.dim) < geo.thickness
+
+
 @item_kernel
 def extrapolate_wall_state(
     # Model
     prm: SPHParams,
+    vessels: wp.array(dtype=VesselGeometry),
     b_vessel: wp.array(dtype=wp.int32),
     # State in
     motions: wp.array(dtype=VesselMotion),
@@ -139,20 +209,29 @@ def extrapolate_wall_state(
     b_p: wp.array(dtype=float),
     b_rho: wp.array(dtype=float),
     b_v_noslip: wp.array(dtype=wp.vec3),
+    b_p_inner: wp.array(dtype=float),
+    b_rho_inner: wp.array(dtype=float),
+    b_v_noslip_inner: wp.array(dtype=wp.vec3),
 ):
     """Pressure, density and no-slip velocity of each dummy wall particle from the liquid around it that sees it
-    (:func:`cosim.fluid.neighbors.wall_seen`)."""
+    (:func:`cosim.fluid.neighbors.wall_seen`). A particle of a sided vessel's own wall (seen from outside) gets
+    two: ``b_p`` ... from the liquid beyond the wall's outer faces, ``b_p_inner`` ... from the liquid on the cavity's
+    side (:func:`on_inner_face`: the liquid inside, which does not see it, and the liquid over the rim that does)."""
     b = wp.tid()
     xb = nb.bx[b]
     vessel = b_vessel[b]
     side = nb.b_side[b]
+    two_faces = side == SEEN_FROM_OUTSIDE
     m = motions[vessel]
+    geo = vessels[vessel]
     arm = xb - m.p_now
     a_wall = m.lin_acc + wp.cross(m.ang_acc, arm) + wp.cross(m.ang_vel, wp.cross(m.ang_vel, arm))
-    sum_w = float(0.0)
-    sum_pw = float(0.0)
-    sum_rho_r = wp.vec3(0.0)
-    sum_v = wp.vec3(0.0)
+    outer = WallStateSums()
+    outer.rho_r = wp.vec3(0.0)
+    outer.v = wp.vec3(0.0)
+    inner = WallStateSums()
+    inner.rho_r = wp.vec3(0.0)
+    inner.v = wp.vec3(0.0)
     radius2 = prm.support * prm.support
     cells = neighbor_cells(nb.spec, xb)
     for k in range(cells.count):
@@ -162,23 +241,23 @@ def extrapolate_wall_state(
         liquid_end = nb.cell_end[cell]  # the liquid only, however near
         f = next_liquid_neighbor(nb.x, nb.cell_start[cell], liquid_end, xb, radius2, 0.0)
         while f < liquid_end:
-            if wall_seen(side, vessel, nb.inside[f]):  # only the liquid that sees this particle
-                r = xb - nb.x[f]
-                r2 = wp.dot(r, r)
-                w = kernel_w(wp.sqrt(r2), prm.inv_h, prm.sigma, prm.kernel)
-                sum_w += w
-                sum_pw += p[f] * w
-                sum_rho_r += (rho[f] * w) * r
-                sum_v += w * v[f]
+            xf = nb.x[f]
+            if two_faces:
+                r = xb - xf
+                w = kernel_w(wp.sqrt(wp.dot(r, r)), prm.inv_h, prm.sigma, prm.kernel)
+                if on_inner_face(prm, geo, m, xf):
+                    inner = add_to_wall_state(inner, w, p[f], rho[f], r, v[f])
+                else:
+                    outer = add_to_wall_state(outer, w, p[f], rho[f], r, v[f])
+            elif wall_seen(side, vessel, nb.inside[f]):  # only the liquid that sees this particle
+                r = xb - xf
+                w = kernel_w(wp.sqrt(wp.dot(r, r)), prm.inv_h, prm.sigma, prm.kernel)
+                outer = add_to_wall_state(outer, w, p[f], rho[f], r, v[f])
             f = next_liquid_neighbor(nb.x, f + 1, liquid_end, xb, radius2, 0.0)
-    pw = float(0.0)
-    v_noslip = bv[b]
-    if sum_w > 0.0:
-        pw = wp.max((sum_pw + wp.dot(prm.gravity - a_wall, sum_rho_r)) / sum_w, 0.0)
-        v_noslip = 2.0 * bv[b] - sum_v / sum_w
-    b_p[b] = pw
-    b_rho[b] = prm.rest_density * wp.pow(1.0 + pw / prm.eos_b, 1.0 / prm.gamma)
-    b_v_noslip[b] = v_noslip
+    g_rel = prm.gravity - a_wall
+    write_wall_state(prm, outer, g_rel, bv[b], b, b_p, b_rho, b_v_noslip)
+    if two_faces:
+        write_wall_state(prm, inner, g_rel, bv[b], b, b_p_inner, b_rho_inner, b_v_noslip_inner)
 
 
 @wp.func

@@ -41,11 +41,11 @@ from __future__ import annotations
 
 import warp as wp
 
-from cosim.fluid.boundary import VesselGeometry, VesselMotion
+from cosim.fluid.boundary import VesselGeometry, VesselMotion, on_inner_face
 from cosim.fluid.diagnostics import DIAG_INTERNAL_ENERGY, DIAG_MAX_ACCEL, DIAG_MAX_COMPRESSION, DIAG_MAX_DENSITY_ERROR, DIAG_PAIR_OVERFLOW
 from cosim.fluid.free_surface import FREE_AT_SURFACE, FREE_LIQUID_OFF, FREE_OUTSIDE_VESSELS, exposed_liquid, renormalisation_term, surface_indicator
 from cosim.fluid.lanes import item_kernel
-from cosim.fluid.neighbors import COINCIDENT_R2, Neighborhood, neighbor_cells, next_liquid_neighbor, next_wall_neighbor, reachable_cell
+from cosim.fluid.neighbors import COINCIDENT_R2, SEEN_FROM_OUTSIDE, Neighborhood, neighbor_cells, next_liquid_neighbor, next_wall_neighbor, reachable_cell
 from cosim.fluid.params import SPHParams
 from cosim.fluid.sph_common import (
     add_wall_reaction,
@@ -302,6 +302,23 @@ def wall_pair_acceleration(
     return ab + viscous_pair(prm, alpha_wall, mb, r, r2, gw, vi - vb, vi - vb_noslip, rhoi, rhob)
 
 
+@wp.func
+def wall_state_seen(
+    prm: SPHParams, vessels: wp.array(dtype=VesselGeometry), motions: wp.array(dtype=VesselMotion), nb: Neighborhood,
+    b_vessel: wp.array(dtype=wp.int32), b_p: wp.array(dtype=float), b_rho: wp.array(dtype=float),
+    b_v_noslip: wp.array(dtype=wp.vec3), b_p_inner: wp.array(dtype=float), b_rho_inner: wp.array(dtype=float),
+    b_v_noslip_inner: wp.array(dtype=wp.vec3), b: int, x: wp.vec3,
+):
+    """The extrapolated pressure (Pa), density (kg/m^3) and no-slip velocity (m/s) of wall particle b as the liquid at
+    x sees it: a sided vessel's own wall particle shows the state of the face x is at
+    (:func:`cosim.fluid.boundary.on_inner_face`), every other its one state."""
+    if nb.b_side[b] == SEEN_FROM_OUTSIDE:
+        vessel = b_vessel[b]
+        if on_inner_face(prm, vessels[vessel], motions[vessel], x):
+            return b_p_inner[b], b_rho_inner[b], b_v_noslip_inner[b]
+    return b_p[b], b_rho[b], b_v_noslip[b]
+
+
 @item_kernel
 def compute_forces(
     # Model
@@ -322,6 +339,9 @@ def compute_forces(
     b_p: wp.array(dtype=float),
     b_rho: wp.array(dtype=float),
     b_v_noslip: wp.array(dtype=wp.vec3),
+    b_p_inner: wp.array(dtype=float),
+    b_rho_inner: wp.array(dtype=float),
+    b_v_noslip_inner: wp.array(dtype=wp.vec3),
     row: wp.array(dtype=wp.int32),
     capacity: int,
     pairs: int,
@@ -390,9 +410,10 @@ def compute_forces(
             else:
                 b = pair_wall(code)
                 r = xi - nb.bx[b]
-                ab = wall_pair_acceleration(
-                    prm, tic, own_wall, alpha_wall, vi, rhoi, r, wp.dot(r, r), gw, wall_mass(prm, b_volume, b), b_p[b], b_rho[b], bv[b], b_v_noslip[b],
+                pb, rhob, vb_noslip = wall_state_seen(
+                    prm, vessels, motions, nb, b_vessel, b_p, b_rho, b_v_noslip, b_p_inner, b_rho_inner, b_v_noslip_inner, b, xi,
                 )
+                ab = wall_pair_acceleration(prm, tic, own_wall, alpha_wall, vi, rhoi, r, wp.dot(r, r), gw, wall_mass(prm, b_volume, b), pb, rhob, bv[b], vb_noslip)
                 sums.a = sums.a + ab
                 add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
     else:
@@ -425,9 +446,10 @@ def compute_forces(
                 if record and count < capacity:
                     pair_index[i, count] = wall_pair(b)
                     pair_grad[i, count] = gw
-                ab = wall_pair_acceleration(
-                    prm, tic, own_wall, alpha_wall, vi, rhoi, r, r2, gw, wall_mass(prm, b_volume, b), b_p[b], b_rho[b], bv[b], b_v_noslip[b],
+                pb, rhob, vb_noslip = wall_state_seen(
+                    prm, vessels, motions, nb, b_vessel, b_p, b_rho, b_v_noslip, b_p_inner, b_rho_inner, b_v_noslip_inner, b, xi,
                 )
+                ab = wall_pair_acceleration(prm, tic, own_wall, alpha_wall, vi, rhoi, r, r2, gw, wall_mass(prm, b_volume, b), pb, rhob, bv[b], vb_noslip)
                 sums.a = sums.a + ab
                 add_wall_reaction(prm, vessels, motions, b_vessel[b], i, nb.bx[b], ab, wall_force, wall_torque)
                 count += 1

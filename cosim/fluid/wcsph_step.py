@@ -32,7 +32,8 @@ from cosim.fluid.substep import PairList, SubstepScratch, end_substep, start_sub
 class WCSPHScratch:
     """WCSPH's per-substep arrays: acc (N,) m/s^2; rho_grad (N,) the renormalised density gradient (kg/m^4); drho
     (N,) kg/m^3/s; pairs: the pair list (tables of one slot where the layout keeps none); b_p (Pa), b_rho (kg/m^3), b_v_noslip (m/s): (Nb,) the wall particles'
-    extrapolated state."""
+    extrapolated state; b_p_inner, b_rho_inner, b_v_noslip_inner: a sided vessel's own wall's state on its inner face
+    (``cosim.fluid.boundary.extrapolate_wall_state``; (Nb,) where some wall is sided, else empty)."""
 
     def __init__(self, m: FluidModel, sh: SubstepScratch):
         d, n, nb, by_column = m.device, m.n_particles, m.n_boundary, sh.layout.pairs_by_column
@@ -46,6 +47,10 @@ class WCSPHScratch:
         self.b_p = wp.zeros(nb, dtype=float, device=d)
         self.b_rho = wp.zeros(nb, dtype=float, device=d)
         self.b_v_noslip = wp.zeros(nb, dtype=wp.vec3, device=d)
+        inner = nb if m.one_sided_walls else 0
+        self.b_p_inner = wp.zeros(inner, dtype=float, device=d)
+        self.b_rho_inner = wp.zeros(inner, dtype=float, device=d)
+        self.b_v_noslip_inner = wp.zeros(inner, dtype=wp.vec3, device=d)
 
 
 def pair_recording(cfg: FluidConfig, sh: SubstepScratch) -> int:
@@ -89,8 +94,9 @@ def extrapolate_wall_state(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
     if not m.n_boundary:
         return
     rec.launch(
-        bd.extrapolate_wall_state, m.n_boundary, prm=m.params, b_vessel=m.b_vessel, motions=sh.motions, nb=sh.neighborhood(m, st), bv=sh.bv,
-        v=st.v, rho=st.rho, p=st.p, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip,
+        bd.extrapolate_wall_state, m.n_boundary, prm=m.params, vessels=m.vessels, b_vessel=m.b_vessel, motions=sh.motions,
+        nb=sh.neighborhood(m, st), bv=sh.bv, v=st.v, rho=st.rho, p=st.p, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip,
+        b_p_inner=sc.b_p_inner, b_rho_inner=sc.b_rho_inner, b_v_noslip_inner=sc.b_v_noslip_inner,
     )
 
 
@@ -100,7 +106,8 @@ def compute_forces(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScra
     rec.launch(
         wcsph.compute_forces, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume, b_vessel=m.b_vessel,
         motions=sh.motions, nb=sh.neighborhood(m, st), v=st.v, rho=st.rho, p=st.p, active=st.active, free=st.free, mass=st.mass,
-        bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip, row=sh.row, capacity=sh.pair_capacity, pairs=pair_recording(m.config, sh),
+        bv=sh.bv, b_p=sc.b_p, b_rho=sc.b_rho, b_v_noslip=sc.b_v_noslip, b_p_inner=sc.b_p_inner, b_rho_inner=sc.b_rho_inner,
+        b_v_noslip_inner=sc.b_v_noslip_inner, row=sh.row, capacity=sh.pair_capacity, pairs=pair_recording(m.config, sh),
         pair_count=sc.pairs.count, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, tic=tension_control(m.config), indicator=sh.free_surface,
         acc=sc.acc, rho_grad=sc.rho_grad, wall_force=sh.wall_force, wall_torque=sh.wall_torque, diag_f=sh.diagnostics.lane_f, diag_i=sh.diagnostics.lane_i,
     )
