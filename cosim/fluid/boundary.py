@@ -138,6 +138,17 @@ class WallStateSums:
 
 
 @wp.func
+def empty_wall_state() -> WallStateSums:
+    """The sums over no liquid: all zero."""
+    sums = WallStateSums()
+    sums.w = 0.0
+    sums.pw = 0.0
+    sums.rho_r = wp.vec3(0.0)
+    sums.v = wp.vec3(0.0)
+    return sums
+
+
+@wp.func
 def add_to_wall_state(sums: WallStateSums, w: float, p: float, rho: float, r: wp.vec3, v: wp.vec3) -> WallStateSums:
     """``sums`` with liquid particle f added: its kernel weight w, pressure p, density rho, x_w - x_f = r, velocity v."""
     out = WallStateSums()
@@ -226,12 +237,8 @@ def extrapolate_wall_state(
     geo = vessels[vessel]
     arm = xb - m.p_now
     a_wall = m.lin_acc + wp.cross(m.ang_acc, arm) + wp.cross(m.ang_vel, wp.cross(m.ang_vel, arm))
-    outer = WallStateSums()
-    outer.rho_r = wp.vec3(0.0)
-    outer.v = wp.vec3(0.0)
-    inner = WallStateSums()
-    inner.rho_r = wp.vec3(0.0)
-    inner.v = wp.vec3(0.0)
+    outer = empty_wall_state()
+    inner = empty_wall_state()
     radius2 = prm.support * prm.support
     cells = neighbor_cells(nb.spec, xb)
     for k in range(cells.count):
