@@ -145,8 +145,8 @@ DEFAULT_FREE_LIQUID_RULE = FreeLiquidRule.FREE_SURFACE
 # ('real_thickness', with wall_pressure 'solved_rest_sum') passes every validation case the covering layers pass, in
 # 2-D and 3-D, and puts the lip where the vessel has it; WCSPH's resting cases stop with them (its continuity density
 # does not see the liquid piling into the corners of a one-layer wall); 'sided' (those walls only for the liquid
-# outside a vessel) passes every 2-D case, but WCSPH keeps 'kernel_layers' until the held-out set and the bench are rerun with
-# 'sided' as the default (docs/walls.md).
+# outside a vessel) passes every 2-D case, but WCSPH keeps 'kernel_layers' until the held-out set and the bench are
+# rerun with 'sided' as the default (docs/walls.md).
 # A wall that holds no particle layer at the spacing (thinner than dx / 2) and a mesh vessel's wall (not validated
 # confined) get 'kernel_layers' under either solver (cosim.fluid.wall_sampling.wall_model_for).
 DEFAULT_WALL_MODEL = {PressureSolver.DFSPH: WallModel.REAL_THICKNESS, PressureSolver.WCSPH: WallModel.KERNEL_LAYERS}
