@@ -178,6 +178,12 @@ def write_wall_state(
 
 
 @wp.func
+def in_vessel_frame_now(m: VesselMotion, x: wp.vec3) -> wp.vec3:
+    """The world point x (m) in the vessel's frame at its pose at the substep's start."""
+    return wp.transpose(m.r_now) @ (x - m.p_now)
+
+
+@wp.func
 def cavity_distance(q: wp.vec3, geo: VesselGeometry, dim: int) -> float:
     """m, the distance of the vessel-frame point q from the vessel's cavity continued upward past its rim (its inner
     section, over the floor, at any height): 0 inside it, the depth into the walls or the distance past their outer
@@ -200,7 +206,7 @@ def on_inner_face(prm: SPHParams, geo: VesselGeometry, m: VesselMotion, x: wp.ve
     the rim (:func:`cavity_distance`) than the wall is thick, as the liquid inside and the liquid
     over the rim and the crest are; otherwise it is beyond the wall's outer faces. The vessel at its pose at the
     substep's start."""
-    return cavity_distance(wp.transpose(m.r_now) @ (x - m.p_now), geo, prm.dim) < geo.thickness
+    return cavity_distance(in_vessel_frame_now(m, x), geo, prm.dim) < geo.thickness
 
 
 @item_kernel

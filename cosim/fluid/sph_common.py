@@ -9,7 +9,7 @@ import math
 
 import warp as wp
 
-from cosim.fluid.boundary import VesselGeometry, VesselMotion, guard_vessel, inside_vessel
+from cosim.fluid.boundary import VesselGeometry, VesselMotion, guard_vessel, in_vessel_frame_now, inside_vessel
 from cosim.fluid.diagnostics import (
     DIAG_ACTIVE,
     DIAG_BREACHES,
@@ -42,7 +42,7 @@ def pair_capacity(dim: int, smoothing_ratio: float) -> int:
 def inside_vessel_now(prm: SPHParams, geo: VesselGeometry, m: VesselMotion, x: wp.vec3) -> bool:
     """Whether the world point x is in the inner volume (below the rim) of the vessel ``geo`` at its pose at the
     substep's start (``m.r_now``, ``m.p_now``)."""
-    return inside_vessel(wp.transpose(m.r_now) @ (x - m.p_now), geo, prm.dim) != 0
+    return inside_vessel(in_vessel_frame_now(m, x), geo, prm.dim) != 0
 
 
 @wp.func
@@ -206,7 +206,7 @@ def finish_particle(
     for k in range(prm.n_vessels):
         m = motions[k]
         geo = vessels[k]
-        q_old = wp.transpose(m.r_now) @ (x_old - m.p_now)
+        q_old = in_vessel_frame_now(m, x_old)
         q_new = wp.transpose(m.r_next) @ (xi - m.p_next)
         q, normal, depth, hits = guard_vessel(q_old, q_new, geo, prm.dim, guard_margin)
         if hits > 0:
