@@ -6,12 +6,13 @@ unchanged."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from cosim.errors import InputError
-from cosim.fluid.config import FluidConfig, WallModel
+from cosim.fluid.config import FluidConfig, PressureSolver, WallModel
 from cosim.fluid.mesh_sampling import classify
 from cosim.fluid.sph_kernels import kernel_values
 from cosim.fluid.seeding import fill_vessel
@@ -183,23 +184,26 @@ def test_a_mesh_wall_too_thin_for_one_layer_is_refused():
         sample_vessel_walls(spec, cfg)
 
 
-def test_unset_the_wall_model_is_the_vessels_own_under_dfsph_and_covers_the_support_under_wcsph():
+def test_unset_the_wall_model_is_the_vessels_own_under_dfsph_and_sided_under_wcsph():
     """Where a wall holds a layer, DFSPH's default walls are the vessel's own, the same particles and volumes as
-    'real_thickness' set; WCSPH's, a wall holding no layer (thinner than dx / 2) and a mesh vessel's cover the
-    support; a wall model that is set holds for every vessel."""
+    'real_thickness' set; WCSPH's are 'sided' (the vessel's own wall thickness seen from outside); a wall holding no
+    layer (thinner than dx / 2) and a mesh vessel's cover the support under either solver; a wall model that is set
+    holds for every vessel."""
     dfsph, wcsph = FluidConfig(dim=2, spacing=0.191 / 32), FluidConfig(dim=2, spacing=0.191 / 32, pressure_solver="wcsph")
     assert dfsph.wall_model is None and wall_model_for(POURER, dfsph) is REAL
     default, confined = sample_vessel_walls(POURER, dfsph), sample_vessel_walls(POURER, real(POURER, 32, 2))
     np.testing.assert_array_equal(default[0], confined[0])
     np.testing.assert_array_equal(default[1], confined[1])
-    assert wall_model_for(POURER, wcsph) is WallModel.KERNEL_LAYERS
-    assert numerical_wall_thickness(POURER, wcsph) == pytest.approx(3 * wcsph.spacing)
+    assert wall_model_for(POURER, wcsph) is WallModel.SIDED
+    assert numerical_wall_thickness(POURER, wcsph) == pytest.approx(POURER.wall_thickness)
     coarse = FluidConfig(dim=3, spacing=0.191 / 16)  # dx / 2 = 6.0 mm against the 5 mm wall
     assert not holds_a_layer(POURER, coarse.spacing) and holds_a_layer(POURER, 0.01)
     assert wall_model_for(POURER, coarse) is WallModel.KERNEL_LAYERS
+    assert wall_model_for(POURER, replace(coarse, pressure_solver=PressureSolver.WCSPH)) is WallModel.KERNEL_LAYERS
     assert len(sample_vessel_walls(POURER, coarse)[0]) > 0
     beaker = mesh_vessel_spec("pourer", load_vessel_mesh(BEAKER), 1180.0)
     assert wall_model_for(beaker, FluidConfig(dim=2, spacing=0.08 / 24)) is WallModel.KERNEL_LAYERS
+    assert wall_model_for(beaker, FluidConfig(dim=2, spacing=0.08 / 24, pressure_solver="wcsph")) is WallModel.KERNEL_LAYERS
     assert wall_model_for(POURER, FluidConfig(dim=2, spacing=0.191 / 32, wall_model="kernel_layers")) is WallModel.KERNEL_LAYERS
     assert wall_model_for(beaker, FluidConfig(dim=2, spacing=0.08 / 24, wall_model="real_thickness")) is REAL
 

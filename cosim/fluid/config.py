@@ -144,12 +144,12 @@ DEFAULT_FREE_LIQUID_RULE = FreeLiquidRule.FREE_SURFACE
 # The wall model when none is given (FluidConfig.wall_model), per pressure solver: DFSPH with the vessel's own walls
 # ('real_thickness', with wall_pressure 'solved_rest_sum') passes every validation case the covering layers pass, in
 # 2-D and 3-D, and puts the lip where the vessel has it; WCSPH's resting cases stop with them (its continuity density
-# does not see the liquid piling into the corners of a one-layer wall); 'sided' (those walls only for the liquid
-# outside a vessel) passes every 2-D case, but WCSPH keeps 'kernel_layers' until the held-out set and the bench are
-# rerun with 'sided' as the default (docs/walls.md).
+# does not see the liquid piling into the corners of a one-layer wall); WCSPH's 'sided' (the vessel's own walls for
+# the liquid outside it, each face's wall state from the liquid at that face, the covering layers for the liquid
+# inside) passes every 2-D case and puts the 3-D launch point within 1 mm of the real lip (docs/walls.md).
 # A wall that holds no particle layer at the spacing (thinner than dx / 2) and a mesh vessel's wall (not validated
 # confined) get 'kernel_layers' under either solver (cosim.fluid.wall_sampling.wall_model_for).
-DEFAULT_WALL_MODEL = {PressureSolver.DFSPH: WallModel.REAL_THICKNESS, PressureSolver.WCSPH: WallModel.KERNEL_LAYERS}
+DEFAULT_WALL_MODEL = {PressureSolver.DFSPH: WallModel.REAL_THICKNESS, PressureSolver.WCSPH: WallModel.SIDED}
 # Monaghan's alpha of pairs with free liquid under DFSPH's 'sound_speed' scale when none is given
 # (FluidConfig.free_artificial_viscosity): c0 does not grow with an impact, so without an approach term the free
 # liquid's impacts need their own, larger alpha (a value set on the pour, docs/artificial_viscosity.md). The signal
@@ -193,7 +193,7 @@ class FluidConfig:
         "or 'real_thickness' (layers confined to the vessel's own wall, their volumes fitted to make up the kernel "
         "support missing behind a thin wall; the lip is the real one) or 'sided' (WCSPH only: liquid inside the vessel "
         "sees the covering layers, liquid outside it, over the rim included, the 'real_thickness' wall; docs/walls.md).", kind="choice",
-        choices=WallModel, none_means="'real_thickness' under DFSPH, 'kernel_layers' under WCSPH; 'kernel_layers' for "
+        choices=WallModel, none_means="'real_thickness' under DFSPH, 'sided' under WCSPH; 'kernel_layers' for "
         "a wall thinner than dx / 2 and a mesh vessel's (chosen on the validation cases)")
     depth_2d: float = setting(0.1, DISCRETISATION, "2-D: the liquid's thickness across the pour plane as seeded (the "
                               "pourer's depth); a particle stands for the 3-D volume dx^2 depth_2d, spread over the depth "
