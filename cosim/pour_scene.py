@@ -21,7 +21,7 @@ from cosim.checks import check_device
 from cosim.config_mapping import from_mapping, read_toml_file, to_toml
 from cosim.coupling.settings import CouplingSettings, PoseFilterLimits
 from cosim.errors import InputError
-from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityDiffusionTerm, DensityIteration, DivergenceConstraint, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, ParticleShifting, PressureSolver, TensionTreatment, ViscousTimeStep, WallModel, WallPressure
+from cosim.fluid.config import DISCRETISATION, ArtificialViscosityScale, DensityDiffusionTerm, DensityIteration, DivergenceConstraint, FluidConfig, FreeLiquidRule, GridReset, InitialState, KernelType, ParticleShifting, PressureSolver, SurfaceDensity, TensionTreatment, ViscousTimeStep, WallModel, WallPressure
 from cosim.io.recording_config import RecordingConfig
 from cosim.pour_arms import ArmsSettings
 from cosim.trajectory.driver_names import JointPrefix
@@ -83,6 +83,7 @@ class FluidSettings:
     free_artificial_viscosity: float | None = like(FluidConfig, "free_artificial_viscosity")
     artificial_viscosity_beta: float | None = like(FluidConfig, "artificial_viscosity_beta")
     initial_state: InitialState = like(FluidConfig, "initial_state")
+    surface_density: SurfaceDensity = like(FluidConfig, "surface_density")
     particle_shifting: ParticleShifting = like(FluidConfig, "particle_shifting")
     shifting_coefficient: float = like(FluidConfig, "shifting_coefficient")
     # ---- WCSPH

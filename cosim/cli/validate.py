@@ -34,7 +34,7 @@ if TYPE_CHECKING:
 DEFAULT_OUT = Path("recordings") / "validate"
 # The FluidConfig fields `cosim validate` takes as options (--wall-model for wall_model, ...), each parsed, checked
 # and described from its declaration; not given, the default scene's value (`cosim scene --dump`)
-NUMERICS_OPTIONS = ("free_liquid", "density_iteration", "density_tolerance", "divergence_constraint", "wall_model", "wall_pressure", "initial_state", "free_liquid_rule",
+NUMERICS_OPTIONS = ("free_liquid", "density_iteration", "density_tolerance", "divergence_constraint", "wall_model", "wall_pressure", "initial_state", "surface_density", "free_liquid_rule",
                     "free_surface_threshold", "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity",
                     "artificial_viscosity_beta", "max_tension", "tension_treatment", "density_diffusion_term", "particle_shifting", "shifting_coefficient", "viscous_time_step")
 

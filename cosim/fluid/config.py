@@ -64,6 +64,13 @@ class InitialState(Enum):
     RELAXED = "relaxed"  # settled in its vessels held still before t = 0; DFSPH corrects compression only, no offsets
 
 
+class SurfaceDensity(Enum):
+    """The density DFSPH holds bound liquid short of a full kernel support to (``cosim.fluid.dfsph.surface_offset``)."""
+
+    SEEDED_OFFSET = "seeded_offset"  # summation + the deficiency seeded at t = 0 ('seeded'), or none ('relaxed')
+    CONTINUITY = "continuity"  # carried by the continuity equation where Marrone's indicator is below 0.75
+
+
 class ArtificialViscosityScale(Enum):
     """The velocity scale v_sig of Monaghan's artificial viscosity Pi_ij = -alpha v_sig h (v_ij . r_ij) /
     ((r_ij^2 + eta^2) rho_ij) (``cosim.fluid.sph_common.viscous_pair``)."""
@@ -310,6 +317,14 @@ class FluidConfig:
                                           "zeroed, until it stops moving, and started from there at rest; DFSPH then "
                                           "corrects compression only, with no per-particle offset: Bender & Koschier "
                                           "2017). docs/relaxed_start.md.")
+    surface_density: SurfaceDensity = setting(SurfaceDensity.SEEDED_OFFSET, PRESSURE, "DFSPH: the density of "
+                                              "bound liquid short of a full kernel support (the surface rows). "
+                                              "'seeded_offset': its summation density plus the deficiency it was "
+                                              "seeded with (initial_state 'seeded'), or none ('relaxed'). "
+                                              "'continuity': carried by the continuity equation wherever Marrone et "
+                                              "al. 2010's indicator is below 0.75 (the summation density inside), "
+                                              "so the offset follows the liquid instead of the seeding. "
+                                              "docs/surface_density.md.")
     # ---- WCSPH
     gamma: float = setting(7.0, WCSPH, "Tait exponent of the equation of state p = rho0 c0^2 / gamma ((rho / rho0)^gamma "
                            "- 1) (Camporredondo et al. 2019).", "", 1.0, 10.0)

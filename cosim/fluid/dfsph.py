@@ -143,6 +143,14 @@ WALL_RELAXATION = wp.constant(0.5)
 # is >= 0)
 UNSEEDED_OFFSET = wp.constant(-1.0)
 
+# FluidConfig.surface_density as the kernels take it (an int argument)
+SURFACE_SEEDED_OFFSET = wp.constant(0)
+SURFACE_CONTINUITY = wp.constant(1)
+# Marrone et al. (2010): a particle whose free-surface indicator is at or above 0.75 has a full kernel support (their
+# scan test examines only those below); its summation density is the liquid's density there. For the square lattice
+# at h = 1.5 dx: the top row 0.499, the second 0.842 (2-D; cosim.fluid.free_surface).
+FULL_SUPPORT_INDICATOR = wp.constant(0.75)
+
 SOLVE_DIVERGENCE = 0
 SOLVE_DENSITY = 1
 # Colours of the Gauss-Seidel density sweep by dimension (:func:`cell_color`)
@@ -165,6 +173,20 @@ def stat_slot(prm: SPHParams, item: int, field: int) -> int:
     :data:`STATS_ROW_STRIDE`; ``cosim.fluid.device_layout``: one replica on the CPU, the row itself). The fields
     are integers, so the sums are the same in any order and for any number of replicas."""
     return (item % prm.atomic_replicas) * STATS_ROW_STRIDE + field
+
+
+@wp.func
+def surface_offset(carried: float, summation: float, indicator: float) -> float:
+    """``FluidConfig.surface_density`` 'continuity': the offset (kg/m^3) that holds a particle short of a full kernel
+    support (free-surface ``indicator`` below FULL_SUPPORT_INDICATOR) to the density ``carried`` to it by the
+    continuity equation, rho_i(t + dt) = rho_i(t) + dt Drho_i/Dt (:func:`carry_density`), and never below its
+    summation density; none with a full support, where the summation density is the liquid's (kg/m^3 in, offset out).
+    The surface rows' kernel deficiency is then not a memory of the seeding but the difference between the two
+    densities, which follows the particle wherever the surface takes it (continuity is what keeps free-surface
+    particles at rho0 in weakly compressible SPH: Colagrossi & Landrini 2003, J. Comput. Phys. 191)."""
+    if indicator < FULL_SUPPORT_INDICATOR:
+        return wp.max(carried - summation, 0.0)
+    return 0.0
 
 
 @wp.func
@@ -218,6 +240,7 @@ def compute_density_factor(
     capacity: int,
     free_liquid: int,
     threshold: float,
+    surface_density: int,
     # State in
     motions: wp.array(dtype=VesselMotion),
     nb: Neighborhood,
@@ -253,7 +276,8 @@ def compute_density_factor(
     iteration; ``increment_per_rho`` = increment / rho, as the neighbours read it) and its counters. More than
     ``capacity`` neighbours (impossible below ~2x compression) count as an overflow, an instability. Under the
     'free_surface' rule (``free_liquid`` = FREE_AT_SURFACE) also each particle's free-surface indicator, from the same
-    walk (``indicator``, ``cosim.fluid.free_surface``)."""
+    walk (``indicator``, ``cosim.fluid.free_surface``). Under ``surface_density`` SURFACE_CONTINUITY also the
+    indicator, and ``rho`` holds on entry the density carried to the particle (:func:`surface_offset`)."""
     i = wp.tid()
     if i == 0:
         solve_stats[STAT_ITERATIONS] = wp.int64(0)
@@ -277,6 +301,7 @@ def compute_density_factor(
     moment = wp.mat33(0.0)
     count = int(0)
     radius2 = prm.support * prm.support
+    with_indicator = free_liquid == FREE_AT_SURFACE or surface_density == SURFACE_CONTINUITY
     cells = neighbor_cells(nb.spec, xi)
     for k in range(cells.count):
         cell = reachable_cell(nb, cells, k, xi, radius2)
@@ -291,7 +316,7 @@ def compute_density_factor(
             density += summation_term(prm, mj, r2)
             gw = kernel_gradient(prm, r, r2)
             gm = mj * gw
-            if free_liquid == FREE_AT_SURFACE:
+            if with_indicator:
                 moment += renormalisation_term(mj / prm.rest_density, r, gw)
             grad_sum += gm
             grad_sq += wp.dot(gm, gm) * (mi / mj)  # m_i m_j |grad W|^2: j's push from i's stiffness
@@ -312,7 +337,7 @@ def compute_density_factor(
             density += summation_term(prm, mb, r2)
             gw = kernel_gradient(prm, r, r2)
             gm = mb * gw
-            if free_liquid == FREE_AT_SURFACE:
+            if with_indicator:
                 moment += renormalisation_term(mb / prm.rest_density, r, gw)
             grad_sum += gm
             if count < capacity:
@@ -327,10 +352,13 @@ def compute_density_factor(
     pair_count[i] = wp.min(count, capacity)
     close_pair_row(pair_slots, i, first, pair_count[i])
     lam = float(0.0)
-    if free_liquid == FREE_AT_SURFACE:
+    if with_indicator:
         lam = surface_indicator(prm.dim, moment)
         indicator[i] = lam
-    density = bound_or_free_density(prm, vessels, motions, free_liquid, i, xi, density / prm.lattice_density, lam, threshold, free, rest_offset)
+    summation = density / prm.lattice_density
+    if surface_density == SURFACE_CONTINUITY:
+        rest_offset[i] = surface_offset(rho[i], summation, lam)
+    density = bound_or_free_density(prm, vessels, motions, free_liquid, i, xi, summation, lam, threshold, free, rest_offset)
     denominator = wp.max(wp.dot(grad_sum, grad_sum) + grad_sq, MIN_FACTOR_DENOMINATOR * prm.lattice_factor_denominator)
     rho[i] = density
     alpha[i] = density / denominator
@@ -1033,6 +1061,29 @@ def compute_wall_reaction(
         kb = (b_kappa_density[b] + b_kappa_divergence[b]) / b_rho[b]
         ab -= (prm.rest_density * b_volume[b] * (ki + kb)) * gw
         add_wall_reaction(prm, vessels, motions, b_vessel[b], i, xb, ab, wall_force, wall_torque)
+
+
+@item_kernel
+def carry_density(
+    # State in
+    active: wp.array(dtype=wp.int32),
+    dt: wp.array(dtype=float),
+    v_star: wp.array(dtype=wp.vec3),
+    bv: wp.array(dtype=wp.vec3),
+    pair_count: wp.array(dtype=wp.int32),
+    pair_slots: PairSlots,
+    pair_index: wp.array(dtype=wp.int32),
+    pair_mass_grad: wp.array(dtype=wp.vec3),
+    # State in/out
+    rho: wp.array(dtype=float),
+):
+    """``FluidConfig.surface_density`` 'continuity': the density the solves held particle i to carried over the
+    substep by the continuity equation, rho_i += dt Drho_i/Dt with the velocities x moved by (v*, and the walls')
+    over the substep's pairs (kg/m^3): the next substep's :func:`surface_offset` reads it."""
+    i = wp.tid()
+    if active[i] == 0:
+        return
+    rho[i] = rho[i] + dt[0] * liquid_density_rate(i, v_star, bv, pair_count, pair_slots, pair_index, pair_mass_grad)
 
 
 @item_kernel

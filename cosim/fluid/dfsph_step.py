@@ -22,7 +22,7 @@ import numpy as np
 import warp as wp
 
 from cosim.fluid import dfsph, wcsph
-from cosim.fluid.config import DensityIteration, DivergenceConstraint, InitialState, WallPressure
+from cosim.fluid.config import DensityIteration, DivergenceConstraint, InitialState, SurfaceDensity, WallPressure
 from cosim.fluid.free_surface import free_liquid_mode
 from cosim.fluid.lanes import LANE_CHUNK, Lanes, PerLane
 from cosim.fluid.launch import launch_now
@@ -30,6 +30,12 @@ from cosim.fluid.model import FluidModel, FluidState
 from cosim.fluid.pair_slots import flat_pair_table, pair_slots
 from cosim.fluid.program import Recorder
 from cosim.fluid.substep import PairList, SubstepScratch, end_substep, start_substep
+
+
+def continuity_surface(m: FluidModel) -> bool:
+    """Whether the surface rows' density is carried by the continuity equation (``FluidConfig.surface_density``
+    'continuity', ``cosim.fluid.dfsph.surface_offset``) rather than held to a seeded offset."""
+    return m.config.surface_density is SurfaceDensity.CONTINUITY
 
 
 def solved_wall_layer(m: FluidModel) -> bool:
@@ -93,7 +99,8 @@ def compute_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
     divergence solve's warm start and counters."""
     rec.launch(
         dfsph.compute_density_factor, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume,
-        capacity=sh.pair_capacity, free_liquid=free_liquid_mode(m.config), threshold=m.config.free_surface_threshold, motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active,
+        capacity=sh.pair_capacity, free_liquid=free_liquid_mode(m.config), threshold=m.config.free_surface_threshold,
+        surface_density=int(continuity_surface(m)), motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active,
         mass=st.mass, row=sh.row, kappa_divergence=st.kappa_divergence, free=st.free, rest_offset=st.rest_offset,
         rho=st.rho, alpha=sc.alpha, increment=sc.increment, increment_per_rho=sc.increment_per_rho,
         pair_count=sc.pairs.count, pair_slots=sc.pair_slots, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, pair_mass_grad=sc.pair_mass_grad,
@@ -231,6 +238,14 @@ def integrate(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, 
     )
 
 
+def carry_density(rec: Recorder, m: FluidModel, st: FluidState, sh: SubstepScratch, sc: DFSPHScratch) -> None:
+    """'continuity' surface density: the held density carried over the substep (``cosim.fluid.dfsph.carry_density``)."""
+    rec.launch(
+        dfsph.carry_density, m.n_particles, active=st.active, dt=sh.dt, v_star=sc.v_star, bv=sh.bv, pair_count=sc.pairs.count,
+        pair_slots=sc.pair_slots, pair_index=sc.pairs.index, pair_mass_grad=sc.pair_mass_grad, rho=st.rho,
+    )
+
+
 def reset_solve_stats(rec: Recorder, sc: DFSPHScratch) -> None:
     """The solves' counters cleared for the next substep."""
     rec.call(0, sc.solve_stats.zero_)
@@ -255,6 +270,10 @@ class DFSPHStep:
         (``cosim.fluid.relaxation``)."""
         launch_now(wcsph.equation_of_state, self.model.n_particles, self.model.device, dict(prm=self.model.params, rho=st.rho, p=st.p))
         st.kappa_density.assign((st.p.numpy() / st.rho.numpy()).astype(np.float32))
+        if continuity_surface(self.model):
+            st.rest_offset.zero_()
+            st.rho.fill_(self.model.config.rest_density)  # at rest, at rest density: what the surface rows carry on
+            return
         seeded = self.model.config.initial_state is InitialState.SEEDED
         st.rest_offset.fill_(float(dfsph.UNSEEDED_OFFSET) if seeded else 0.0)
 
@@ -289,5 +308,7 @@ class DFSPHStep:
         density_solve(rec, m, st, sh, sc, self.gauss_seidel)
         compute_wall_reaction(rec, m, st, sh, sc)
         integrate(rec, m, st, sh, sc)
+        if continuity_surface(m):
+            carry_density(rec, m, st, sh, sc)
         reset_solve_stats(rec, sc)
         end_substep(rec, m, sh)

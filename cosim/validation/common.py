@@ -17,7 +17,7 @@ from declared_settings.setting import check_settings, declared, like
 NUMERICS_FIELDS = (
     "kernel", "smoothing_ratio", "cfl", "sound_speed_factor", "free_liquid", "free_liquid_rule", "free_surface_threshold", "density_iteration",
     "density_tolerance", "wall_model", "artificial_viscosity", "artificial_viscosity_scale", "free_artificial_viscosity", "artificial_viscosity_beta",
-    "initial_state", "wall_pressure", "divergence_constraint", "max_tension", "tension_treatment", "density_diffusion_term", "particle_shifting",
+    "initial_state", "surface_density", "wall_pressure", "divergence_constraint", "max_tension", "tension_treatment", "density_diffusion_term", "particle_shifting",
     "shifting_coefficient", "viscous_time_step",
 )
 
