@@ -47,7 +47,8 @@ def test_relaxed_ring_liquid_stays_at_rest_and_unrelaxed_does_not() -> None:
 
     print(f"unrelaxed: {1e3 * raw_speed:.1f} mm/s, mean height {1e3 * raw_height:.2f} mm; relaxed: {1e3 * speed:.1f} mm/s, "
           f"{1e3 * height:.2f} mm; seeded {1e3 * seeded_height:.2f} mm")
-    assert raw_speed > 0.08  # the agitation the relaxation removes
+    # the agitation the relaxation removes: the unrelaxed rings move several times as fast
+    assert raw_speed > 3 * speed
     # The agitated liquid no longer swells: DFSPH's divergence solve lets liquid below rest density close
     # (fluid.divergence_constraint 'past_rest_density'); removing every compressing rate, its mean height rose > 4 mm.
     assert abs(raw_height - seeded_height) < 0.002

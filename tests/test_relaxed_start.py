@@ -1,5 +1,6 @@
-"""fluid.initial_state: 'seeded' keeps the seeded kernel deficiency as DFSPH's per-particle rest offset and starts
-as seeded; 'relaxed' settles the liquid in its vessel, held still, until it stops moving (or a time cap), with no
+"""fluid.initial_state, under DFSPH's seeded offsets (surface_density 'seeded_offset'; the continuity surface:
+tests/test_surface_density.py): 'seeded' keeps the seeded kernel deficiency as DFSPH's per-particle rest offset and
+starts as seeded; 'relaxed' settles the liquid in its vessel, held still, until it stops moving (or a time cap), with no
 offset, and the run starts there at rest, no particle compressed beyond the solve's per-particle bound."""
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from cosim.fluid.config import GRAVITY, FluidConfig, InitialState
+from cosim.fluid.config import GRAVITY, FluidConfig, InitialState, SurfaceDensity
 from cosim.fluid.dfsph import MAX_PARTICLE_RESIDUAL
 from cosim.fluid.relaxation import AT_REST, RELAX_INTERVAL, RELAX_TIME_CAP, STALLED, TIME_CAP, stop_speed
 from cosim.fluid.seeding import fill_vessel
@@ -27,7 +28,7 @@ def _tank(state: InitialState | None, **solver_args) -> FluidSolver:
     tank = VesselSpec(name="tank", inner_width=WIDTH, inner_depth=0.1, inner_height=0.08)
     fields = {} if state is None else {"initial_state": state}
     cfg = FluidConfig(dim=2, spacing=SPACING, max_expected_speed=2 * math.sqrt(GRAVITY * FILL), domain_min=(-0.1, -0.1, -0.05),
-                      domain_max=(0.1, 0.1, 0.15), cpu_threads=1, **fields)
+                      domain_max=(0.1, 0.1, 0.15), cpu_threads=1, surface_density=SurfaceDensity.SEEDED_OFFSET, **fields)
     return FluidSolver(cfg, [tank], [Pose()], fill_vessel(tank, FILL, cfg), **solver_args)
 
 

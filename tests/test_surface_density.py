@@ -43,8 +43,8 @@ def _top_row_drop(solver: FluidSolver, duration: float) -> float:
     return float((start[top, 2] - solver.positions()[top, 2]).mean())
 
 
-def test_seeded_offset_is_the_default():
-    assert FluidConfig().surface_density is SurfaceDensity.SEEDED_OFFSET
+def test_continuity_is_the_default():
+    assert FluidConfig().surface_density is SurfaceDensity.CONTINUITY
 
 
 def test_continuity_holds_the_relaxed_top_row_where_compression_alone_lets_it_sink():
@@ -74,9 +74,9 @@ def test_surface_density_is_a_declared_setting_of_scenes_and_validation_numerics
     from cosim.pour_scene import FluidSettings
     from cosim.validation.common import NUMERICS_FIELDS
 
-    assert FluidSettings().fluid_config(0.191).surface_density is SurfaceDensity.SEEDED_OFFSET
-    chosen = dataclasses.replace(FluidSettings(), surface_density=SurfaceDensity.CONTINUITY)
-    assert chosen.fluid_config(0.191).surface_density is SurfaceDensity.CONTINUITY
+    assert FluidSettings().fluid_config(0.191).surface_density is SurfaceDensity.CONTINUITY
+    chosen = dataclasses.replace(FluidSettings(), surface_density=SurfaceDensity.SEEDED_OFFSET)
+    assert chosen.fluid_config(0.191).surface_density is SurfaceDensity.SEEDED_OFFSET
     assert "surface_density" in NUMERICS_FIELDS
 
 

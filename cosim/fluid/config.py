@@ -317,7 +317,7 @@ class FluidConfig:
                                           "zeroed, until it stops moving, and started from there at rest; DFSPH then "
                                           "corrects compression only, with no per-particle offset: Bender & Koschier "
                                           "2017). docs/relaxed_start.md.")
-    surface_density: SurfaceDensity = setting(SurfaceDensity.SEEDED_OFFSET, PRESSURE, "DFSPH: the density of "
+    surface_density: SurfaceDensity = setting(SurfaceDensity.CONTINUITY, PRESSURE, "DFSPH: the density of "
                                               "bound liquid short of a full kernel support (the surface rows). "
                                               "'seeded_offset': its summation density plus the deficiency it was "
                                               "seeded with (initial_state 'seeded'), or none ('relaxed'). "
