@@ -60,15 +60,15 @@ class PressureSolver(Enum):
 class InitialState(Enum):
     """How the seeded liquid starts (``cosim.fluid.relaxation``)."""
 
-    SEEDED = "seeded"  # as seeded; DFSPH holds each bound particle to the kernel deficiency it was seeded with
-    RELAXED = "relaxed"  # settled in its vessels held still before t = 0; DFSPH corrects compression only, no offsets
+    SEEDED = "seeded"  # as seeded, at rest
+    RELAXED = "relaxed"  # settled in its vessels held still before t = 0, then at rest
 
 
 class SurfaceDensity(Enum):
     """The density DFSPH holds bound liquid short of a full kernel support to (``cosim.fluid.dfsph.surface_offset``)."""
 
-    SEEDED_OFFSET = "seeded_offset"  # summation + the deficiency seeded at t = 0 ('seeded'), or none ('relaxed')
     CONTINUITY = "continuity"  # carried by the continuity equation where Marrone's indicator is below 0.75
+    SEEDED_OFFSET = "seeded_offset"  # summation + the deficiency seeded at t = 0 ('seeded'), or none ('relaxed')
 
 
 class ArtificialViscosityScale(Enum):
@@ -311,19 +311,19 @@ class FluidConfig:
                                           "the validation cases: the largest at which DFSPH's hydrostatic column "
                                           "passes (docs/particle_shifting.md).", "", 0.0, 1.0)
     initial_state: InitialState = setting(InitialState.SEEDED, PRESSURE, "How the liquid starts: 'seeded' (from "
-                                          "its seeded lattice; DFSPH holds each bound particle to the kernel deficiency "
-                                          "it was seeded with, so the surface rows stay at their seeded spacing) or "
-                                          "'relaxed' (settled first with its vessels held still and its velocities "
-                                          "zeroed, until it stops moving, and started from there at rest; DFSPH then "
-                                          "corrects compression only, with no per-particle offset: Bender & Koschier "
-                                          "2017). docs/relaxed_start.md.")
+                                          "its seeded lattice, at rest) or 'relaxed' (settled first with its vessels "
+                                          "held still and its velocities zeroed, until it stops moving, and started "
+                                          "from there at rest). Under surface_density 'seeded_offset' DFSPH holds "
+                                          "each bound particle of a 'seeded' start to the kernel deficiency it was "
+                                          "seeded with, and a 'relaxed' one to none (compression only: Bender & "
+                                          "Koschier 2017). docs/relaxed_start.md.")
     surface_density: SurfaceDensity = setting(SurfaceDensity.CONTINUITY, PRESSURE, "DFSPH: the density of "
                                               "bound liquid short of a full kernel support (the surface rows). "
-                                              "'seeded_offset': its summation density plus the deficiency it was "
-                                              "seeded with (initial_state 'seeded'), or none ('relaxed'). "
                                               "'continuity': carried by the continuity equation wherever Marrone et "
                                               "al. 2010's indicator is below 0.75 (the summation density inside), "
                                               "so the offset follows the liquid instead of the seeding. "
+                                              "'seeded_offset': its summation density plus the deficiency it was "
+                                              "seeded with (initial_state 'seeded'), or none ('relaxed'). "
                                               "docs/surface_density.md.")
     # ---- WCSPH
     gamma: float = setting(7.0, WCSPH, "Tait exponent of the equation of state p = rho0 c0^2 / gamma ((rho / rho0)^gamma "

@@ -10,7 +10,9 @@ A substep, after the neighbour search:
                            rho_i = (sum_j m_j W_ij + sum_b rho0 V_b W_ib) / s (summation density, wall particles
                            included; s = the sum over a resting lattice / rho0, 1.005 for Wendland C2 at h = 1.5 dx
                            in 2-D, so the liquid as seeded is at rest instead of 0.5 % compressed), plus the bound
-                           liquid's seeded surface offset (:func:`bound_or_free_density`), and the DFSPH
+                           liquid's surface offset (the density the continuity equation carries to the rows short
+                           of a full support, :func:`surface_offset`; or the seeded deficiency,
+                           :func:`bound_or_free_density`), and the DFSPH
                            factor alpha_i = rho_i / (|sum_j m_j grad W_ij + sum_b rho0 V_b grad W_ib|^2
                            + sum_j m_i m_j |grad W_ij|^2) (denominator bounded below; m_j: each particle's
                            own mass, ``cosim.fluid.model``); starts the divergence solve.
@@ -204,7 +206,8 @@ def bound_or_free_density(
     rest_offset: wp.array(dtype=float),
 ) -> float:
     """The density the solves hold particle i to (kg/m^3), from its summation density ``summation`` (over a resting
-    lattice's). With ``initial_state`` 'seeded', a particle's first substep stores the kernel deficiency it was
+    lattice's). With ``surface_density`` 'continuity' the offset is :func:`surface_offset`'s, written this substep.
+    With 'seeded_offset' and ``initial_state`` 'seeded', a particle's first substep stores the kernel deficiency it was
     seeded with, max(rho0 - summation, 0), as its ``rest_offset``: the seeded liquid is at rest, so its surface rows,
     short of neighbours above, are held at the spacing they were seeded with instead of sinking until their sums
     reach rho0 (without it a resting column's top rows merge below their spacing). With 'relaxed' every offset is 0

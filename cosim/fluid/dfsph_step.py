@@ -11,6 +11,7 @@
                                  compression is small
     compute_wall_reaction        the vessels' share of both solves' pair forces; the interval's average pressure
     integrate                    x += dt v*, the wall guard, diagnostics
+    carry_density                ('continuity' surface density) the held density carried over the substep
     end_substep: reduce_wrenches; next_row (``cosim.fluid.substep``)
 
 Each solve is a loop on a device flag (``wp.capture_while``) that ``check_convergence`` clears.
@@ -263,8 +264,9 @@ class DFSPHStep:
 
     def initialise(self, st: FluidState) -> None:
         """The seeded pressure (hydrostatic for a filled vessel) as the stiffness the liquid was already under: the
-        first density solve warm-starts from it as from any previous substep's. With ``initial_state`` 'seeded', the
-        seeded kernel deficiency is measured in the first substep and kept as each particle's rest offset
+        first density solve warm-starts from it as from any previous substep's. With ``surface_density`` 'continuity'
+        the liquid starts at rho0, which the continuity equation carries on where a particle's support is not full
+        (``cosim.fluid.dfsph.surface_offset``). With 'seeded_offset' and ``initial_state`` 'seeded', the seeded kernel deficiency is measured in the first substep and kept as each particle's rest offset
         (``cosim.fluid.dfsph.bound_or_free_density``); with 'relaxed', no particle has one: the liquid is held to its
         summation density, compression only (Bender & Koschier 2017), and settles before t = 0
         (``cosim.fluid.relaxation``)."""

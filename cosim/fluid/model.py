@@ -187,8 +187,10 @@ class FluidState:
     DFSPH only, m^2/s^2, the stiffness (p / rho) each of its two solves applied in the last substep (the warm start
     of the next; zero under WCSPH); free: 1 while the particle is free liquid (WCSPH: memoryless summation density,
     no tension, :func:`cosim.fluid.wcsph.update_free_liquid`; DFSPH: no seeded offset), 0 while it is bound (its
-    density follows the continuity equation under WCSPH); rest_offset: DFSPH only, kg/m^3, the kernel deficiency a
-    bound particle was seeded with (:func:`cosim.fluid.dfsph.bound_or_free_density`).
+    density follows the continuity equation under WCSPH); rest_offset: DFSPH only, kg/m^3, what a bound particle is held to
+    beyond its summation density: the carried density's excess where its support is not full (``surface_density``
+    'continuity', :func:`cosim.fluid.dfsph.surface_offset`) or the kernel deficiency it was seeded with
+    ('seeded_offset', :func:`cosim.fluid.dfsph.bound_or_free_density`).
     """
 
     x: wp.array
