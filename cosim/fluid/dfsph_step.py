@@ -101,7 +101,7 @@ def compute_density_factor(rec: Recorder, m: FluidModel, st: FluidState, sh: Sub
     rec.launch(
         dfsph.compute_density_factor, m.n_particles, prm=m.params, vessels=m.vessels, b_volume=m.b_volume,
         capacity=sh.pair_capacity, free_liquid=free_liquid_mode(m.config), threshold=m.config.free_surface_threshold,
-        surface_density=int(continuity_surface(m)), motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active,
+        surface_density=dfsph.SURFACE_CONTINUITY if continuity_surface(m) else dfsph.SURFACE_SEEDED_OFFSET, motions=sh.motions, nb=sh.neighborhood(m, st), active=st.active,
         mass=st.mass, row=sh.row, kappa_divergence=st.kappa_divergence, free=st.free, rest_offset=st.rest_offset,
         rho=st.rho, alpha=sc.alpha, increment=sc.increment, increment_per_rho=sc.increment_per_rho,
         pair_count=sc.pairs.count, pair_slots=sc.pair_slots, pair_index=sc.pairs.index, pair_grad=sc.pairs.grad, pair_mass_grad=sc.pair_mass_grad,
