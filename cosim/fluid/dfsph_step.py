@@ -266,7 +266,8 @@ class DFSPHStep:
         """The seeded pressure (hydrostatic for a filled vessel) as the stiffness the liquid was already under: the
         first density solve warm-starts from it as from any previous substep's. With ``surface_density`` 'continuity'
         the liquid starts at rho0, which the continuity equation carries on where a particle's support is not full
-        (``cosim.fluid.dfsph.surface_offset``). With 'seeded_offset' and ``initial_state`` 'seeded', the seeded kernel deficiency is measured in the first substep and kept as each particle's rest offset
+        (``cosim.fluid.dfsph.surface_offset``). With 'seeded_offset' and ``initial_state`` 'seeded', the seeded
+        kernel deficiency is taken in the first substep and kept as each particle's rest offset
         (``cosim.fluid.dfsph.bound_or_free_density``); with 'relaxed', no particle has one: the liquid is held to its
         summation density, compression only (Bender & Koschier 2017), and settles before t = 0
         (``cosim.fluid.relaxation``)."""

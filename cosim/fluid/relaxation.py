@@ -18,7 +18,7 @@ solve's own motion); or after ``duration`` s ('time cap'). The clock, the step c
 account then restart from the relaxed liquid at rest (:meth:`cosim.fluid.solver.FluidSolver.restart_at_rest`).
 Under ``surface_density`` 'seeded_offset' (no offsets when relaxed) the settled top row still sums short of rho0,
 resting on the row below in a stacking the compression-only solve holds but that is not stable: released, it drops
-into that row's gaps within about half a second (measured in docs/relaxed_start.md). Under 'continuity' (DFSPH's
+into that row's gaps within about half a second (docs/relaxed_start.md). Under 'continuity' (DFSPH's
 default) the surface rows keep the density the continuity equation carries to them through the relaxation
 (``cosim.fluid.dfsph.surface_offset``).
 """
