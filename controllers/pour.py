@@ -134,6 +134,7 @@ class PourController:
         self._theta1 = 0.0  # rad, theta1 as the PID reads it: through its measurement filter
         self._last_poured = 0.0
         self._sigma_prev = 0.0
+        self._vessel_held = False  # SIM_HOLD: the vessel itself has stopped at phi, not only its command
         self._since = math.nan  # start of the current settle (SIM_DAMP) or max-tilt (CFS) interval, s
         self._cfs_history: deque[tuple[float, float, float]] = deque()  # (t, poured, tilt) over the last hold
         self._tilt_history: deque[tuple[float, float, float]] = deque()  # (t, commanded, measured tilt), LAG_WINDOW
@@ -249,6 +250,7 @@ class PourController:
         self._cfs_head = m.h_q  # the head filter starts on the measurement (no step into CFS)
         if phase is Phase.SIM_HOLD:
             self._sigma_prev = m.slosh_angle
+            self._vessel_held = False
         elif phase is Phase.SIM_DAMP:
             assert self._pid is not None and self._smoother is not None
             # The damping starts from the vessel's measured tilt: a command that ran ahead of the arm (the task-space
@@ -368,7 +370,11 @@ class PourController:
             return stop
         sigma, prev = m.slosh_angle, self._sigma_prev
         self._sigma_prev = sigma
-        if prev < 0.0 <= sigma:
+        # The paper's t1: theta1 returns to zero "while theta remains at phi". The command reaches phi at t0's end;
+        # the vessel follows it late (the arm's filter and servos) and the surface answers its motion until it
+        # stops, so a crossing counts once the measured tilt has stopped rising (the previous step's is not below).
+        self._vessel_held = self._vessel_held or (bool(self._tilt_history) and m.tilt <= self._tilt_history[-1][2])
+        if self._vessel_held and prev < 0.0 <= sigma:
             return Phase.SIM_DAMP, f"t1 done: slosh angle crossed zero toward the lip ({prev:+.4f} -> {sigma:+.4f} rad)"
         limit = self.config.sim.hold_timeout_periods * self.model.period
         if self._elapsed(m) >= limit:

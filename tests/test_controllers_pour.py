@@ -110,6 +110,26 @@ def test_sim_timeline_on_the_linear_plant() -> None:
     assert t[-1] < 60.0
 
 
+def test_the_hold_waits_for_the_vessel_not_its_command() -> None:
+    """t1 ends at the slosh angle's zero crossing toward the lip with the vessel itself at phi (the paper: theta1
+    returns to zero "while theta remains at phi"). An arm 0.3 s behind its command is still tilting when the
+    command reaches phi, and the surface crosses zero while it does (0.05 s into the hold on this plant): that
+    crossing is the vessel's motion, not the induced wave's return, and does not end the hold."""
+    delay = 30  # control periods: 0.3 s, the coupled pour's arm lag
+    controller, _, trace = _run(_config(), duration=3.0, arm_delay_steps=delay)
+    times = {(tr.source, tr.target): tr.t for tr in controller.transitions}
+    t_hold, t_damp = times[(Phase.SIM_EXCITE, Phase.SIM_HOLD)], times[(Phase.SIM_HOLD, Phase.SIM_DAMP)]
+    tilt, sigma = trace.series("tilt"), trace.series("theta1") - trace.series("tilt")
+    hold = np.flatnonzero((trace.t >= t_hold - 1e-9) & (trace.t < t_damp - 1e-9))
+    k_damp = hold[-1] + 1
+    rising = np.flatnonzero(np.diff(tilt[hold[0] - 1 : k_damp + 1]) > 0.0)
+    assert rising.size and rising[-1] < len(hold)  # the vessel was still rising in the hold, and stopped in it
+    early = [k for k in hold[1 : rising[-1] + 1] if sigma[k - 1] < 0.0 <= sigma[k]]
+    assert early  # the surface crossed zero toward the lip while the vessel rose
+    assert sigma[k_damp - 1] < 0.0 <= sigma[k_damp] and tilt[k_damp] <= tilt[k_damp - 1]
+    assert t_damp - t_hold >= delay * controller.dt
+
+
 def test_holding_the_tilt_leaves_the_slosh_the_pid_damps() -> None:
     """The comparison case sim.damping = hold: t2 moves to the PID's reference open loop and holds it. On the
     model plant (a pendulum without damping) the slosh then stays above a third of its amplitude at t2's start and
