@@ -372,7 +372,7 @@ class PourController:
         self._sigma_prev = sigma
         # The paper's t1: theta1 returns to zero "while theta remains at phi". The command reaches phi at t0's end;
         # the vessel follows it late (the arm's filter and servos) and the surface answers its motion until it
-        # stops, so a crossing counts once the measured tilt has stopped rising (the previous step's is not below).
+        # stops, so a crossing counts once the vessel's own tilt (m.tilt) has stopped rising (not above the last).
         self._vessel_held = self._vessel_held or (bool(self._tilt_history) and m.tilt <= self._tilt_history[-1][2])
         if self._vessel_held and prev < 0.0 <= sigma:
             return Phase.SIM_DAMP, f"t1 done: slosh angle crossed zero toward the lip ({prev:+.4f} -> {sigma:+.4f} rad)"

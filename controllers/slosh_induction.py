@@ -4,9 +4,9 @@ Timeline (Fig. 7), run by :class:`controllers.pour.PourController` about the cen
   t0  excitation theta = phi sin(alpha t) until theta = phi (a quarter period, pi / (2 alpha));
   t1  hold theta = phi until the slosh angle sigma = theta1 - theta crosses zero toward the lip (the induced wave
       runs toward the lip with its largest speed) with the vessel itself at phi: the paper's theta1 returns to zero
-      "while theta remains at phi". The arm reaches phi after its command does (0.2-0.3 s later in the coupled
-      pour), and a crossing while it still tilts is the surface answering that motion, which ends t0 and t1 within
-      a control period or a slosh period apart depending on a few milliseconds of phase;
+      "while theta remains at phi". The arm reaches phi after its command does (its task-space filter and servos
+      lag it), and a crossing while it still tilts is the surface answering that motion: counted, it would end t1
+      at once or a slosh period later depending on a few milliseconds of phase (docs/controller.md);
   t2  PID damping of theta1 (:mod:`controllers.pid`, through the smoother it is designed with) toward the tilt at
       which the resting liquid would stand sim.damp_head (below the crest) over the crest;
   t3  hand-over to the constant-flow stage once |sigma| has stayed within sim.settle_tolerance for
