@@ -38,6 +38,7 @@ def test_table_from_a_known_pour(tmp_path: Path) -> None:
     lines = study_table([tmp_path]).splitlines()
     assert lines[0] == "| liquid.fill_depth | " + " | ".join(COLUMNS) + " |"
     cells = [c.strip() for c in lines[2].strip("|").split("|")]
-    # spill 1 %, steady at 1.8 s, h_q 15 +- 2 mm after 2.0 s (median 15, quartiles 13 and 17), t2 1.0 s, sigma 0.040 -> 0.04 e^-2.25 = 0.004 rad (the last half period starts at 1.75 s)
-    assert cells == ["0.15", "1.00", "1.80", "15.0, 4.0", "1.00", "t2 done", "0.040", "0.004", "2.90"]
+    # spill 1 %, steady at 1.8 s, h_q 15 +- 2 mm after 2.0 s (median 15, quartiles 13 and 17), t1 and t2 1.0 s each,
+    # sigma 0.040 -> 0.04 e^-2.25 = 0.004 rad (the last half period starts at 1.75 s)
+    assert cells == ["0.15", "1.00", "1.80", "15.0, 4.0", "1.00", "1.00", "t2 done", "0.040", "0.004", "2.90"]
     assert "failed: liquid.fill_depth: too high" in lines[3]

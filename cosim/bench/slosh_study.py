@@ -6,7 +6,7 @@ Reads each sweep output's sweep.csv (``cosim sweep``, e.g. examples/sim_study.to
 and, for every pour that ran, its summary.json and series.csv, and prints one Markdown row per pour: its axes, the
 spill (% of what it poured), when the outflow became steady (s after the pour's start), the spread of h_q in CFS
 (median and interquartile range after the steady outflow, mm, over the samples with a surface to measure: the probe
-reports -inner height for a vessel too empty for one), how long t2 lasted and why it ended, the slosh angle's largest
+reports -inner height for a vessel too empty for one), how long t1 (the hold) lasted, how long t2 lasted and why it ended, the slosh angle's largest
 |sigma| over the first and the last half slosh period of t2 (rad), and when the pour was done (s).
 """
 
@@ -24,7 +24,7 @@ from controllers.config import CFS_MAX_HEAD
 from cosim.atomic_files import write_text_atomic
 
 HALF_PERIOD_SAMPLES = 25  # control steps (10 ms) in half a slosh period of the paper's vessel (0.50 s period)
-COLUMNS = ("spill (% of poured)", "steady outflow (s)", "h_q in CFS: median, IQR (mm)", "t2 (s)", "t2 ended",
+COLUMNS = ("spill (% of poured)", "steady outflow (s)", "h_q in CFS: median, IQR (mm)", "t1 (s)", "t2 (s)", "t2 ended",
            "max sigma, t2 start (rad)", "max sigma, t2 end (rad)", "done at (s)")
 
 
@@ -43,6 +43,7 @@ def pour_row(folder: Path) -> list[str]:
     steady = math.nan if steady is None else steady
     measured = h_q > -CFS_MAX_HEAD  # the probe's "no surface" is -inner height; CFS heads lie within +-CFS_MAX_HEAD
     cfs = (phase == "cfs") & (t >= steady + summary["scene"]["coupling"]["start_delay"]) & measured
+    hold = np.flatnonzero(phase == "sim_hold")
     damp = np.flatnonzero(phase == "sim_damp")
     ended = next((tr["reason"].split(":")[0].split(",")[0] for tr in summary["transitions"] if tr["from"] == "sim_damp"), "")
     done = next((p["start"] for p in summary["phases"] if p["phase"] == "done"), math.nan)
@@ -51,6 +52,7 @@ def pour_row(folder: Path) -> list[str]:
         "-" if math.isnan(steady) else f"{steady:.2f}",
         "{:.1f}, {:.1f}".format(1e3 * np.median(h_q[cfs]), 1e3 * np.subtract(*np.percentile(h_q[cfs], [75, 25])))
         if cfs.any() else "-",
+        f"{t[hold[-1]] - t[hold[0]] + 0.01:.2f}" if hold.size else "-",
         f"{t[damp[-1]] - t[damp[0]] + 0.01:.2f}" if damp.size else "-",
         ended or "-",
         f"{np.max(np.abs(sigma[damp[:HALF_PERIOD_SAMPLES]])):.3f}" if damp.size else "-",
