@@ -5,8 +5,10 @@
 Reads each sweep output's sweep.csv (``cosim sweep``, e.g. examples/sim_study.toml and examples/approach_study.toml)
 and, for every pour that ran, its summary.json and series.csv, and prints one Markdown row per pour: its axes, the
 spill (% of what it poured), when the outflow became steady (s after the pour's start), the spread of h_q in CFS
-(median and interquartile range after the steady outflow, mm, over the samples with a surface to measure: the probe
-reports -inner height for a vessel too empty for one), how long t1 (the hold) lasted, how long t2 lasted and why it ended, the slosh angle's largest
+(median and interquartile range after the steady outflow, mm, over the samples with a surface to measure, the probe
+reporting -inner height for a vessel too empty for one, until 90 % of what the pour poured has left: the rest drains
+near the deepest tilt with the head at a fraction of a millimetre, for as long as the stall rule lets it, and would
+be most of the samples), how long t1 (the hold) lasted, how long t2 lasted and why it ended, the slosh angle's largest
 |sigma| over the first and the last half slosh period of t2 (rad), and when the pour was done (s).
 """
 
@@ -23,8 +25,9 @@ import numpy as np
 from controllers.config import CFS_MAX_HEAD
 from cosim.atomic_files import write_text_atomic
 
+HEAD_WINDOW_FRACTION = 0.9  # of the poured volume: h_q in CFS is read until this much has left
 HALF_PERIOD_SAMPLES = 25  # control steps (10 ms) in half a slosh period of the paper's vessel (0.50 s period)
-COLUMNS = ("spill (% of poured)", "steady outflow (s)", "h_q in CFS: median, IQR (mm)", "t1 (s)", "t2 (s)", "t2 ended",
+COLUMNS = ("spill (% of poured)", "steady outflow (s)", "h_q in CFS to 90 % poured: median, IQR (mm)", "t1 (s)", "t2 (s)", "t2 ended",
            "max sigma, t2 start (rad)", "max sigma, t2 end (rad)", "done at (s)")
 
 
@@ -42,7 +45,8 @@ def pour_row(folder: Path) -> list[str]:
     steady = summary["outflow"].get("steady_outflow")
     steady = math.nan if steady is None else steady
     measured = h_q > -CFS_MAX_HEAD  # the probe's "no surface" is -inner height; CFS heads lie within +-CFS_MAX_HEAD
-    cfs = (phase == "cfs") & (t >= steady + summary["scene"]["coupling"]["start_delay"]) & measured
+    holding = np.array([float(r["poured_volume"]) for r in rows]) < HEAD_WINDOW_FRACTION * poured
+    cfs = (phase == "cfs") & (t >= steady + summary["scene"]["coupling"]["start_delay"]) & measured & holding
     hold = np.flatnonzero(phase == "sim_hold")
     damp = np.flatnonzero(phase == "sim_damp")
     ended = next((tr["reason"].split(":")[0].split(",")[0] for tr in summary["transitions"] if tr["from"] == "sim_damp"), "")
