@@ -27,8 +27,8 @@ from cosim.atomic_files import write_text_atomic
 
 HEAD_WINDOW_FRACTION = 0.9  # of the poured volume: h_q in CFS is read until this much has left
 HALF_PERIOD_SAMPLES = 25  # control steps (10 ms) in half a slosh period of the paper's vessel (0.50 s period)
-COLUMNS = ("spill (% of poured)", "steady outflow (s)", "h_q in CFS to 90 % poured: median, IQR (mm)", "t1 (s)", "t2 (s)", "t2 ended",
-           "max sigma, t2 start (rad)", "max sigma, t2 end (rad)", "done at (s)")
+COLUMNS = ("spill (% of poured)", "steady outflow (s)", "h_q in CFS to 90 % poured: median, IQR (mm)", "t1 (s)",
+           "t2 (s)", "t2 ended", "max sigma, t2 start (rad)", "max sigma, t2 end (rad)", "done at (s)")
 
 
 def pour_row(folder: Path) -> list[str]:
