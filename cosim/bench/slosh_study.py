@@ -44,9 +44,9 @@ def pour_row(folder: Path) -> list[str]:
     spill = 100.0 * summary["spilled_volume"] / poured if poured > 0 else math.nan
     steady = summary["outflow"].get("steady_outflow")
     steady = math.nan if steady is None else steady
-    measured = h_q > -CFS_MAX_HEAD  # the probe's "no surface" is -inner height; CFS heads lie within +-CFS_MAX_HEAD
+    has_surface = h_q > -CFS_MAX_HEAD  # the probe's "no surface" is -inner height; CFS heads lie within +-CFS_MAX_HEAD
     holding = np.array([float(r["poured_volume"]) for r in rows]) < HEAD_WINDOW_FRACTION * poured
-    cfs = (phase == "cfs") & (t >= steady + summary["scene"]["coupling"]["start_delay"]) & measured & holding
+    cfs = (phase == "cfs") & (t >= steady + summary["scene"]["coupling"]["start_delay"]) & has_surface & holding
     hold = np.flatnonzero(phase == "sim_hold")
     damp = np.flatnonzero(phase == "sim_damp")
     ended = next((tr["reason"].split(":")[0].split(",")[0] for tr in summary["transitions"] if tr["from"] == "sim_damp"), "")
