@@ -121,3 +121,45 @@ def test_a_coarse_run_measures_the_coefficient_of_the_resolution_study() -> None
     ratio = result.raw["coefficient"] / result.raw["rehbock"]
     assert ratio == pytest.approx(COARSE_RATIO, abs=COARSE_TOLERANCE)
     assert result.raw["head"] == pytest.approx(0.04, rel=0.15)  # the flow settled near the head the piston supplies
+    # the nappe springs from the crest's upstream edge as over a sharp crest, even 5 spacings across the head: its
+    # lower surface's highest point within 1 mm of 0.112 H (4.8 mm measured against 4.4 mm), at 0.25 H and back at
+    # the crest's level at 0.67 H, each within one bin (a spacing)
+    nappe = next(m for m in result.metrics if m.name.startswith("nappe's lower surface"))
+    assert nappe.passed, nappe
+    head = result.raw["head"]
+    assert result.raw["nappe_rise_x"] == pytest.approx(weir.NAPPE_RISE_AT * head, abs=COARSE_SPACING)
+    assert result.raw["nappe_return_x"] == pytest.approx(weir.NAPPE_RETURN_AT * head, abs=COARSE_SPACING)
+
+
+def test_the_nappe_surfaces_are_the_lowest_and_highest_liquid_in_each_bin() -> None:
+    p = weir.Params(head=0.04, spacing=0.01)  # 4 bins of 10 mm from the weir's upstream face
+    ch = weir.Channel(p, 0.01, 0.005, 0.012)
+    crest = p.crest_height
+    x = np.array([
+        [0.002, 0.0, crest + 0.010], [0.008, 0.0, crest + 0.030],  # bin 0: lower 10 - 5, upper 30 + 5 mm
+        [0.015, 0.0, crest + 0.012],  # bin 1: one particle, both surfaces from it
+        [0.035, 0.0, crest - 0.030],  # bin 3: below the crest, within one head of it
+        [0.035, 0.0, crest - 0.050],  # more than a head below the crest: not the nappe's
+        [-0.001, 0.0, crest + 0.001],  # upstream of the weir
+        [0.041, 0.0, crest + 0.001],  # past the last bin
+        [0.025, 0.0, crest + 0.020],  # inactive
+    ])
+    active = np.array([True] * 7 + [False])
+    np.testing.assert_allclose(ch.nappe_x, [0.005, 0.015, 0.025, 0.035])
+    lower, upper = ch.nappe_surfaces(x, active)
+    np.testing.assert_allclose(lower, [0.005, 0.007, np.nan, -0.035], atol=1e-12)
+    np.testing.assert_allclose(upper, [0.035, 0.017, np.nan, -0.025], atol=1e-12)
+
+
+def test_the_nappe_profile_reads_its_rise_and_where_it_returns_to_the_crest() -> None:
+    x = np.array([0.5, 1.5, 2.5, 3.5])
+    first = np.array([1.0, 3.0, 2.0, -2.0])
+    second = np.array([1.0, np.nan, 2.0, -2.0])  # a bin empty in one sample: the mean over the other samples
+    never = np.array([np.nan] * 4)
+    nappe = weir.nappe_profile(x, [first, second], [first + 10.0, never])
+    np.testing.assert_allclose(nappe.lower, [1.0, 3.0, 2.0, -2.0])
+    assert (nappe.rise, nappe.rise_x) == (3.0, 1.5)
+    assert nappe.return_x == pytest.approx(2.5 + 2.0 / 4.0)  # linear between 2 at 2.5 and -2 at 3.5
+    assert nappe.upper_at_weir == 11.0
+    assert np.isnan(weir.nappe_profile(x, [first.clip(0.0)], [first]).return_x)  # never back below the crest
+    assert np.isnan(weir.nappe_profile(x, [never], [never]).rise)

@@ -48,6 +48,6 @@ CASES: dict[str, Case] = {
     "shake": Case("moving_vessel", "run_shake", "full vessel shaken at resonance"),
     "slosh-plant": Case("slosh_plant", "run", "slosh pendulum (omega1, hinge, damping) from tilts vs potential flow"),
     "free-fall": Case("free_fall", "run", "outflow particles vs their free-fall parabolas (Camporredondo et al. 2019, Eqs. 6-7)"),
-    "outflow": Case("weir", "run", "steady flow over a sharp-crested weir: discharge coefficient vs Rehbock (2-D)"),
+    "outflow": Case("weir", "run", "steady flow over a sharp-crested weir: discharge coefficient vs Rehbock, nappe vs Bazin (2-D or 3-D)"),
 }
 DEFAULT_CASES = ("hydrostatic", "slosh", "dam-break", "free-fall", "coupling-static")

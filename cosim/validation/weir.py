@@ -43,6 +43,7 @@ from cosim.fluid.seeding import ParticleSet, liquid_block
 from cosim.fluid.solver import FluidSolver
 from cosim.fluid.wall_sampling import numerical_wall_thickness
 from cosim.frames import Pose
+from cosim.validation.launch_point import LIP_TOLERANCE
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
 from cosim.vessel import VesselSpec
 from declared_settings.setting import documented, setting
@@ -58,6 +59,13 @@ STATION_HEADS = 4.0  # the head is measured this many nominal heads upstream of 
 STATION_SPACINGS = 10  # width of the head's strip, particle spacings
 PISTON_CLEARANCE_HEADS = 3.0  # the piston stays this many nominal heads behind the strip
 SAMPLE_INTERVAL = 0.01  # s
+# The nappe over a sharp crest, fully ventilated, the approach velocity negligible (Bazin's measurements, as given by
+# Chow 1959, "Open-Channel Hydraulics", and Henderson 1966): its lower surface rises from the crest's upstream edge
+# to NAPPE_RISE H above the crest at NAPPE_RISE_AT H downstream of the weir's upstream face and passes the crest's
+# level again at NAPPE_RETURN_AT H; its upper surface stands NAPPE_UPPER_AT_WEIR H above the crest at the weir.
+NAPPE_RISE, NAPPE_RISE_AT, NAPPE_RETURN_AT, NAPPE_UPPER_AT_WEIR = 0.112, 0.25, 0.67, 0.85
+NAPPE_EXTENT_HEADS = 1.0  # the nappe's surfaces are read from the weir's upstream face this many nominal heads on
+NAPPE_DEPTH_HEADS = 1.0  # liquid up to this many heads below the crest counts as the nappe's
 DOMAIN_MARGIN = 0.05  # m, the domain past the channel's walls (downstream: where the nappe leaves it, counted as passed)
 WEIR_FACTOR = (2.0 / 3.0) * math.sqrt(2.0 * GRAVITY)  # m^(1/2)/s: q / (C_d H^(3/2))
 
@@ -200,10 +208,67 @@ class Channel:
         surface = float(np.mean(top[np.isfinite(top)])) + 0.5 * self.dx if inside.any() else 0.0
         return float(inside.sum()) * self.cell / self.strip - self.crest, surface - self.crest
 
+    def nappe_surfaces(self, x: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """m above the crest, the nappe's lower and upper surface in bins one spacing wide from the weir's upstream
+        face to NAPPE_EXTENT_HEADS nominal heads downstream (:attr:`nappe_x`): the lowest and the highest liquid
+        particle centre in the bin (liquid above the crest less NAPPE_DEPTH_HEADS heads) less and plus dx/2; NaN
+        where the bin holds none."""
+        bins = len(self.nappe_x)
+        over = active & (x[:, 0] >= 0.0) & (x[:, 0] < bins * self.dx) & (x[:, 2] > self.crest - NAPPE_DEPTH_HEADS * self.head)
+        lower, upper = np.full(bins, np.inf), np.full(bins, -np.inf)
+        column = np.floor(x[over, 0] / self.dx).astype(int)
+        np.minimum.at(lower, column, x[over, 2])
+        np.maximum.at(upper, column, x[over, 2])
+        lower = np.where(np.isfinite(lower), lower - 0.5 * self.dx - self.crest, np.nan)
+        upper = np.where(np.isfinite(upper), upper + 0.5 * self.dx - self.crest, np.nan)
+        return lower, upper
+
+    @property
+    def nappe_x(self) -> np.ndarray:
+        """m, the centres of the nappe's bins downstream of the weir's upstream face."""
+        return (np.arange(math.ceil(NAPPE_EXTENT_HEADS * self.head / self.dx - 1e-9)) + 0.5) * self.dx
+
     def passed_area(self, x: np.ndarray, active: np.ndarray) -> float:
         """m^2, the liquid's section area (per unit width) that has passed the weir's upstream face (still beyond it,
         or gone from the domain)."""
         return float(((~active) | (x[:, 0] > 0.0)).sum()) * self.cell
+
+
+@dataclass(frozen=True)
+class Nappe:
+    """The nappe's surfaces over the measuring window (m above the crest; x m from the weir's upstream face): per
+    bin the mean over the samples in which the bin held liquid (NaN if never), and read off them the lower
+    surface's highest point (``rise`` at ``rise_x``), where it passes the crest's level again after it
+    (``return_x``, linear between bins; NaN if within the bins it does not), and the upper surface in the first bin
+    (``upper_at_weir``)."""
+
+    x: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    rise: float
+    rise_x: float
+    return_x: float
+    upper_at_weir: float
+
+
+def nappe_profile(x: np.ndarray, lowers: list[np.ndarray], uppers: list[np.ndarray]) -> Nappe:
+    """The window's mean nappe from the per-sample surfaces of :meth:`Channel.nappe_surfaces` at bin centres ``x``."""
+    def mean(samples: list[np.ndarray]) -> np.ndarray:
+        a = np.array(samples, float).reshape(-1, len(x))
+        held = np.isfinite(a)
+        count = held.sum(axis=0)
+        return np.where(count > 0, np.where(held, a, 0.0).sum(axis=0) / np.maximum(count, 1), np.nan)
+
+    lower, upper = mean(lowers), mean(uppers)
+    if not np.isfinite(lower).any():
+        return Nappe(x, lower, upper, math.nan, math.nan, math.nan, float(upper[0]))
+    k = int(np.nanargmax(lower))
+    return_x = math.nan
+    for i in range(k, len(x) - 1):
+        if lower[i] >= 0.0 > lower[i + 1]:
+            return_x = float(x[i] + (x[i + 1] - x[i]) * lower[i] / (lower[i] - lower[i + 1]))
+            break
+    return Nappe(x, lower, upper, float(lower[k]), float(x[k]), return_x, float(upper[0]))
 
 
 def run(p: Params) -> CaseResult:
@@ -227,7 +292,7 @@ def run(p: Params) -> CaseResult:
     plates = ch.side_plates()
     solver = FluidSolver(cfg, [ch.tank(), ch.piston(), *(spec for spec, _ in plates)],
                          [ch.tank_pose(), ch.piston_pose(0.0), *(pose for _, pose in plates)], moving, device=p.device, relax_start=False)
-    t, passed, heads, surface_heads = [0.0], [0.0], [p.head], [p.head]
+    t, passed, heads, surface_heads, lowers, uppers = [0.0], [0.0], [p.head], [p.head], [], []
     start = time.perf_counter()
     while solver.time < p.duration - 1e-9:
         solver.set_vessel_poses([ch.tank_pose(), ch.piston_pose(solver.time + SAMPLE_INTERVAL), *(pose for _, pose in plates)])
@@ -238,6 +303,10 @@ def run(p: Params) -> CaseResult:
         head, surface_head = ch.heads_at_station(x, active)
         heads.append(head)
         surface_heads.append(surface_head)
+        if solver.time >= p.duration - p.window - 1e-9:
+            lower, upper = ch.nappe_surfaces(x, active)
+            lowers.append(lower)
+            uppers.append(upper)
     wall_time = time.perf_counter() - start
     t, passed, heads, surface_heads = np.array(t), np.array(passed), np.array(heads), np.array(surface_heads)
     window = t >= t[-1] - p.window - 1e-9
@@ -247,10 +316,13 @@ def run(p: Params) -> CaseResult:
     coefficient = q / (WEIR_FACTOR * head15) if head15 > 0.0 else float("nan")
     surface_head15 = float(np.mean(np.clip(surface_heads[window], 0.0, None) ** 1.5))
     reference = rehbock(head, p.crest_height)
+    nappe = nappe_profile(ch.nappe_x, lowers, uppers)
     drift = float(np.polyfit(t[window], heads[window], 1)[0] * p.window)
     metrics = [
         Metric(f"C_d at H0={1e3 * p.head:g} mm", coefficient, reference, (coefficient - reference) / reference, COEFFICIENT_TOLERANCE),
         Metric("head H over the crest", head, p.head, (head - p.head) / p.head, float("inf"), "m"),
+        Metric("nappe's lower surface: highest point above the crest", nappe.rise, NAPPE_RISE * head,
+               nappe.rise - NAPPE_RISE * head, LIP_TOLERANCE, "m", absolute=True),
     ]
     raw = {
         "t": t.tolist(),
@@ -268,6 +340,13 @@ def run(p: Params) -> CaseResult:
         "channel_length": ch.length,
         "crest_thickness": thickness,
         "head_over_crest_thickness": head / thickness,
+        "nappe_x": nappe.x.tolist(),
+        "nappe_lower": nappe.lower.tolist(),
+        "nappe_upper": nappe.upper.tolist(),
+        "nappe_rise": nappe.rise,
+        "nappe_rise_x": nappe.rise_x,
+        "nappe_return_x": nappe.return_x,
+        "nappe_upper_at_weir": nappe.upper_at_weir,
         "particles": solver.n_particles,
         "steps": solver.step_count,
     }
