@@ -261,7 +261,7 @@ def test_a_section_changes_only_its_own_keys_of_the_scene_default(tmp_path, toml
     "toml, dim, across, head_in_spacings",
     [
         ("", 2, 32, 3.0),  # the default scene: 3 dx = 17.9 mm, over the 5 mm of Camporredondo et al. (2019)
-        ("[fluid]\ndim = 3\n", 3, 32, 3.5),  # 3-D: 3.5 spacings, 20.9 mm
+        ("[fluid]\ndim = 3\n", 3, 32, 3.0),  # 3-D: 3 spacings too, 17.9 mm
         ("[fluid]\ndim = 3\nparticles_across = 16\n[controller]\nstream_particles = 2.5\n", 3, 16, 2.5),
         ("[controller]\nstream_particles = 1.5\n", 2, 32, 1.5),
     ],
