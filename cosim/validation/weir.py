@@ -43,8 +43,8 @@ from cosim.fluid.seeding import ParticleSet, liquid_block
 from cosim.fluid.solver import FluidSolver
 from cosim.fluid.wall_sampling import numerical_wall_thickness
 from cosim.frames import Pose
-from cosim.validation.launch_point import LIP_TOLERANCE
 from cosim.validation.common import CaseResult, FluidCaseParams, Metric, case_fluid_config, new_figure
+from cosim.validation.launch_point import LIP_TOLERANCE
 from cosim.vessel import VesselSpec
 from declared_settings.setting import documented, setting
 
