@@ -10,7 +10,7 @@ from cosim.validation import weir
 
 
 def _run(spacings: float, error: float) -> study.HeadRun:
-    return study.HeadRun(spacings, 0.01, 0.01, 1.0, error, 0.0, 100, 1.0)
+    return study.HeadRun(spacings, 0.01, 0.01, 1.0, error, 0.0, 0.0011, 100, 1.0)
 
 
 def test_the_floor_is_the_smallest_head_from_which_on_every_head_passes() -> None:
