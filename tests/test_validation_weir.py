@@ -163,3 +163,11 @@ def test_the_nappe_profile_reads_its_rise_and_where_it_returns_to_the_crest() ->
     assert nappe.upper_at_weir == 11.0
     assert np.isnan(weir.nappe_profile(x, [first.clip(0.0)], [first]).return_x)  # never back below the crest
     assert np.isnan(weir.nappe_profile(x, [never], [never]).rise)
+
+
+def test_the_plot_writes_the_coefficient_and_the_nappe_inset(tmp_path) -> None:
+    result = weir.run(weir.Params(head=0.04, spacing=COARSE_SPACING, duration=0.2, window=0.1))
+    assert len(result.raw["nappe_x"]) == 5 and any(np.isfinite(result.raw["nappe_lower"]))  # 40 mm in 8 mm bins
+    path = tmp_path / "outflow.png"
+    weir.plot(result, path)
+    assert path.stat().st_size > 10_000
