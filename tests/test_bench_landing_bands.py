@@ -17,7 +17,7 @@ DT = 0.01  # s, the control step
 
 def synthetic_run(folder, lip_offset: float, throw: float) -> None:
     """A pour whose poured fraction rises linearly from 0 to 1 over 10 s; the lip at lip_offset - 0.1 f (f the
-    poured fraction) and the stream landing ``throw`` past it, except while f < 0.05 (no stream measured yet)."""
+    poured fraction) and the stream landing ``throw`` past it, except while f < 0.05 (no stream at the rim yet)."""
     t = np.arange(0.0, 10.0 + DT / 2, DT)
     fraction = t / 10.0
     lip = lip_offset - 0.1 * fraction
@@ -52,7 +52,7 @@ def test_the_reference_table_separates_the_path_from_the_throw(tmp_path) -> None
     assert row.count("-13.0 (-5.0, -8.0)") == len(landing_bands.BANDS)
 
 
-def test_a_band_without_a_measured_landing_is_nan_and_a_bad_folder_is_refused(tmp_path) -> None:
+def test_a_band_without_a_landing_is_nan_and_a_bad_folder_is_refused(tmp_path) -> None:
     synthetic_run(tmp_path / "run", lip_offset=0.1, throw=0.12)
     series = {c: [math.nan] * 3 for c in COLUMNS}
     series.update(t=[0.0, 0.01, 0.02], poured_volume=[0.0, 0.0, 0.0])

@@ -122,8 +122,8 @@ def test_a_coarse_run_measures_the_coefficient_of_the_resolution_study() -> None
     assert ratio == pytest.approx(COARSE_RATIO, abs=COARSE_TOLERANCE)
     assert result.raw["head"] == pytest.approx(0.04, rel=0.15)  # the flow settled near the head the piston supplies
     # the nappe springs from the crest's upstream edge as over a sharp crest, even 5 spacings across the head: its
-    # lower surface's highest point within 1 mm of 0.112 H (4.8 mm measured against 4.4 mm), at 0.25 H and back at
-    # the crest's level at 0.67 H, each within one bin (a spacing)
+    # lower surface's highest point within 1 mm of 0.112 H, at 0.25 H and back at the crest's level at 0.67 H, each
+    # within one bin (a spacing)
     nappe = next(m for m in result.metrics if m.name.startswith("nappe's lower surface"))
     assert nappe.passed, nappe
     head = result.raw["head"]

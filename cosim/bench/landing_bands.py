@@ -5,7 +5,7 @@
 Reads run folders of ``cosim pour`` (series.csv, summary.json: :mod:`cosim.io.pour_series`). Pours of one scene
 at different resolutions or settings pour at different rates, so their landings are compared at equal poured
 fractions, not at equal times. Per band of the poured fraction (poured volume over the initial volume, ``BANDS``),
-over the control steps whose stream was measured crossing the catcher's rim plane, the medians of
+over the control steps at which the stream crossed the catcher's rim plane, the medians of
 
 * ``landing``: ``landing_measured_x``, m, the world x at which the stream crosses the rim plane;
 * ``lip``: ``lip_x``, m, the world x of the pourer's lip at that step: where the controller's path has put the
@@ -40,7 +40,7 @@ BAND_KEYS = ("landing", "lip", "throw", "tilt", "v_q", "h_q")
 @dataclass(frozen=True)
 class RunBands:
     """name: the run folder's name. bands: per band of BANDS, the medians named in BAND_KEYS (m, rad, m/s; NaN
-    where no step of that band measured a landing) and ``steps``, the steps they are taken over. pour_time: s,
+    where no step of that band has a landing) and ``steps``, the steps they are taken over. pour_time: s,
     from 10 to 90 % of the initial volume poured (NaN if the pour never reached 90 %)."""
 
     name: str
@@ -49,7 +49,7 @@ class RunBands:
 
 
 def band_medians(series: dict[str, list], initial_volume: float) -> tuple[list[dict[str, float]], float]:
-    """Per band of BANDS the medians of BAND_KEYS over the steps with a measured landing, and the time (s) from 10
+    """Per band of BANDS the medians of BAND_KEYS over the steps with a landing, and the time (s) from 10
     to 90 % poured, from a series.csv's columns and the initial volume (m^3)."""
     col = {c: np.asarray(series[c], float) for c in ("t", "poured_volume", "landing_measured_x", "lip_x", "tilt", "v_q", "h_q")}
     fraction = col["poured_volume"] / initial_volume

@@ -372,7 +372,7 @@ def plot(result: CaseResult, path) -> None:
     ax.set_ylabel("C_d = q / ((2/3) sqrt(2g) H^1.5)")
     ax.legend(loc="lower right")
     fig.tight_layout()
-    # inset: the nappe's surfaces over the window against Bazin's (heights and distances over the measured head)
+    # inset: the nappe's surfaces over the window against Bazin's (heights and distances in units of the head H)
     inset = fig.add_axes((0.2, 0.6, 0.26, 0.24))
     x, lower, upper = (np.asarray(r[k], float) / r["head"] for k in ("nappe_x", "nappe_lower", "nappe_upper"))
     inset.plot(x, lower, "o-", ms=3, label="SPH lower / upper")
