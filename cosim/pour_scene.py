@@ -151,7 +151,7 @@ class CatcherSettings:
 # The CFS head's floor in particle spacings, by dimension (ControllerSettings.stream_particles not set): the smallest
 # head (on a half-spacing grid) the liquid resolves as a flow over a crest, the weir case's discharge coefficient
 # within its 5 % of Rehbock's from that head on (python -m cosim.bench.weir_head_floor [--dim 3];
-# docs/outflow_validation.md has the tables). 2-D: at every resolution studied (24, 32, 48 across). 3-D: at the 3-D
+# docs/outflow_validation.md has the tables). 2-D: at every resolution studied (24, 32, 48, 64 across). 3-D: at the 3-D
 # pour's 32 across, in a channel as wide as the default pourer is deep (0.10 m), whose side walls cost the flow about
 # a point of C_d against a channel twice as wide. Both 3 spacings: 2.5 fails in 2-D and in 3-D.
 STREAM_PARTICLES = {2: 3.0, 3: 3.0}

@@ -14,7 +14,8 @@ docs/walls.md). ``--dim 3`` runs the 3-D channel, ``--depth`` m wide (default th
 of the sheet a 3-D pour sends over its lip). Per head: the measured head,
 the discharge against the piston's supply, the discharge coefficient against Rehbock's (the case's 5 %
 tolerance), and how high the nappe's lower surface rises above the crest against Bazin's 0.112 H (reported:
-the case checks it at its own resolution). The floor it reports is the smallest head from which on every head run is within the tolerance.
+the case checks it at its own resolution). The floor it reports is the smallest head from which on every head run
+is within the tolerance.
 """
 
 from __future__ import annotations
