@@ -17,8 +17,8 @@ from cosim.fluid.mesh_sampling import classify
 from cosim.fluid.sph_kernels import kernel_values
 from cosim.fluid.seeding import fill_vessel
 from cosim.fluid.sph_kernels import kernel_derivatives
-from cosim.fluid.wall_sampling import (holds_a_layer, numerical_wall_thickness, one_layer_depth, sample_vessel_walls, slab_particles,
-                                       wall_model_for)
+from cosim.fluid.wall_sampling import (first_row_lattice, holds_a_layer, numerical_wall_thickness, one_layer_depth, sample_vessel_walls,
+                                       slab_particles, wall_model_for)
 from cosim.mesh_vessel import load_vessel_mesh
 from cosim.pour_scene import FluidSettings
 from cosim.vessel import VesselShape, VesselSpec, mesh_vessel_spec, seed_pouring_vessel
@@ -148,6 +148,34 @@ def test_a_thin_walls_volumes_make_up_the_missing_kernel_sum(spec, dim, across):
     assert error.min() > -0.01
     assert np.abs(slab - reference[near]).max() > 0.03
     assert np.all(volumes > 0.0)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("slack", [0.3, 0.8])
+def test_a_thin_walls_fit_does_not_depend_on_the_spacings_across(dim, slack):
+    """The fit's probes are the liquid's first row as it settles against each face, dx/2 from it
+    (``first_row_lattice``), wherever the centred fill leaves its first column: a box 20 + slack spacings across (and
+    10 + slack deep in 3-D) fits its side walls as the box of whole spacings does. Centred, the fill's first column
+    stood (1 + slack) dx / 2 from each wall, and past a slack of 0.75 no probe reached the one layer, which kept its
+    slab volume, a quarter short."""
+    dx = POURER.inner_width / 20
+    cfg = FluidConfig(dim=dim, spacing=dx, wall_model=REAL)
+    whole = replace(POURER, inner_width=20 * dx, inner_depth=10 * dx)
+    offset = replace(POURER, inner_width=(20 + slack) * dx, inner_depth=(10 + slack) * dx)
+    lattice = first_row_lattice(offset, cfg)
+    assert 0.5 * offset.inner_width - np.abs(lattice[:, 0]).max() == pytest.approx(0.5 * dx, rel=1e-9)
+    if dim == 3:
+        assert 0.5 * offset.section_depth - np.abs(lattice[:, 1]).max() == pytest.approx(0.5 * dx, rel=1e-9)
+    np.testing.assert_array_equal(first_row_lattice(whole, cfg), fill_vessel(whole, whole.inner_height, cfg).positions)
+
+    def side_wall_fit(spec: VesselSpec) -> float:
+        """The median over the side walls' particles of the fitted volume over the particle's slab volume (a wall's
+        particles along a face are spaced to fill it, so their slab volumes differ between the boxes)."""
+        points, volumes = sample_vessel_walls(spec, cfg)
+        side = (np.abs(points[:, 0]) > 0.5 * spec.inner_width) & (points[:, 2] > 0.0)
+        return float(np.median(volumes[side] / slab_particles(spec, cfg)[1][side]))
+
+    assert side_wall_fit(offset) == pytest.approx(side_wall_fit(whole), rel=0.005)
 
 
 def _gradient_sums(points: np.ndarray, volumes: np.ndarray, probes: np.ndarray, cfg: FluidConfig) -> np.ndarray:

@@ -164,6 +164,30 @@ def _kernel_sums(pairs, volumes: np.ndarray, n_probes: int) -> np.ndarray:
     return np.bincount(rows, weights * volumes[cols], n_probes)
 
 
+def first_row_lattice(spec: VesselSpec, cfg: FluidConfig) -> np.ndarray:
+    """(n, 3) m, vessel frame: the lattice of liquid filling ``spec`` to its rim (:func:`cosim.fluid.seeding.fill_vessel`)
+    with each half of it against the walls it is nearest to, so that the first row stands dx/2 from every face as
+    liquid settles against it. The fill centres its lattice between the walls: across an inner size W that is not
+    whole spacings, n = floor(W / dx) columns leave a slack s = W - n dx, and the first column stands (dx + s) / 2
+    from each wall, up to a spacing. Here each half moves s / 2 toward its wall (the half on the -x side by -s / 2,
+    the other by +s / 2; across the depth likewise for a 3-D box; a 3-D cylinder's rings already lie half a ring's
+    width inside its wall, and the floor's first layer stands dx/2 above it). On whole spacings nothing moves."""
+    from cosim.fluid.seeding import fill_vessel
+
+    lattice = fill_vessel(spec, spec.inner_height, cfg).positions.copy()
+    dx = cfg.spacing
+    sizes = [(0, spec.inner_width)]
+    if cfg.dim == 3 and not spec.is_box:
+        sizes = []
+    elif cfg.dim == 3:
+        sizes.append((1, spec.section_depth))
+    for axis, size in sizes:
+        slack = size - math.floor(size / dx + 1e-9) * dx
+        if slack > 1e-9 * dx:
+            lattice[:, axis] += 0.5 * slack * np.sign(lattice[:, axis])
+    return lattice
+
+
 def fit_wall_volumes(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, volumes: np.ndarray) -> np.ndarray:
     """Volumes (m^dim) of a thin wall's dummy particles ``points`` (their own slab volumes ``volumes`` to start from)
     that make up the kernel support missing behind the wall.
@@ -174,8 +198,8 @@ def fit_wall_volumes(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, vol
     would: S_ref(p). A thinner wall's own layers supply less. As Akinci et al. (2012, "Versatile rigid-fluid
     coupling for incompressible SPH") give boundary particles volumes of their own so that a particle at a wall
     sums to its rest density, the volumes are fitted here so that S(p) = S_ref(p) at the probes p, the liquid's
-    first row along the walls: the points of its initial lattice filling the vessel to its rim
-    (:func:`cosim.fluid.seeding.fill_vessel`) whose nearest wall particle is nearer than FIRST_ROW_REACH dx, where
+    first row along the walls: the points of the lattice filling the vessel to its rim with its first row dx/2 from
+    every face (:func:`first_row_lattice`) whose nearest wall particle is nearer than FIRST_ROW_REACH dx, where
     the walls' share of the sum is largest (a quarter of it mid-face, against a few per cent one row further):
     FIT_SWEEPS multiplicative sweeps V_b <- V_b sum_p W_pb S_ref(p) / S(p) / sum_p W_pb (each particle scaled by
     the mean shortfall of the probes it reaches, weighted by its kernel there; volumes stay positive). Inner edges
@@ -188,9 +212,7 @@ def fit_wall_volumes(spec: VesselSpec, cfg: FluidConfig, points: np.ndarray, vol
     per particle match the sums of the wall particles themselves, which lack the layers behind them
     (docs/walls.md).
     """
-    from cosim.fluid.seeding import fill_vessel
-
-    probes = fill_vessel(spec, spec.inner_height, cfg).positions
+    probes = first_row_lattice(spec, cfg)
     rows, cols, r = _near_pairs(probes, points, cfg)
     nearest = np.full(len(probes), np.inf)
     np.minimum.at(nearest, rows, r)
