@@ -155,9 +155,9 @@ def test_a_thin_walls_volumes_make_up_the_missing_kernel_sum(spec, dim, across):
 def test_a_thin_walls_fit_does_not_depend_on_the_spacings_across(dim, slack):
     """The fit's probes are the liquid's first row as it settles against each face, dx/2 from it
     (``first_row_lattice``), wherever the centred fill leaves its first column: a box 20 + slack spacings across (and
-    10 + slack deep in 3-D) fits its side walls as the box of whole spacings does. Centred, the fill's first column
-    stood (1 + slack) dx / 2 from each wall, and past a slack of 0.75 no probe reached the one layer, which kept its
-    slab volume, a quarter short."""
+    10 + slack deep in 3-D) fits its side walls as the box of whole spacings does. The centred fill's first column
+    stands (1 + slack) dx / 2 from each wall: past a slack of 0.75 none of it is within the fit's reach of the one
+    layer, which would keep its slab volume, a quarter short."""
     dx = POURER.inner_width / 20
     cfg = FluidConfig(dim=dim, spacing=dx, wall_model=REAL)
     whole = replace(POURER, inner_width=20 * dx, inner_depth=10 * dx)
