@@ -176,11 +176,9 @@ def first_row_lattice(spec: VesselSpec, cfg: FluidConfig) -> np.ndarray:
 
     lattice = fill_vessel(spec, spec.inner_height, cfg).positions.copy()
     dx = cfg.spacing
-    sizes = [(0, spec.inner_width)]
-    if cfg.dim == 3 and not spec.is_box:
-        sizes = []
-    elif cfg.dim == 3:
-        sizes.append((1, spec.section_depth))
+    sizes = [(0, spec.inner_width)]  # (axis, inner size): 2-D sections are boxes
+    if cfg.dim == 3:
+        sizes = [(0, spec.inner_width), (1, spec.section_depth)] if spec.is_box else []
     for axis, size in sizes:
         slack = size - math.floor(size / dx + 1e-9) * dx
         if slack > 1e-9 * dx:
