@@ -151,6 +151,22 @@ def test_the_nappe_surfaces_are_the_lowest_and_highest_liquid_in_each_bin() -> N
     np.testing.assert_allclose(upper, [0.035, 0.017, np.nan, -0.025], atol=1e-12)
 
 
+def test_in_3d_the_nappe_surfaces_are_each_columns_averaged_across_the_channel() -> None:
+    """In 3-D each bin is read per column a spacing wide across the channel, and the columns holding liquid are
+    averaged: not the lowest particle over the whole width."""
+    p = weir.Params(head=0.04, spacing=0.01, dim=3, depth=0.1)  # 10 columns across
+    ch = weir.Channel(p, 0.01, 0.005, 0.012)
+    crest = p.crest_height
+    x = np.array([
+        [0.005, -0.045, crest + 0.010], [0.005, -0.045, crest + 0.030],  # bin 0, first column: 10 / 30 mm
+        [0.005, 0.045, crest + 0.020],  # bin 0, last column: 20 / 20 mm
+        [0.015, 0.0, crest + 0.012],  # bin 1, one column
+    ])
+    lower, upper = ch.nappe_surfaces(x, np.ones(len(x), bool))
+    np.testing.assert_allclose(lower, [0.010, 0.007, np.nan, np.nan], atol=1e-12)  # (5 + 15) / 2 mm, then 12 - 5
+    np.testing.assert_allclose(upper, [0.030, 0.017, np.nan, np.nan], atol=1e-12)  # (35 + 25) / 2 mm, then 12 + 5
+
+
 def test_the_nappe_profile_reads_its_rise_and_where_it_returns_to_the_crest() -> None:
     x = np.array([0.5, 1.5, 2.5, 3.5])
     first = np.array([1.0, 3.0, 2.0, -2.0])

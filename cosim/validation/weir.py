@@ -212,16 +212,27 @@ class Channel:
         """m above the crest, the nappe's lower and upper surface in bins one spacing wide from the weir's upstream
         face to NAPPE_EXTENT_HEADS nominal heads downstream (:attr:`nappe_x`): the lowest and the highest liquid
         particle centre in the bin (liquid above the crest less NAPPE_DEPTH_HEADS heads) less and plus dx/2; NaN
-        where the bin holds none."""
+        where the bin holds none. In 3-D each bin is read so in each column one spacing wide across the channel and
+        the columns that hold liquid are averaged: the nappe's surface across its width, as Bazin's profile is the
+        section of a nappe uniform across its flume. (The lowest particle over the whole width is the lowest of all
+        the columns' readings, each a spacing coarse, and lies under the surface they read together:
+        docs/outflow_validation.md.)"""
         bins = len(self.nappe_x)
         over = active & (x[:, 0] >= 0.0) & (x[:, 0] < bins * self.dx) & (x[:, 2] > self.crest - NAPPE_DEPTH_HEADS * self.head)
-        lower, upper = np.full(bins, np.inf), np.full(bins, -np.inf)
         column = np.floor(x[over, 0] / self.dx).astype(int)
+        across = 1
+        if self.dim == 3:
+            across = int(round(self.depth / self.dx))
+            row = np.clip(np.floor((x[over, 1] + 0.5 * self.depth) / self.dx).astype(int), 0, across - 1)
+            column = column * across + row
+        lower, upper = np.full(bins * across, np.inf), np.full(bins * across, -np.inf)
         np.minimum.at(lower, column, x[over, 2])
         np.maximum.at(upper, column, x[over, 2])
         lower = np.where(np.isfinite(lower), lower - 0.5 * self.dx - self.crest, np.nan)
         upper = np.where(np.isfinite(upper), upper + 0.5 * self.dx - self.crest, np.nan)
-        return lower, upper
+        if across == 1:
+            return lower, upper
+        return _finite_mean(lower.reshape(bins, across), axis=1), _finite_mean(upper.reshape(bins, across), axis=1)
 
     @property
     def nappe_x(self) -> np.ndarray:
@@ -232,6 +243,13 @@ class Channel:
         """m^2, the liquid's section area (per unit width) that has passed the weir's upstream face (still beyond it,
         or gone from the domain)."""
         return float(((~active) | (x[:, 0] > 0.0)).sum()) * self.cell
+
+
+def _finite_mean(a: np.ndarray, axis: int) -> np.ndarray:
+    """The mean of ``a`` along ``axis`` over its finite entries; NaN where none is."""
+    held = np.isfinite(a)
+    count = held.sum(axis=axis)
+    return np.where(count > 0, np.where(held, a, 0.0).sum(axis=axis) / np.maximum(count, 1), np.nan)
 
 
 @dataclass(frozen=True)
@@ -254,10 +272,7 @@ class Nappe:
 def nappe_profile(x: np.ndarray, lowers: list[np.ndarray], uppers: list[np.ndarray]) -> Nappe:
     """The window's mean nappe from the per-sample surfaces of :meth:`Channel.nappe_surfaces` at bin centres ``x``."""
     def mean(samples: list[np.ndarray]) -> np.ndarray:
-        a = np.array(samples, float).reshape(-1, len(x))
-        held = np.isfinite(a)
-        count = held.sum(axis=0)
-        return np.where(count > 0, np.where(held, a, 0.0).sum(axis=0) / np.maximum(count, 1), np.nan)
+        return _finite_mean(np.array(samples, float).reshape(-1, len(x)), axis=0)
 
     lower, upper = mean(lowers), mean(uppers)
     if not np.isfinite(lower).any():
