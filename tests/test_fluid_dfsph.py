@@ -130,7 +130,7 @@ def test_the_wetted_wall_layer_is_the_one_facing_the_liquid():
 
     spec = VesselSpec(name="tank", inner_width=B, inner_depth=0.1, inner_height=0.2)
     dx = B / 16
-    points, _ = sample_vessel_walls(spec, FluidConfig(dim=2, spacing=dx, smoothing_ratio=1.5))
+    points, _ = sample_vessel_walls(spec, FluidConfig(dim=2, spacing=dx, smoothing_ratio=1.5, wall_model="kernel_layers"))
     wetted = wetted_layer(spec, points, dx, 2)
     x, z = points[:, 0], points[:, 2]
     inside_x = np.abs(x) < 0.5 * B

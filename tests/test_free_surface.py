@@ -121,7 +121,7 @@ def test_the_closed_form_3x3_eigenvalue_matches_numpy():
 def test_walls_count_as_neighbours_so_liquid_against_them_is_inside():
     tank = VesselSpec(name="tank", inner_width=0.191, inner_height=0.2)
     cfg = FluidConfig(dim=2, spacing=0.191 / 16, pressure_solver="dfsph", max_expected_speed=2.0, free_liquid_rule="free_surface",
-                      domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.35))
+                      domain_min=(-0.2, -0.15, -0.1), domain_max=(0.2, 0.15, 0.35), wall_model="kernel_layers")  # the lattice continued
     solver = _indicator_after_one_step(cfg, fill_vessel(tank, 0.1, cfg), [tank], [Pose()])
     lam, z = solver.free_surface_indicator(), solver.positions()[:, 2]
     below_surface = z < z.max() - 1.5 * cfg.spacing  # every row but the top two, the floor's and the walls' own included

@@ -10,6 +10,8 @@ import time
 import pytest
 
 import cosim.fluid.memory
+from cosim.fluid.config import KernelType
+from cosim.fluid.wall_sampling import one_layer_depth
 from cosim.cli.main import main
 from cosim.pour_checks import LONG_RUN_S, SECONDS_PER_PARTICLE_STEP, check_pour, estimate_wall_time
 from cosim.pour_scene import PourScene
@@ -89,7 +91,8 @@ def test_pour_prints_the_checks_particle_count_and_estimate_before_its_first_ste
     poured = capsys.readouterr().err.strip().splitlines()
     summary = json.loads((tmp_path / "run" / "summary.json").read_text())
     assert len(checked) == 2 and poured[:2] == checked
-    # 8 across: the 5 mm wall holds no layer at dx / 2 = 11.9 mm, so its walls cover the support past the real lip
-    assert checked[1].startswith("walls: kernel_layers, 71.6 mm of dummy layers for the pourer's 5.0 mm wall")
-    assert summary["walls"]["pourer"] == {"wall_model": "kernel_layers", "lip_outside_real_m": pytest.approx(3 * 0.191 / 8 - 0.005)}
+    # 8 across: the 5 mm wall holds no layer at dx / 2 = 11.9 mm; its one layer stands at one_layer_depth past the real lip
+    depth = one_layer_depth(KernelType.WENDLAND_C2, 1.5, 2) * 0.191 / 8
+    assert checked[1].startswith(f"walls: real_thickness, {depth * 1e3:.1f} mm of dummy layers for the pourer's 5.0 mm wall")
+    assert summary["walls"]["pourer"] == {"wall_model": "real_thickness", "lip_outside_real_m": pytest.approx(depth - 0.005)}
     assert checked[0].startswith(f"{summary['particles']} liquid particles (2-D")  # exact for a box in 2-D

@@ -55,10 +55,17 @@ def test_other_wall_models_are_seen_by_all_liquid():
         assert len(wall_sides(TANK, cfg)) == len(sample_vessel_walls(TANK, cfg)[0])
 
 
-def test_a_wall_too_thin_for_a_layer_gets_the_covering_layers():
+def test_a_wall_too_thin_for_a_layer_of_its_own_is_seen_from_outside_at_its_one_layer():
+    """A box wall thinner than dx / 2 is 'sided' too: the liquid outside sees its one layer (at one_layer_depth,
+    outside the wall), the liquid inside the covering layers."""
     thin = replace(TANK, wall_thickness=0.4 * DX)
-    assert wall_model_for(thin, wcsph(WallModel.SIDED)) is WallModel.KERNEL_LAYERS
-    assert (wall_sides(thin, wcsph(WallModel.SIDED)) == SEEN_ALWAYS).all()
+    cfg = wcsph(WallModel.SIDED)
+    assert wall_model_for(thin, cfg) is WallModel.SIDED
+    sides = wall_sides(thin, cfg)
+    outside = sample_vessel_walls(thin, cfg)[0][sides == SEEN_FROM_OUTSIDE]
+    assert len(outside) > 0 and (sides == SEEN_FROM_INSIDE).any()
+    assert np.abs(outside[:, 0]).max() == pytest.approx(0.5 * thin.inner_width + numerical_wall_thickness(thin, cfg))
+    assert numerical_wall_thickness(thin, cfg) > thin.wall_thickness
 
 
 def test_sided_walls_are_refused_under_dfsph():

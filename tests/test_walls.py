@@ -67,7 +67,7 @@ def test_a_thin_wall_holds_one_layer_at_its_depth(spec, dim, across):
     along the faces it stays on the lattice."""
     cfg = real(spec, across, dim)
     points, _ = sample_vessel_walls(spec, cfg)
-    layers = slab_particles(spec, FluidConfig(dim=dim, spacing=cfg.spacing))[0]
+    layers = slab_particles(spec, FluidConfig(dim=dim, spacing=cfg.spacing, wall_model="kernel_layers"))[0]
     kept = layers[inside_real_wall(spec, layers, dim)]
     depth = min(one_layer_depth(cfg.kernel, cfg.smoothing_ratio, dim) * cfg.spacing, spec.wall_thickness)
     assert len(points) == len(kept)
@@ -83,11 +83,12 @@ def test_a_thin_wall_holds_one_layer_at_its_depth(spec, dim, across):
         assert np.array_equal(np.sort(points[side & ~floor, 2]), np.sort(kept[(kept[:, 2] >= 0.0) & (np.abs(kept[:, 0]) > b), 2]))
 
 
-@pytest.mark.parametrize("dim, across", [(2, 32), (3, 24)])
+@pytest.mark.parametrize("dim, across", [(2, 32), (3, 24), (2, 16), (3, 16)])
 def test_one_layer_gives_the_first_row_the_covering_walls_kernel_sum_and_gradient(dim, across):
     """Mid-floor, dx/2 above it (the liquid's first row), the one fitted layer at ``one_layer_depth`` sums to the
     covering walls' share of the summation density within 0.5 % of it and matches its gradient (the normal push)
-    within 2 %; at the lattice's own depth dx/2 the gradient was 11-12 % short (docs/walls.md)."""
+    within 2 %; at the lattice's own depth dx/2 the gradient was 11-12 % short (docs/walls.md). At 16 across the 5 mm
+    wall is thinner than dx/2, and its layer stands at that depth all the same, outside the wall."""
     cfg = real(POURER, across, dim)
     thin, volumes = sample_vessel_walls(POURER, cfg)
     full, full_volumes = sample_vessel_walls(POURER, FluidConfig(dim=dim, spacing=cfg.spacing))
@@ -98,10 +99,25 @@ def test_one_layer_gives_the_first_row_the_covering_walls_kernel_sum_and_gradien
     assert push == pytest.approx(_gradient_sums(full, full_volumes, first_row, cfg)[0, 2], rel=0.02)
 
 
-def test_a_box_wall_thinner_than_half_a_spacing_is_refused():
-    cfg = real(POURER, 12, 2)  # 15.9 mm: the 5 mm wall holds no layer at dx / 2
-    with pytest.raises(InputError, match="fluid.wall_model: the pourer vessel's wall .* thicker than dx / 2"):
-        sample_vessel_walls(POURER, cfg)
+@pytest.mark.parametrize("dim, across", [(2, 12), (3, 16)])
+def test_a_box_wall_thinner_than_half_a_spacing_holds_the_first_layer_at_one_layer_depth(dim, across):
+    """dx = 15.9 / 11.9 mm: the 5 mm wall holds no layer of its own at dx/2. It holds the covering walls' first layer
+    (every particle of theirs dx/2 behind an inner face), moved to ``one_layer_depth`` dx behind it, outside the
+    wall; the liquid sees the wall that deep, and the fit makes up the rest of the support."""
+    cfg = real(POURER, across, dim)
+    assert not holds_a_layer(POURER, cfg.spacing)
+    points, volumes = sample_vessel_walls(POURER, cfg)
+    layers = slab_particles(POURER, FluidConfig(dim=dim, spacing=cfg.spacing, wall_model="kernel_layers"))[0]
+    b, d = 0.5 * POURER.inner_width, 0.5 * POURER.section_depth
+    behind = np.stack([np.abs(layers[:, 0]) - b, np.abs(layers[:, 1]) - d if dim == 3 else np.zeros(len(layers)), -layers[:, 2]], axis=1)
+    assert len(points) == np.count_nonzero(behind.max(axis=1) < 0.5 * cfg.spacing + 1e-9)
+    depth = one_layer_depth(cfg.kernel, cfg.smoothing_ratio, dim) * cfg.spacing
+    assert depth > POURER.wall_thickness
+    floor, side = points[:, 2] < 0.0, np.abs(points[:, 0]) > b + 1e-12
+    assert np.allclose(points[floor, 2], -depth, atol=1e-12)
+    assert np.allclose(np.abs(points[side, 0]), b + depth, atol=1e-12)
+    assert numerical_wall_thickness(POURER, cfg) == pytest.approx(depth)
+    assert np.all(volumes > 0.0)
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -213,10 +229,9 @@ def test_a_mesh_wall_too_thin_for_one_layer_is_refused():
 
 
 def test_unset_the_wall_model_is_the_vessels_own_under_dfsph_and_sided_under_wcsph():
-    """Where a wall holds a layer, DFSPH's default walls are the vessel's own, the same particles and volumes as
-    'real_thickness' set; WCSPH's are 'sided' (the vessel's own wall thickness seen from outside); a wall holding no
-    layer (thinner than dx / 2) and a mesh vessel's cover the support under either solver; a wall model that is set
-    holds for every vessel."""
+    """DFSPH's default walls are the vessel's own, the same particles and volumes as 'real_thickness' set, a box
+    wall thinner than dx / 2 included; WCSPH's are 'sided' (the vessel's own wall thickness seen from outside); a
+    mesh vessel's cover the support under either solver; a wall model that is set holds for every vessel."""
     dfsph, wcsph = FluidConfig(dim=2, spacing=0.191 / 32), FluidConfig(dim=2, spacing=0.191 / 32, pressure_solver="wcsph")
     assert dfsph.wall_model is None and wall_model_for(POURER, dfsph) is REAL
     default, confined = sample_vessel_walls(POURER, dfsph), sample_vessel_walls(POURER, real(POURER, 32, 2))
@@ -226,8 +241,8 @@ def test_unset_the_wall_model_is_the_vessels_own_under_dfsph_and_sided_under_wcs
     assert numerical_wall_thickness(POURER, wcsph) == pytest.approx(POURER.wall_thickness)
     coarse = FluidConfig(dim=3, spacing=0.191 / 16)  # dx / 2 = 6.0 mm against the 5 mm wall
     assert not holds_a_layer(POURER, coarse.spacing) and holds_a_layer(POURER, 0.01)
-    assert wall_model_for(POURER, coarse) is WallModel.KERNEL_LAYERS
-    assert wall_model_for(POURER, replace(coarse, pressure_solver=PressureSolver.WCSPH)) is WallModel.KERNEL_LAYERS
+    assert wall_model_for(POURER, coarse) is REAL
+    assert wall_model_for(POURER, replace(coarse, pressure_solver=PressureSolver.WCSPH)) is WallModel.SIDED
     assert len(sample_vessel_walls(POURER, coarse)[0]) > 0
     beaker = mesh_vessel_spec("pourer", load_vessel_mesh(BEAKER), 1180.0)
     assert wall_model_for(beaker, FluidConfig(dim=2, spacing=0.08 / 24)) is WallModel.KERNEL_LAYERS

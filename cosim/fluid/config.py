@@ -154,8 +154,9 @@ DEFAULT_FREE_LIQUID_RULE = FreeLiquidRule.FREE_SURFACE
 # does not see the liquid piling into the corners of a one-layer wall); WCSPH's 'sided' (the vessel's own walls for
 # the liquid outside it, each face's wall state from the liquid at that face, the covering layers for the liquid
 # inside) passes every 2-D case and puts the 3-D launch point within 1 mm of the real lip (docs/walls.md).
-# A wall that holds no particle layer at the spacing (thinner than dx / 2) and a mesh vessel's wall (not validated
-# confined) get 'kernel_layers' under either solver (cosim.fluid.wall_sampling.wall_model_for).
+# A mesh vessel's wall (not validated confined) gets 'kernel_layers' under either solver; a box's or cylinder's wall
+# thinner than dx / 2 holds its one layer outside it, where one layer gives the liquid's first row the covering walls'
+# kernel sum and gradient (cosim.fluid.wall_sampling.wall_model_for, one_layer_wall_depth).
 DEFAULT_WALL_MODEL = {PressureSolver.DFSPH: WallModel.REAL_THICKNESS, PressureSolver.WCSPH: WallModel.SIDED}
 # Monaghan's alpha of pairs with free liquid under DFSPH's 'sound_speed' scale when none is given
 # (FluidConfig.free_artificial_viscosity): c0 does not grow with an impact, so without an approach term the free
@@ -201,7 +202,7 @@ class FluidConfig:
         "support missing behind a thin wall; the lip is the real one) or 'sided' (WCSPH only: liquid inside the vessel "
         "sees the covering layers, liquid outside it, over the rim included, the 'real_thickness' wall; docs/walls.md).", kind="choice",
         choices=WallModel, none_means="'real_thickness' under DFSPH, 'sided' under WCSPH; 'kernel_layers' for "
-        "a wall thinner than dx / 2 and a mesh vessel's (chosen on the validation cases)")
+        "a mesh vessel's (chosen on the validation cases)")
     depth_2d: float = setting(0.1, DISCRETISATION, "2-D: the liquid's thickness across the pour plane as seeded (the "
                               "pourer's depth); a particle stands for the 3-D volume dx^2 depth_2d, spread over the depth "
                               "of any other vessel it enters (cosim.fluid.model). Volumes and wrenches reported outside "

@@ -10,12 +10,16 @@ The walls hold layers of dummy particles (Adami, Hu & Adams 2012), filled one of
 - ``real_thickness``: the same lattice, the liquid's own continued behind every wetted face (layers at depths
   dx/2, 3 dx/2, ... as Adami, Hu & Adams 2012 place theirs), kept only where it lies inside the vessel's own wall
   (depth behind the inner faces at most t), so the outer faces and the pour lip are the vessel's: the layers whose
-  centres fit in the wall, at least one, which needs t >= dx/2 (as a mesh wall's, :mod:`cosim.fluid.mesh_sampling`).
-  A wall thinner than the kernel support then lacks the particles behind it that a liquid particle near its face
-  would sum over; their volumes are fitted to make that up (:func:`fit_wall_volumes`). A box's or cylinder's wall
-  that holds one layer (t < 3 dx / 2) has it moved deeper, to :func:`one_layer_depth` (about 0.6 dx, or t where
-  the wall is thinner), so that the fitted layer also gives the liquid's first row the covering walls' kernel
-  gradient; along the faces it stays on the lattice. A mesh wall keeps the lattice's depth.
+  centres fit in the wall, at least one. A wall thinner than the kernel support then lacks the particles behind it
+  that a liquid particle near its face would sum over; their volumes are fitted to make that up
+  (:func:`fit_wall_volumes`). A box's or cylinder's wall that holds one layer (t < 3 dx / 2) has it moved deeper, to
+  :func:`one_layer_depth` (about 0.6 dx, or t where the wall is thinner), so that the fitted layer also gives the
+  liquid's first row the covering walls' kernel gradient; along the faces it stays on the lattice. A box's or
+  cylinder's wall thinner than dx/2 holds no layer of its own; it gets the lattice's first layer at
+  :func:`one_layer_depth`, the one place where one layer gives the first row both moments of the missing support,
+  which is outside the wall by one_layer_depth dx - t (:func:`one_layer_wall_depth`; docs/walls.md, "A wall
+  thinner than dx / 2"). A mesh wall keeps the lattice's depth and needs t >= dx/2
+  (:mod:`cosim.fluid.mesh_sampling`).
 
 - ``sided`` (WCSPH): both sets, each seen from one side of the vessel (:func:`wall_sides`): the liquid inside the
   vessel's inner volume sees the ``kernel_layers`` particles, the liquid outside it (over the rim, in the stream,
@@ -97,26 +101,38 @@ def holds_a_layer(spec: VesselSpec, spacing: float) -> bool:
     return spec.wall_thickness * (1.0 + 1e-9) >= 0.5 * spacing
 
 
+def one_layer_wall_depth(spec: VesselSpec, cfg: FluidConfig) -> float:
+    """Depth (m) behind the inner faces of a box's or cylinder's wall that holds one layer of dummy particles
+    under ``real_thickness``: :func:`one_layer_depth` dx, or the wall's own thickness t where that is less and the
+    wall holds the lattice's first layer (t >= dx/2, :func:`holds_a_layer`). A thinner wall holds none of its own,
+    and its layer stands at :func:`one_layer_depth` dx, outside the wall's outer face."""
+    depth = one_layer_depth(cfg.kernel, cfg.smoothing_ratio, cfg.dim) * cfg.spacing
+    return min(depth, spec.wall_thickness) if holds_a_layer(spec, cfg.spacing) else depth
+
+
 def wall_model_for(spec: VesselSpec, cfg: FluidConfig) -> WallModel:
     """How ``spec``'s walls are filled: ``cfg.wall_model`` where set; where unset the pressure solver's own
-    (:data:`cosim.fluid.config.DEFAULT_WALL_MODEL`), except that a wall holding no layer at the spacing
-    (:func:`holds_a_layer`) and a mesh vessel's wall, whose confined sampling is not validated, get
-    ``kernel_layers``; so does such a wall under ``sided``, set or not."""
+    (:data:`cosim.fluid.config.DEFAULT_WALL_MODEL`), except that a mesh vessel's wall, whose confined sampling is not
+    validated, gets ``kernel_layers``, and so does a mesh vessel's wall under ``sided``, set or not."""
     model = cfg.wall_model
     if model is None:
         model = DEFAULT_WALL_MODEL[cfg.pressure_solver]
-        if model is WallModel.REAL_THICKNESS and (spec.is_mesh or not holds_a_layer(spec, cfg.spacing)):
+        if model is WallModel.REAL_THICKNESS and spec.is_mesh:
             return WallModel.KERNEL_LAYERS
-    if model is WallModel.SIDED and (spec.is_mesh or not holds_a_layer(spec, cfg.spacing)):
-        return WallModel.KERNEL_LAYERS  # no own wall to see from outside (or, for a mesh, no inner volume test)
+    if model is WallModel.SIDED and spec.is_mesh:
+        return WallModel.KERNEL_LAYERS  # no inner volume test for a mesh
     return model
 
 
 def numerical_wall_thickness(spec: VesselSpec, cfg: FluidConfig) -> float:
     """Wall thickness (m) the liquid sees: the vessel's own, or under ``kernel_layers`` the dummy layers' if those
-    are thicker (under ``sided`` the vessel's own: the covering layers beyond it are seen only from inside)."""
+    are thicker; under ``real_thickness`` and ``sided`` (whose covering layers beyond the wall are seen only from
+    inside) the vessel's own, or a box's or cylinder's wall thinner than dx/2 as deep as its one layer stands
+    (:func:`one_layer_wall_depth`)."""
     if wall_model_for(spec, cfg) in (WallModel.REAL_THICKNESS, WallModel.SIDED):
-        return spec.wall_thickness
+        if spec.is_mesh or holds_a_layer(spec, cfg.spacing):
+            return spec.wall_thickness
+        return one_layer_wall_depth(spec, cfg)
     return max(spec.wall_thickness, wall_layers(cfg.spacing, cfg.support_radius) * cfg.spacing)
 
 
@@ -280,7 +296,9 @@ def _fill_disc(radius: float, z0: float, z1: float, step: float) -> tuple[np.nda
 def slab_particles(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
     """The walls' dummy particles (n, 3) in the vessel frame and their slab volumes (n,) (m^dim), before any fit
     (:func:`sample_vessel_walls`). Box and cylinder walls are filled as ``kernel_layers`` fills them (at least the
-    vessel's own thickness); under ``real_thickness`` only the particles inside the vessel's own wall are kept."""
+    vessel's own thickness); under ``real_thickness`` only the particles inside the vessel's own wall are kept (a
+    box's or cylinder's wall thinner than dx/2: the first layer), a single layer moved to
+    :func:`one_layer_wall_depth`."""
     h = spec.inner_height
     spacing, dim = cfg.spacing, cfg.dim
     confined = wall_model_for(spec, cfg) is WallModel.REAL_THICKNESS
@@ -303,10 +321,11 @@ def slab_particles(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.n
         parts = [_fill_disc(r + t, -t, 0.0, spacing), _fill_cylinder_shells(r, r + t, 0.0, h, spacing)]
     points, volumes = np.concatenate([p for p, _ in parts]), np.concatenate([v for _, v in parts])
     if confined:
-        inside = _depths_outside(spec, points, dim).max(axis=1) <= spec.wall_thickness * (1.0 + 1e-9)
+        kept = spec.wall_thickness if spec.is_mesh else max(spec.wall_thickness, 0.5 * spacing)  # a box: a layer at least
+        inside = _depths_outside(spec, points, dim).max(axis=1) <= kept * (1.0 + 1e-9)
         points, volumes = points[inside], volumes[inside]
         if spec.wall_thickness < 1.5 * spacing and not spec.is_mesh:
-            points = _deepen_one_layer(spec, points, min(one_layer_depth(cfg.kernel, cfg.smoothing_ratio, dim) * spacing, spec.wall_thickness), dim)
+            points = _deepen_one_layer(spec, points, one_layer_wall_depth(spec, cfg), dim)
     return points, volumes
 
 
@@ -353,7 +372,7 @@ def sample_vessel_walls(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray,
     """Dummy wall particles (n, 3) in the vessel frame and their volumes (n,) (m^dim), for ``cfg``'s spacing,
     kernel support, dimension and wall model; a thin wall's volumes fitted (:func:`fit_wall_volumes`); under
     ``sided`` the ``kernel_layers`` particles, then the ``real_thickness`` ones (:func:`wall_sides`). Raises
-    InputError for a wall too thin to hold a layer."""
+    InputError for a mesh wall too thin to hold a layer."""
     if wall_model_for(spec, cfg) is WallModel.SIDED:
         sets = [sample_vessel_walls(spec, replace(cfg, wall_model=model)) for model in SIDED_SETS]
         return np.concatenate([p for p, _ in sets]), np.concatenate([v for _, v in sets])
