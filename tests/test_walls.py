@@ -10,6 +10,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from cosim.errors import InputError
 from cosim.fluid.config import FluidConfig, PressureSolver, WallModel
@@ -256,3 +257,26 @@ def test_the_scene_sets_the_wall_model_and_refuses_another():
     with pytest.raises(InputError, match="fluid.wall_model"):
         FluidSettings(wall_model="thin")
     assert math.isclose(FluidSettings().fluid_config(0.191).support_radius, 3 * 0.191 / 32)
+
+
+def test_a_thin_wall_keeps_the_edges_of_a_box_not_whole_spacings_deep():
+    """3-D, 24 across the pourer (0.1 m deep: 12.57 spacings): the floor's lattice across the depth is not aligned
+    with the side walls, and its first point under them lies 4.4 mm past their faces, deeper than dx / 2 (3.98 mm).
+    A 2 mm wall keeps those edge particles as the 5 mm wall does: the same particles at the same one-layer depth,
+    the same fitted volumes."""
+    cfg = FluidConfig(dim=3, spacing=POURER.inner_width / 24)
+    thick, thick_volumes = sample_vessel_walls(POURER, cfg)
+    thin, thin_volumes = sample_vessel_walls(replace(POURER, wall_thickness=0.002), cfg)
+    np.testing.assert_array_equal(thin, thick)
+    np.testing.assert_allclose(thin_volumes, thick_volumes, rtol=1e-12)
+
+
+@pytest.mark.parametrize("across", [16, 20, 27])
+def test_no_two_particles_of_a_one_layer_wall_coincide(across):
+    """A wall just under 3 dx / 2 holds one layer; across a 3-D box's depth that is not whole spacings the floor's
+    lattice can put two of its points behind a side wall within that thickness, and moved to the one layer's depth
+    they would coincide (200 to 330 pairs at these resolutions): one is kept."""
+    cfg = FluidConfig(dim=3, spacing=POURER.inner_width / across)
+    points, _ = sample_vessel_walls(replace(POURER, wall_thickness=1.49 * cfg.spacing), cfg)
+    nearest, _ = cKDTree(points).query(points, k=2)
+    assert nearest[:, 1].min() > 0.5 * cfg.spacing

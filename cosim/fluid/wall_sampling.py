@@ -136,6 +136,12 @@ def numerical_wall_thickness(spec: VesselSpec, cfg: FluidConfig) -> float:
     return max(spec.wall_thickness, wall_layers(cfg.spacing, cfg.support_radius) * cfg.spacing)
 
 
+# A box's or cylinder's wall that holds one layer (thinner than 3 dx / 2) keeps the covering lattice's points at most
+# this many dx (or its own thickness, if more) behind its inner faces: the first layer. Each slab's lattice steps about
+# dx along every axis but is aligned with the faces only along its own normal (a floor's lattice across a 3-D box's
+# depth that is not whole spacings is not), so its first point behind another face lies anywhere within a step of
+# it, not at dx/2, and may lie deeper than a thin wall is thick
+FIRST_LAYER_REACH = 1.0
 # Sweeps of the multiplicative fit of the thin walls' volumes (fit_wall_volumes); the kernel sums it matches settle to
 # within 0.1 % well before
 FIT_SWEEPS = 40
@@ -321,11 +327,15 @@ def slab_particles(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.n
         parts = [_fill_disc(r + t, -t, 0.0, spacing), _fill_cylinder_shells(r, r + t, 0.0, h, spacing)]
     points, volumes = np.concatenate([p for p, _ in parts]), np.concatenate([v for _, v in parts])
     if confined:
-        kept = spec.wall_thickness if spec.is_mesh else max(spec.wall_thickness, 0.5 * spacing)  # a box: a layer at least
+        one_layer = spec.wall_thickness < 1.5 * spacing and not spec.is_mesh
+        kept = max(spec.wall_thickness, FIRST_LAYER_REACH * spacing) if one_layer else spec.wall_thickness
         inside = _depths_outside(spec, points, dim).max(axis=1) <= kept * (1.0 + 1e-9)
         points, volumes = points[inside], volumes[inside]
-        if spec.wall_thickness < 1.5 * spacing and not spec.is_mesh:
+        if one_layer:
             points = _deepen_one_layer(spec, points, one_layer_wall_depth(spec, cfg), dim)
+            _, first = np.unique(np.round(points / spacing, 9), axis=0, return_index=True)
+            keep = np.sort(first)  # two points of one slab's lattice behind a face moved onto one: keep the first
+            points, volumes = points[keep], volumes[keep]
     return points, volumes
 
 
