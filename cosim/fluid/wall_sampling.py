@@ -302,9 +302,9 @@ def _fill_disc(radius: float, z0: float, z1: float, step: float) -> tuple[np.nda
 def slab_particles(spec: VesselSpec, cfg: FluidConfig) -> tuple[np.ndarray, np.ndarray]:
     """The walls' dummy particles (n, 3) in the vessel frame and their slab volumes (n,) (m^dim), before any fit
     (:func:`sample_vessel_walls`). Box and cylinder walls are filled as ``kernel_layers`` fills them (at least the
-    vessel's own thickness); under ``real_thickness`` only the particles inside the vessel's own wall are kept (a
-    box's or cylinder's wall thinner than dx/2: the first layer), a single layer moved to
-    :func:`one_layer_wall_depth`."""
+    vessel's own thickness); under ``real_thickness`` only the particles inside the vessel's own wall are kept. A
+    box's or cylinder's wall that holds one layer keeps the first point behind every face (at most max(t,
+    FIRST_LAYER_REACH dx) deep, thinner walls included), moved to :func:`one_layer_wall_depth`."""
     h = spec.inner_height
     spacing, dim = cfg.spacing, cfg.dim
     confined = wall_model_for(spec, cfg) is WallModel.REAL_THICKNESS
