@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -246,10 +247,11 @@ class Channel:
 
 
 def _finite_mean(a: np.ndarray, axis: int) -> np.ndarray:
-    """The mean of ``a`` along ``axis`` over its finite entries; NaN where none is."""
-    held = np.isfinite(a)
-    count = held.sum(axis=axis)
-    return np.where(count > 0, np.where(held, a, 0.0).sum(axis=axis) / np.maximum(count, 1), np.nan)
+    """The mean of ``a`` (finite or NaN) along ``axis`` over its finite entries; NaN where none is (numpy's nanmean,
+    without its warning for an all-NaN slice: a bin the nappe did not reach)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmean(a, axis=axis)
 
 
 @dataclass(frozen=True)
