@@ -31,7 +31,7 @@ import numpy as np
 from controllers.config import CFS_MAX_HEAD, CatcherConfig, PourConfig
 from controllers.geometry import VesselGeometry
 from controllers.slosh import SloshModel
-from cosim.atomic_files import check_output_folder
+from cosim.atomic_files import PARTIAL_NAME_EXTRA, PARTIAL_TAG, check_output_folder
 from cosim.coupling.exchange import ROLES
 from cosim.coupling.follower_lag import follower_lag
 from cosim.coupling.loop import CoupledPour, build_pour
@@ -172,9 +172,11 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
     (:func:`cosim.pour_checks.check_pour`; ``long_run_ok`` accepts a run estimated at over an hour) come first, and
     with ``progress``, their particle counts and run-time estimate are printed before the first step.
     ``identify_plant``: see :func:`prepare`."""
-    final = destination(out, scene.run_name)
     field = "--out" if out is not None else "--out (default recordings/)"
-    check_output_folder(final.parent, field)
+    if out is not None:
+        check_output_folder(out, field, PARTIAL_NAME_EXTRA)  # a name too long refused before anything looks it up
+    final = destination(out, scene.run_name)
+    check_output_folder(final, field, PARTIAL_NAME_EXTRA)
     plan = check_pour(scene, long_run_ok)
     if progress:
         print(plan.summary(), file=sys.stderr, flush=True)
@@ -185,7 +187,7 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
     pour = prepare(scene, plan, identify_plant)
     try:
         final.parent.mkdir(parents=True, exist_ok=True)
-        work = Path(tempfile.mkdtemp(prefix=f".{final.name}.partial-", dir=final.parent))
+        work = Path(tempfile.mkdtemp(prefix=f".{final.name}{PARTIAL_TAG}", dir=final.parent))
     except OSError as exc:
         raise InputError(f"{field}: cannot create a folder in {final.parent} ({exc.strerror or exc})") from None
     umask = os.umask(0)

@@ -323,6 +323,9 @@ class RobotSettings:
 
 DEFAULT_SCENE_NAME = "seed-pour"  # the run folders' name of the embedded default scene
 _NOT_IN_NAMES = re.compile(r"[^A-Za-z0-9_-]")
+# characters of a scene's name: the run folder, "<time>-<name>[-k]", and its unfinished sibling must fit the 255 bytes
+# of a file name (cosim.pour_run)
+MAX_NAME_LENGTH = 200
 
 
 @dataclass(frozen=True)
@@ -358,6 +361,8 @@ class PourScene:
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or _NOT_IN_NAMES.search(self.name):
             raise InputError(f"scene.name: must be letters, digits, '-' or '_' (or '': the scene file's name), got {self.name!r}")
+        if len(self.name) > MAX_NAME_LENGTH:
+            raise InputError(f"scene.name: at most {MAX_NAME_LENGTH} characters (it names the run folder), got {len(self.name)}")
         check_device("scene.device", self.device)
         if self.robots.scene and self.cell_config() is not None:
             raise InputError("robots.scene: a scene file brings its own vessels and placement, and its arms; leave [vessels], "
@@ -381,8 +386,8 @@ class PourScene:
 
     def named_after(self, path: str | Path) -> "PourScene":
         """This scene, named after the file ``path`` (its stem, other characters than letters, digits, '-' and '_'
-        made '_') unless it has a name of its own."""
-        return self if self.name else replace(self, name=_NOT_IN_NAMES.sub("_", Path(path).stem))
+        made '_', cut to :data:`MAX_NAME_LENGTH`) unless it has a name of its own."""
+        return self if self.name else replace(self, name=_NOT_IN_NAMES.sub("_", Path(path).stem)[:MAX_NAME_LENGTH])
 
 
 def load_scene(path: str | Path) -> PourScene:

@@ -5,6 +5,7 @@ partial run folder."""
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -14,7 +15,7 @@ import pytest
 
 import cosim.atomic_files
 import cosim.pour_run
-from cosim.atomic_files import check_output_folder
+from cosim.atomic_files import PARTIAL_TAG, check_output_folder
 from cosim.cli.main import main
 from cosim.errors import InputError
 
@@ -49,11 +50,51 @@ def test_an_output_folder_below_a_file_is_one_line_exit_2_and_nothing_written(tm
 
 
 def test_a_folder_without_write_permission_is_refused_by_name(tmp_path, monkeypatch):
-    # root may write anywhere, so the permission is taken away at the check itself
-    monkeypatch.setattr(cosim.atomic_files.os, "access", lambda path, mode: False)
-    with pytest.raises(InputError, match=r"^--out: cannot write in .*\(no permission, or a read-only file system\)$"):
+    # root may write anywhere, so the permission is taken away at the check's trial folder itself
+    def refuse(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(cosim.atomic_files.tempfile, "mkdtemp", refuse)
+    with pytest.raises(InputError, match=r"^--out: cannot write in .*\(Permission denied\)$"):
         check_output_folder(tmp_path / "new" / "deeper", "--out")
     assert _files(tmp_path) == []
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux's /proc")
+def test_a_folder_that_grants_write_permission_but_takes_no_folder_is_refused(tmp_path):
+    # os.access grants root /proc; only trying shows that no folder can be made there
+    assert os.access("/proc", os.W_OK) or os.geteuid() != 0
+    with pytest.raises(InputError, match=r"^--out: cannot write in /proc \("):
+        check_output_folder("/proc/no_such_folder/run", "--out")
+
+
+LONG = "n" * 300  # bytes: a name no common file system takes (255 at most)
+
+# (command line with {long} for a path whose last name is too long, the name's length in the error)
+LONG_NAMES = [
+    ("pour --out {long} --quiet --no-log", "300 bytes long; at most 237"),  # its unfinished sibling adds 18
+    ("scene --dump --out {long}.toml", "305 bytes long; at most 240"),  # its temporary sibling adds 10 and the suffix
+    ("validate coupling-static --out {long}", "300 bytes long; at most 255"),
+    ("stress --quick --out {long}", "300 bytes long; at most 255"),
+]
+
+
+@pytest.mark.parametrize("command,expected", LONG_NAMES, ids=["pour", "scene", "validate", "stress"])
+def test_a_name_too_long_for_the_file_system_is_one_line_exit_2_and_nothing_written(tmp_path, capsys, command, expected):
+    argv = command.format(long=tmp_path / LONG).split()
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "error: --out: the name 'nnnn" in err[0] and expected in err[0], err
+    assert _files(tmp_path) == []
+
+
+def test_a_scene_name_too_long_for_a_run_folder_is_refused_and_a_long_file_name_is_cut(tmp_path):
+    from cosim.pour_scene import MAX_NAME_LENGTH, PourScene
+
+    with pytest.raises(InputError, match=rf"^scene.name: at most {MAX_NAME_LENGTH} characters"):
+        PourScene(name="x" * (MAX_NAME_LENGTH + 1))
+    named = PourScene().named_after(tmp_path / ("f" * 240 + ".toml"))
+    assert named.name == "f" * MAX_NAME_LENGTH
 
 
 def test_a_writable_path_passes_and_creates_nothing(tmp_path):
@@ -65,8 +106,12 @@ def test_a_writable_path_passes_and_creates_nothing(tmp_path):
 def test_a_pour_whose_run_folder_cannot_be_made_is_one_line_exit_2(tmp_path, capsys, monkeypatch):
     # a folder that passes the check but cannot be made all the same (as under /proc): refused by name, not a
     # traceback, and nothing left behind
-    def refuse(*args, **kwargs):
-        raise PermissionError(13, "Permission denied")
+    real = cosim.pour_run.tempfile.mkdtemp
+
+    def refuse(*args, prefix="", **kwargs):  # the run's own folder only: the check's trial folder is made
+        if PARTIAL_TAG in prefix:
+            raise PermissionError(13, "Permission denied")
+        return real(*args, prefix=prefix, **kwargs)
 
     monkeypatch.setattr(cosim.pour_run.tempfile, "mkdtemp", refuse)
     assert main(["pour", "--out", str(tmp_path / "run"), "--quiet", "--no-log", "--duration", "0.01"]) == 2
@@ -106,7 +151,7 @@ def test_a_terminated_pour_leaves_nothing_behind_and_exits_143(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "cosim", "pour", "--out", str(out), "--no-log", "--quiet"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60.0
-    while not list(tmp_path.glob(".run.partial-*")) and proc.poll() is None and time.monotonic() < deadline:
+    while not list(tmp_path.glob(f".run{PARTIAL_TAG}*")) and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
     time.sleep(1.0)  # into the step loop
     assert proc.poll() is None, proc.communicate()

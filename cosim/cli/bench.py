@@ -30,7 +30,7 @@ import shutil
 from datetime import datetime, timezone
 from pathlib import Path
 
-from cosim.atomic_files import check_output_folder, write_text_atomic
+from cosim.atomic_files import check_output_file, check_output_folder, write_text_atomic
 from cosim.errors import InputError
 
 DEFAULT_OUT = Path("recordings") / "bench"
@@ -131,7 +131,7 @@ def run(args) -> int:
         raise InputError("--scenes: only with --plan heldout")
     check_output_folder(args.out, "--out")
     if args.docs is not None:
-        check_output_folder(args.docs.parent, "--docs")
+        check_output_file(args.docs, "--docs")
     if args.cache is not None:
         check_output_folder(args.cache, "--cache")
     if args.plan == "targets":

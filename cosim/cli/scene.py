@@ -11,8 +11,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from cosim.atomic_files import check_output_folder, write_text_atomic
-from cosim.errors import InputError
+from cosim.atomic_files import check_output_file, write_text_atomic
 
 
 def register(subparsers, summary: str) -> None:
@@ -30,9 +29,7 @@ def run(args) -> int:
     from cosim.pour_scene import PourScene, dump_scene, load_scene
 
     if args.out is not None:
-        if args.out.is_dir():
-            raise InputError(f"--out: {args.out} is a folder; give the scene file's name")
-        check_output_folder(args.out.parent, "--out")
+        check_output_file(args.out, "--out")
     scene = load_scene(args.check) if args.check else PourScene()
     if args.check:
         from cosim.pour_checks import check_pour

@@ -26,7 +26,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from cosim.atomic_files import write_text_atomic
+from cosim.atomic_files import PARTIAL_TAG, write_text_atomic
 from cosim.errors import InputError
 
 if TYPE_CHECKING:
@@ -120,5 +120,5 @@ class SweepStore:
     def remove_partial(self, key: str) -> None:
         """Remove what a worker that died without cleaning up (killed, its node lost) left of the pour: its hidden
         temporary run folders. Call only before the pour runs again."""
-        for leftover in self.pours.glob(f".{key}.partial-*"):
+        for leftover in self.pours.glob(f".{key}{PARTIAL_TAG}*"):
             shutil.rmtree(leftover, ignore_errors=True)
