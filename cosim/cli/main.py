@@ -19,7 +19,7 @@ import importlib
 import signal
 import sys
 import threading
-from typing import Iterator
+from typing import Iterator, NoReturn
 
 from cosim import __version__
 from cosim.errors import InputError, SimulationError
@@ -45,10 +45,19 @@ def requested_command(argv: list[str]) -> str | None:
     return word if word in SUBCOMMANDS else None
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """argparse's parser (its subcommands' too: ``add_subparsers`` makes them of the root's class) whose usage errors
+    are one line and exit status 2, as every other bad input: ``cosim pour: error: argument --threads: invalid int
+    value: 'abc' (see cosim pour --help)``. argparse itself prints the whole usage block first."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """The ``cosim`` parser, with ``command``'s full parser (its module imported and registered) and a bare entry
     for every other subcommand: only the command that runs is imported."""
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="cosim",
         description="Simulate robot pours: MuJoCo arms holding vessels, a warp-lang SPH liquid, "
         "slosh-induction pouring control, jerk-limited joint trajectories and Rerun logs.",
@@ -108,6 +117,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()
+        print(f"cosim: error: a command is required: {', '.join(SUBCOMMANDS)}", file=sys.stderr)
         return 2
     try:
         with _sigterm_unwinds():
