@@ -71,7 +71,10 @@ def test_a_tank_rounded_to_whole_spacings_says_so(capsys):
                                   ["validate", "hydrostatic", "--device", "tpu"], ["validate", "--density-tolerance", "-1"],
                                   ["validate", "slosh-plant", "--shape", "cylinder"], ["validate", "slosh-plant", "--spacing", "0.05"],
                                   ["validate", "dam-break", "--gate-speed", "0"], ["validate", "dam-break", "--gate-speed", "inf"],
-                                  ["validate", "hydrostatic", "--free-liquid", "maybe"]])
+                                  ["validate", "hydrostatic", "--free-liquid", "maybe"],
+                                  # refused before the first case prints its progress line
+                                  ["validate", "hydrostatic", "--spacing", "0.05"], ["validate", "slosh", "dam-break", "--spacing", "0.05"],
+                                  ["validate", "hydrostatic", "--scene", "/nonexistent/scene.toml"]])
 def test_bad_input_exits_2_with_one_line(argv, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()

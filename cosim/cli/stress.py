@@ -111,6 +111,10 @@ def run(args) -> int:
     from tqdm import tqdm
 
     check_output_folder(args.out, "--out")
+    if args.device != "cpu":  # an absent device refused here, not as every configuration's outcome
+        from cosim.fluid.runtime import resolve_device
+
+        resolve_device(args.device)
     store = ResultStore(args.out / RESULTS, fresh=args.fresh)
     todo = [c for c in configs if c.id not in store]
     commands = [] if args.fresh else _commands(args.out)

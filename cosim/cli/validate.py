@@ -167,6 +167,10 @@ def run(args) -> int:
     jobs = [(name, params) for name in names for params in _case_params(name, args)]  # validates every input first
     if not args.no_plot:
         check_output_folder(args.out, "--out")
+    if args.device != "cpu":  # an absent device refused before any case runs (warp imported only for this)
+        from cosim.fluid.runtime import resolve_device
+
+        resolve_device(args.device)
     results = []
     for name, params in jobs:
         print(f"running {name} ({', '.join(f'{k}={v}' for k, v in vars(params).items() if v is not None)}) ...", file=sys.stderr)

@@ -97,6 +97,11 @@ class Params(FluidCaseParams):
     gate_speed: float | None = setting(None, DAM_BREAK, "The column is released by a gate lifted at this speed "
                                        "(cosim.validation.dam_gate).", "m/s", 0.0, MAX_GATE_SPEED, lo_open=True,
                                        none_means="released instantaneously")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        require_particles_across("spacing", self.width, self.resolved_spacing, 8)  # refused before any case runs
+
     @property
     def resolved_spacing(self) -> float:
         return self.spacing if self.spacing is not None else self.width / PARTICLES_ACROSS
@@ -108,7 +113,6 @@ class Params(FluidCaseParams):
 
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
-    require_particles_across("spacing", p.width, dx, 8)
     a = whole_spacings(p.width, dx)  # the column the lattice fills; T and Z are scaled by it
     height = p.column_height(a)
     depth = p.tank_depth(dx)

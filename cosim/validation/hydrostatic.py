@@ -54,6 +54,11 @@ class Params(FluidCaseParams):
     fill: float = setting(0.159, HYDROSTATIC, "Fill depth.", "m", 0.0, 2.0, lo_open=True)
     duration: float = setting(2.0, HYDROSTATIC, "Simulated time before measuring.", "s", 0.0, 60.0, lo_open=True)
     scene: str = ""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        require_particles_across("spacing", self.tank_width, self.resolved_spacing, 8)  # refused before any case runs
+
     @property
     def resolved_spacing(self) -> float:
         return self.spacing if self.spacing is not None else self.tank_width / MIN_PARTICLES_ACROSS
@@ -90,7 +95,6 @@ def _mesh_liquid_height(tank: VesselSpec, volume: float, dim: int, depth: float)
 
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
-    require_particles_across("spacing", p.tank_width, dx, 8)
     if p.scene:
         tank = p.scene_tank()
         width, depth = tank.inner_width, tank.section_depth

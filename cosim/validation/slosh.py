@@ -58,6 +58,11 @@ class Params(FluidCaseParams):
     width: float = setting(VesselSpec.inner_width, SLOSH, "Tank inner width B.", "m", 0.0, 2.0, lo_open=True)
     fill: float = setting(0.108, SLOSH, "Fill depth A.", "m", 0.0, 2.0, lo_open=True)
     periods: float = setting(5.0, SLOSH, "Oscillation periods measured after the pulse.", "", 0.0, 50.0, lo_open=True)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        require_particles_across("spacing", self.width, self.resolved_spacing, 8)  # refused before any case runs
+
     @property
     def resolved_spacing(self) -> float:
         return self.spacing if self.spacing is not None else self.width / MIN_PARTICLES_ACROSS
@@ -65,7 +70,6 @@ class Params(FluidCaseParams):
 
 def run(p: Params) -> CaseResult:
     dx = p.resolved_spacing
-    require_particles_across("spacing", p.width, dx, 8)
     width, depth = whole_spacings(p.width, dx), p.tank_depth(dx)
     f_ref = eq17_frequency(width, p.fill)
     period = 1.0 / f_ref
