@@ -103,6 +103,26 @@ def test_cli_refuses_an_output_folder_that_is_not_a_sweep(tmp_path, capsys):
     assert "is not a sweep's output folder" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("address", ["bogus", "ray:/host", "host:port"])
+def test_cli_refuses_an_address_ray_cannot_join_and_writes_nothing(tmp_path, capsys, address):
+    path = tmp_path / "s.toml"
+    path.write_text('[axes]\n"liquid.fill_depth" = [0.1]\n')
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--address", address]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"cosim sweep: error: --address: must be 'auto', 'ray://HOST:PORT' or 'HOST:PORT', got {address!r}"]
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_without_the_cluster_it_names_writes_nothing(tmp_path, capsys, monkeypatch):
+    # its manifest (sweep.json) is written once the cluster is joined
+    monkeypatch.delenv("RAY_ADDRESS", raising=False)
+    path = tmp_path / "s.toml"
+    path.write_text('[axes]\n"liquid.fill_depth" = [0.1]\n')
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--address", "auto"]) == 2
+    assert capsys.readouterr().err.startswith("cosim sweep: error: --address: no Ray cluster at auto (")
+    assert not (tmp_path / "out").exists()
+
+
 def test_pour_key_follows_the_scene_and_the_code():
     scene = PourScene()
     other = replace(scene, liquid=replace(scene.liquid, fill_depth=0.1))

@@ -11,6 +11,7 @@ library.json (the trajectory library) in ``--out``. Exit status 1 when a pour fa
 from __future__ import annotations
 
 import argparse
+import re
 from importlib.util import find_spec
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -38,6 +39,16 @@ def register(subparsers, summary: str) -> None:
     p.add_argument("--dry-run", action="store_true", help="print the pours, their resources and estimated cost; run nothing")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
+
+
+ADDRESS = re.compile(r"(ray://)?[A-Za-z0-9._-]+:[0-9]{1,5}")
+
+
+def check_address(address: str) -> None:
+    """Refuse a ``--address`` that is none of the forms Ray joins: 'auto', 'ray://HOST:PORT' (Ray Client) or
+    'HOST:PORT' (the head's own address, as ``ray start --head`` prints it)."""
+    if address != "auto" and not ADDRESS.fullmatch(address):
+        raise InputError(f"--address: must be 'auto', 'ray://HOST:PORT' or 'HOST:PORT', got {address!r}")
 
 
 def print_dry_run(plan: SweepPlan) -> None:
@@ -72,6 +83,8 @@ def run(args) -> int:
 
     if args.max_parallel is not None:
         MAX_PARALLEL.check("--max-parallel", args.max_parallel)
+    if args.address is not None:
+        check_address(args.address)
     spec = load_sweep(args.sweep)
     out = args.out if args.out is not None else DEFAULT_ROOT / f"sweep-{spec.name}"
     check_output_folder(out, "--out")
@@ -91,9 +104,9 @@ def run(args) -> int:
     from cosim.sweep.report import write_report
     from cosim.sweep.runner import connect, run_pours
 
-    plan.store.write_manifest({"sweep": spec.name, "code": plan.code, "code_version": plan.version, "pours": len(plan.pours)})
-    connected = connect(args.address)
+    connected = connect(args.address)  # before anything is written: a cluster that is not there leaves no sweep.json
     try:
+        plan.store.write_manifest({"sweep": spec.name, "code": plan.code, "code_version": plan.version, "pours": len(plan.pours)})
         ran = run_pours(plan, args.max_parallel, progress=not args.quiet)
     finally:
         report = write_report(plan)  # what is done so far, also after Ctrl-C

@@ -10,6 +10,8 @@ the sweep runs the pour again.
 
 from __future__ import annotations
 
+import logging
+import warnings
 from collections import deque
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -75,10 +77,21 @@ def connect(address: str | None) -> bool:
 
     if ray.is_initialized():
         return False
+    # Ray Client logs the settings it passes to the server and warns of a timeout before it raises it: the outcome
+    # is this function's one line
+    client_log = logging.getLogger("ray.client_builder")
+    level = client_log.level
+    client_log.setLevel(logging.WARNING)
     try:
-        ray.init(address=address, include_dashboard=False, log_to_driver=False)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            ray.init(address=address, include_dashboard=False, log_to_driver=False)
     except ConnectionError as exc:
         raise InputError(f"--address: no Ray cluster at {address} ({str(exc).splitlines()[0]})") from None
+    except ValueError as exc:  # an address Ray cannot use here (a Ray Client address without ray[client])
+        raise InputError(f"--address: {address}: {str(exc).strip().splitlines()[0]}") from None
+    finally:
+        client_log.setLevel(level)
     return True
 
 
