@@ -95,3 +95,38 @@ def test_replay_bad_input_exits_2_with_one_line(tmp_path, capsys, content, expec
 def test_replay_bad_model_exits_2(hold_csv, tmp_path, capsys):
     assert main(["replay", str(hold_csv), "--model", str(tmp_path / "none.xml")]) == 2
     assert "file not found" in capsys.readouterr().err
+
+
+def _with(path, column: str, row: int, value: float):
+    """A copy of the two-sample trajectory at ``path`` with one entry set: ``column`` of sample ``row``."""
+    from cosim.trajectory.csv_file import read_trajectory_csv
+
+    t = read_trajectory_csv(path)
+    kind, name = column.rsplit(".", 1)[1], column.rsplit(".", 1)[0]
+    arrays = {"pos": t.positions.copy(), "vel": t.velocities.copy(), "acc": t.accelerations.copy()}
+    arrays[kind][row, t.joint_names.index(name)] = value
+    out = path.with_name(f"{column.replace('/', '_')}.csv")
+    write_trajectory_csv(out, JointTrajectory(t.time, t.joint_names, arrays["pos"], arrays["vel"], arrays["acc"]))
+    return out
+
+
+@pytest.mark.parametrize(
+    ("column", "value", "expected"),
+    [
+        ("pour_arm/elbow.pos", 100.0, r"pour_arm/elbow\.pos: must be in \[-\S+, \S+\] rad \(the joint's range\), got 100 at t = 0\.2 s"),
+        ("catch_arm/wrist_1.vel", -1e6, r"catch_arm/wrist_1\.vel: must be within \+-\S+ rad/s \(the arm's joint speed limit\), got -1e\+06 at t = 0\.2 s"),
+    ],
+)
+def test_replay_of_a_trajectory_past_the_arms_limits_is_refused_before_it_runs(hold_csv, capsys, column, value, expected):
+    # MuJoCo driven there would blow up and the replay report it as a failed run (exit 1), after the run
+    path = _with(hold_csv, column, 1, value)
+    assert main(["replay", str(path)]) == 2
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and re.search(expected, lines[0]), lines
+    assert captured.out == ""
+
+
+def test_replay_model_that_is_a_folder_says_so(hold_csv, tmp_path, capsys):
+    assert main(["replay", str(hold_csv), "--model", str(tmp_path)]) == 2
+    assert "a folder, not a scene file" in capsys.readouterr().err

@@ -197,6 +197,8 @@ def _arm_info(model: mujoco.MjModel, home: mujoco.MjData, role: ArmRole, source:
 
 
 def _load_spec(path: Path) -> mujoco.MjSpec:
+    if path.is_dir():
+        raise InputError(f"scene {path}: a folder, not a scene file")
     if not path.is_file():
         raise InputError(f"scene {path}: file not found")
     try:

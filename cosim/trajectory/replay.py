@@ -43,6 +43,7 @@ import numpy as np
 from cosim.errors import InputError, SimulationError
 from cosim.robots.scene import RobotScene
 from cosim.robots.scene_config import ArmRole
+from cosim.trajectory.checks import LIMIT_RTOL, POSITION_TOLERANCE
 from cosim.trajectory.feedforward import DEFAULT_TOLERANCE_M, Feedforward
 from cosim.trajectory.interpolation import QuinticInterpolator
 from cosim.trajectory.joint_trajectory import JointTrajectory
@@ -143,6 +144,30 @@ def _arm_columns(scene: RobotScene, trajectory: JointTrajectory) -> dict[ArmRole
     return columns
 
 
+def _check_within_limits(scene: RobotScene, trajectory: JointTrajectory) -> None:
+    """Refuse a trajectory the arms cannot run: a sample's position outside its joint's range, or its speed over the
+    arm's joint speed limit (where the scene gives them). MuJoCo would otherwise be driven there and report the
+    blow-up as a failed replay."""
+    model = scene.model
+    speed_limit = {name: float(limit) for arm in scene.arms.values() for name, limit in zip(arm.joints, arm.max_joint_speed)}
+    for j, name in enumerate(trajectory.joint_names):
+        jid = model.joint(name).id
+        positions, speeds = trajectory.positions[:, j], np.abs(trajectory.velocities[:, j])
+        if model.jnt_limited[jid]:
+            lo, hi = (float(v) for v in model.jnt_range[jid])
+            outside = np.flatnonzero((positions < lo - POSITION_TOLERANCE) | (positions > hi + POSITION_TOLERANCE))
+            if outside.size:
+                k = int(outside[0])
+                raise InputError(f"trajectory: {name}.pos: must be in [{lo:.6g}, {hi:.6g}] rad (the joint's range), got "
+                                 f"{positions[k]:.6g} at t = {trajectory.time[k]:.6g} s")
+        limit = speed_limit.get(name, math.inf)
+        over = np.flatnonzero(speeds > limit * (1.0 + LIMIT_RTOL))
+        if over.size:
+            k = int(over[0])
+            raise InputError(f"trajectory: {name}.vel: must be within +-{limit:.6g} rad/s (the arm's joint speed limit), "
+                             f"got {trajectory.velocities[k, j]:.6g} at t = {trajectory.time[k]:.6g} s")
+
+
 def _torque_limits(model: mujoco.MjModel, trajectory: JointTrajectory) -> tuple[np.ndarray, np.ndarray]:
     """(dof indices (J,), torque limit (J,) N m) of the trajectory's joints; inf where the joint is not clamped."""
     dofs, limits = [], []
@@ -157,6 +182,7 @@ def _torque_limits(model: mujoco.MjModel, trajectory: JointTrajectory) -> tuple[
 def replay(scene: RobotScene, trajectory: JointTrajectory, feedforward: Feedforward = Feedforward.GRAVITY) -> ReplayReport:
     """Play ``trajectory`` on ``scene`` (its live data is reset to home first) and measure the tracking."""
     columns = _arm_columns(scene, trajectory)
+    _check_within_limits(scene, trajectory)
     model, data = scene.model, scene.data
     scene.reset_home()
     command = QuinticInterpolator(trajectory)
