@@ -160,9 +160,12 @@ class ArmSettings:
         )
 
     def reach_field(self, label: str) -> str:
-        """The setting a pose out of this arm's reach is blamed on: its base position where the section is set (its
-        arm or its base is the user's), else the placement of the vessels."""
-        return "placement" if self == ArmSettings() else f"{label}.base_pos"
+        """The setting a pose out of this arm's reach is blamed on: the placement of the vessels where the section is
+        not set; its home posture's IK seed where that alone is set (the seed picks the posture the checks start
+        from); else its base position (its arm or its base is the user's)."""
+        if self == ArmSettings():
+            return "placement"
+        return f"{label}.home_seed" if self == replace(ArmSettings(), home_seed=self.home_seed) else f"{label}.base_pos"
 
     def with_folder(self, folder: Path) -> "ArmSettings":
         """These settings with a relative :attr:`mjcf` taken from ``folder`` (the scene file's)."""

@@ -2,7 +2,8 @@
 
 :func:`check_pour` refuses a scene (one :class:`InputError` line naming the field) or returns a :class:`PourPlan`:
 the robot scene, the joint limits, the liquid's configuration, its particle counts, its memory and an estimate of
-the run's wall time. Checked, in order: Rerun present when the recording is on; the device; the robot scene (the
+the run's wall time. Checked, in order: Rerun present when the recording is on; the exported trajectory's sample
+rate against the run's length; the device; the robot scene (the
 scene file, or the cell of the scene's vessels and arms, their home postures solved); the fill below the
 pourer's rim; the catcher holding what is poured; the catcher above the table; each arm's load against its rated
 payload; the joint-limit overrides; the arms' reach over the pour's poses, free of collisions (:func:`check_reach`);
@@ -151,7 +152,12 @@ def robot_scene(scene: PourScene) -> RobotScene:
 
     config = scene.cell_config()
     if config is None:
-        return RobotScene.load(scene.robots.scene or None)
+        try:
+            return RobotScene.load(scene.robots.scene or None)
+        except InputError as exc:
+            if not scene.robots.scene:
+                raise
+            raise InputError(f"robots.scene: {exc}") from None
     return RobotScene.from_config(config)
 
 
@@ -257,7 +263,7 @@ def _check_contact(
         raise InputError(
             f"{field}: {label}: {hit.geom1} ({hit.body1}) touches {hit.geom2} ({hit.body2}) ({hit.pair}, "
             f"{-hit.distance * 1e3:.1f} mm deep); place the vessels (placement.*) or the arms (arms.*.base_pos) "
-            f"elsewhere, or ask less of the arms"
+            f"elsewhere, seed their home postures elsewhere (arms.*.home_seed), or ask less of the arms"
         )
 
 
@@ -274,6 +280,10 @@ def check_pour(scene: PourScene, long_run_ok: bool = False) -> PourPlan:
     if scene.logging.enabled and find_spec("rerun") is None:
         raise InputError("logging.enabled: the Rerun recording needs rerun-sdk, which is not installed "
                          "(install it, or run without the recording: --no-log or logging.enabled = false)")
+    if scene.trajectory.sample_rate_hz * scene.coupling.max_duration < 1.0:  # the exported trajectory's two samples
+        raise InputError(f"trajectory.sample_rate_hz: must give at least 2 samples over coupling.max_duration = "
+                         f"{scene.coupling.max_duration:g} s, >= {1.0 / scene.coupling.max_duration:.6g} Hz; got "
+                         f"{scene.trajectory.sample_rate_hz:g}")
     device = resolve_device(scene.device)
     robots = robot_scene(scene)
     pourer = robots.arms[ArmRole.POUR].vessel

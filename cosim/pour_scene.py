@@ -391,13 +391,16 @@ class PourScene:
 
 
 def load_scene(path: str | Path) -> PourScene:
-    """Read a scene TOML file; any problem is one InputError line naming the file and the field. Arm files
-    (``arms.*.mjcf``) given by a relative path are taken from the scene file's folder."""
+    """Read a scene TOML file; any problem is one InputError line naming the file and the field. Files it names by a
+    relative path (``arms.*.mjcf``, ``vessels.*.mesh``, ``robots.scene``) are taken from the scene file's folder."""
     path = Path(path)
     table = read_toml_file(path, "scene file")
     for vessel in table.get("vessels", {}).values() if isinstance(table.get("vessels"), dict) else ():
         if isinstance(vessel, dict) and isinstance(vessel.get("mesh"), str) and vessel["mesh"]:
             vessel["mesh"] = str((path.parent / vessel["mesh"]).resolve())  # relative to the scene file (an absolute path stays)
+    robots = table.get("robots")
+    if isinstance(robots, dict) and isinstance(robots.get("scene"), str) and robots["scene"]:
+        robots["scene"] = str((path.parent / robots["scene"]).resolve())  # as the meshes
     try:
         scene = from_mapping(PourScene, table, "scene")
     except InputError as exc:

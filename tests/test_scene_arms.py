@@ -186,6 +186,24 @@ def test_scene_check_and_pour_refuse_a_bad_arm_with_the_same_line(case, tmp_path
     assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml"]  # nothing written
 
 
+def test_an_arm_whose_flange_site_is_on_an_unnamed_body_is_refused_by_name(tmp_path, capsys, monkeypatch):
+    # the vessel's mount is built on that body by its name: MuJoCo's own error was a traceback
+    monkeypatch.chdir(tmp_path)
+    arm = SMALL_ARM.read_text().replace('<body name="link_6" ', "<body ")
+    (tmp_path / "unnamed_flange.xml").write_text(arm)
+    (tmp_path / "scene.toml").write_text(_example_with(f"mjcf = {json.dumps(str(tmp_path / 'unnamed_flange.xml'))}"))
+    checked = refusal(capsys, ["scene", "--check", "scene.toml"], "scene")
+    assert re.search(rf"^{ARM}\.flange_site: the body that holds site 'tool0' in .*unnamed_flange\.xml has no name", checked.removeprefix("scene.toml: ")), checked
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scene.toml", "unnamed_flange.xml"]
+
+
+def test_an_ik_seed_alone_is_what_a_home_posture_in_collision_is_blamed_on(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "scene.toml").write_text("[arms.pour]\nhome_seed = [-1.0, -1.0, -1.0, -1.0, -1.0, -1.0]\n")
+    checked = refusal(capsys, ["scene", "--check", "scene.toml"], "scene")
+    assert checked.removeprefix("scene.toml: ").startswith("arms.pour.home_seed: the vessels at home: "), checked
+
+
 def test_the_bundled_arm_refuses_a_user_arms_mapping():
     with pytest.raises(InputError, match=r"^arms\.catch\.joints: the bundled UR10e brings its own; set arms\.catch\.mjcf"):
         ArmsSettings(catch=ArmSettings(joints=JOINTS))

@@ -48,6 +48,10 @@ REFUSED = {
                                         "bottom middle (controller.cfs.max_tilt 100 deg): pourer/front (pourer) touches catcher/back (catcher)"),
     "vessels with a scene file": ("[robots]\nscene = 'my_scene.xml'\n[vessels.pourer]\ninner_width = 0.1\n",
                                   "robots.scene: a scene file brings its own vessels and placement"),
+    # taken from the scene file's folder, and named
+    "a scene file that is not there": ("[robots]\nscene = 'my_scene.xml'\n", "robots.scene: scene "),
+    "a trajectory of fewer than two samples": ("[trajectory]\nsample_rate_hz = 1e-9\n", "trajectory.sample_rate_hz: must give "
+                                               "at least 2 samples over coupling.max_duration = 60 s, >= 0.0166667 Hz; got 1e-09"),
 }
 
 
@@ -96,3 +100,12 @@ def test_pour_prints_the_checks_particle_count_and_estimate_before_its_first_ste
     assert checked[1].startswith(f"walls: real_thickness, {depth * 1e3:.1f} mm of dummy layers for the pourer's 5.0 mm wall")
     assert summary["walls"]["pourer"] == {"wall_model": "real_thickness", "lip_outside_real_m": pytest.approx(depth - 0.005)}
     assert checked[0].startswith(f"{summary['particles']} liquid particles (2-D")  # exact for a box in 2-D
+
+
+def test_a_relative_robots_scene_is_taken_from_the_scene_files_folder(tmp_path, monkeypatch):
+    from cosim.pour_scene import load_scene
+
+    (tmp_path / "cell").mkdir()
+    (tmp_path / "cell" / "scene.toml").write_text("[robots]\nscene = 'my_scene.xml'\n")
+    monkeypatch.chdir(tmp_path)
+    assert load_scene("cell/scene.toml").robots.scene == str(tmp_path / "cell" / "my_scene.xml")

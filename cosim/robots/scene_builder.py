@@ -124,8 +124,12 @@ def _check_mapping(alone: mujoco.MjModel, placement: ArmPlacement, path: Path) -
             raise InputError(f"{field}.joints: no joint {joint!r} in {path}")
         if int(alone.jnt_type[jid]) not in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
             raise InputError(f"{field}.joints: {joint!r} is not a hinge or slide joint")
-    if mujoco.mj_name2id(alone, mujoco.mjtObj.mjOBJ_SITE, placement.arm.flange_site) < 0:
+    site = mujoco.mj_name2id(alone, mujoco.mjtObj.mjOBJ_SITE, placement.arm.flange_site)
+    if site < 0:
         raise InputError(f"{field}.flange_site: no site {placement.arm.flange_site!r} in {path}")
+    if not alone.body(int(alone.site_bodyid[site])).name:  # the vessel's mount is built on that body, by its name
+        raise InputError(f"{field}.flange_site: the body that holds site {placement.arm.flange_site!r} in {path} has no name; "
+                         "give it one")
 
 
 def _joint_actuators(alone: mujoco.MjModel, joint_id: int) -> list[str]:
