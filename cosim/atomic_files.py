@@ -51,11 +51,12 @@ def check_output_folder(path: str | os.PathLike, field: str, name_extra: int = 0
     as they are written)."""
     target = Path(path)
     existing, missing = target, []
-    while not os.path.exists(existing) and existing != existing.parent:  # os.path: False for a name too long, no error
+    while not os.path.lexists(existing) and existing != existing.parent:  # os.path: False for a name too long, no error
         missing.append(existing.name)
         existing = existing.parent
-    if not existing.is_dir():
-        raise InputError(f"{field}: {existing} is a file, not a folder")
+    if not os.path.isdir(existing):
+        what = "a file" if os.path.exists(existing) else "a broken link"
+        raise InputError(f"{field}: {existing} is {what}, not a folder")
     name_max = _path_limit(existing, "PC_NAME_MAX", 255)
     for k, name in enumerate(missing):
         allowed = name_max - (name_extra if k == 0 else 0)

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import functools
 import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -305,6 +306,6 @@ def load_vessel_mesh(path: str | Path, pour_direction: float = 0.0, field_name: 
     """The vessel mesh in ``path`` (OBJ or STL, metres, opening up), its pour direction ``pour_direction`` deg about
     +z from the file's +x. Raises InputError naming ``field_name`` for a missing or unreadable file, a bounding box
     outside :data:`MESH_SIZE_RANGE` (units), a mesh that is not watertight, or one without an opening."""
-    path = Path(path).resolve()
-    mtime = path.stat().st_mtime if path.is_file() else 0.0
+    path = Path(os.path.abspath(path))
+    mtime = os.stat(path).st_mtime if os.path.isfile(path) else 0.0  # os.path: False for a name too long or a loop
     return _cached(str(path), float(pour_direction), mtime, field_name)

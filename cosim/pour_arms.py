@@ -17,6 +17,7 @@ limits (:func:`joint_limit_overrides`), under a scene's ``trajectory.limits``, w
 from __future__ import annotations
 
 import dataclasses
+import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -171,7 +172,7 @@ class ArmSettings:
         """These settings with a relative :attr:`mjcf` taken from ``folder`` (the scene file's)."""
         if not self.is_user_arm or Path(self.mjcf).is_absolute():
             return self
-        return replace(self, mjcf=str((folder / self.mjcf).resolve()))
+        return replace(self, mjcf=os.path.abspath(folder / self.mjcf))
 
     def limit_overrides(self, arm: str, joints: tuple[str, ...]) -> dict[str, JointLimitOverride]:
         """Per joint (``<arm>/<joint>``, ``joints`` the scene's full names), the acceleration and jerk limits these

@@ -282,8 +282,8 @@ def check_pour(scene: PourScene, long_run_ok: bool = False) -> PourPlan:
                          "(install it, or run without the recording: --no-log or logging.enabled = false)")
     if scene.trajectory.sample_rate_hz * scene.coupling.max_duration < 1.0:  # the exported trajectory's two samples
         raise InputError(f"trajectory.sample_rate_hz: must give at least 2 samples over coupling.max_duration = "
-                         f"{scene.coupling.max_duration:g} s, >= {1.0 / scene.coupling.max_duration:.6g} Hz; got "
-                         f"{scene.trajectory.sample_rate_hz:g}")
+                         f"{scene.coupling.max_duration:g} s (cosim pour --duration), >= {1.0 / scene.coupling.max_duration:.6g} "
+                         f"Hz, or a longer run; got {scene.trajectory.sample_rate_hz:g}")
     device = resolve_device(scene.device)
     robots = robot_scene(scene)
     pourer = robots.arms[ArmRole.POUR].vessel

@@ -11,6 +11,7 @@ base pose, its grasp; :mod:`cosim.pour_arms`), ``robots`` (a MuJoCo scene file i
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -397,10 +398,10 @@ def load_scene(path: str | Path) -> PourScene:
     table = read_toml_file(path, "scene file")
     for vessel in table.get("vessels", {}).values() if isinstance(table.get("vessels"), dict) else ():
         if isinstance(vessel, dict) and isinstance(vessel.get("mesh"), str) and vessel["mesh"]:
-            vessel["mesh"] = str((path.parent / vessel["mesh"]).resolve())  # relative to the scene file (an absolute path stays)
+            vessel["mesh"] = os.path.abspath(path.parent / vessel["mesh"])  # relative to the scene file (an absolute path stays)
     robots = table.get("robots")
     if isinstance(robots, dict) and isinstance(robots.get("scene"), str) and robots["scene"]:
-        robots["scene"] = str((path.parent / robots["scene"]).resolve())  # as the meshes
+        robots["scene"] = os.path.abspath(path.parent / robots["scene"])  # as the meshes
     try:
         scene = from_mapping(PourScene, table, "scene")
     except InputError as exc:

@@ -88,6 +88,24 @@ def test_a_name_too_long_for_the_file_system_is_one_line_exit_2_and_nothing_writ
     assert _files(tmp_path) == []
 
 
+def test_an_output_path_that_is_a_link_loop_is_refused_before_the_work(tmp_path, capsys):
+    # it exists as a name but is no folder: the pour ran to its end and failed at its rename before
+    (tmp_path / "a").symlink_to(tmp_path / "b")
+    (tmp_path / "b").symlink_to(tmp_path / "a")
+    before = _files(tmp_path)
+    assert main(["pour", "--out", str(tmp_path / "a"), "--quiet", "--no-log", "--duration", "0.01"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"cosim pour: error: --out: {tmp_path / 'a'} is a broken link, not a folder"]
+    assert _files(tmp_path) == before
+
+
+def test_an_input_path_the_system_refuses_is_one_line_exit_2(tmp_path, capsys):
+    # an OSError about a path the user gave (here a name too long to look up) is bad input, not a traceback
+    assert main(["view", "--print-only", str(tmp_path / LONG)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("cosim view: error: [Errno ") and "File name too long" in err[0], err
+
+
 def test_a_scene_name_too_long_for_a_run_folder_is_refused_and_a_long_file_name_is_cut(tmp_path):
     from cosim.pour_scene import MAX_NAME_LENGTH, PourScene
 

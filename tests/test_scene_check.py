@@ -51,7 +51,7 @@ REFUSED = {
     # taken from the scene file's folder, and named
     "a scene file that is not there": ("[robots]\nscene = 'my_scene.xml'\n", "robots.scene: scene "),
     "a trajectory of fewer than two samples": ("[trajectory]\nsample_rate_hz = 1e-9\n", "trajectory.sample_rate_hz: must give "
-                                               "at least 2 samples over coupling.max_duration = 60 s, >= 0.0166667 Hz; got 1e-09"),
+                                               "at least 2 samples over coupling.max_duration = 60 s (cosim pour --duration), >= 0.0166667 Hz, or a longer run; got 1e-09"),
 }
 
 

@@ -95,13 +95,15 @@ def _sigterm_unwinds() -> Iterator[None]:
 
 
 def exit_status(exc: Exception) -> int | None:
-    """2 for bad input, 1 for a simulation that broke, None for anything else (a bug: raised). The controllers'
-    errors are looked up only where their package is loaded already (nothing else can have raised one), so that
-    refusing an option does not import it and NumPy with it."""
+    """2 for bad input (an OSError about a path among it), 1 for a simulation that broke, None for anything else (a
+    bug: raised). The controllers' errors are looked up only where their package is loaded already (nothing else can
+    have raised one), so that refusing an option does not import it and NumPy with it."""
     if isinstance(exc, InputError):
         return 2
     if isinstance(exc, SimulationError):
         return 1
+    if isinstance(exc, OSError) and exc.filename is not None:  # a path given that the system refuses (too long, a
+        return 2  # link loop, not readable, ...): its own one line names it
     errors = sys.modules.get("controllers.errors")
     if errors is not None and isinstance(exc, errors.ControllerInputError):
         return 2
