@@ -73,6 +73,8 @@ def test_axes_set_their_keys_on_the_base_scene_file(tmp_path):
     ({"axes": {"liquid.fill_depth": {"start": 0.1, "stop": 0.2, "num": 0}}}, "axes.liquid.fill_depth.num: must be in [1, 100000]"),
     ({"axes": {"liquid.fill_depth": {"uniform": [0.2, 0.1], "samples": 2}}}, "axes.liquid.fill_depth.uniform: lo must be below hi"),
     ({"axes": {"liquid.fill_depth": {"uniform": [0.1, 0.2]}}}, "axes.liquid.fill_depth.samples: a uniform axis in mode 'grid'"),
+    ({"axes": {"liquid.fill_depth": {"uniform": [-1e308, 1e308], "samples": 2}}}, "axes.liquid.fill_depth.uniform: hi - lo must be a finite number"),
+    ({"axes": {"liquid.fill_depth": {"start": -1e308, "stop": 1e308, "num": 3}}}, "axes.liquid.fill_depth: stop - start must be a finite number"),
     ({"mode": "sample", "axes": {"liquid.fill_depth": [0.1]}}, "samples: mode 'sample' needs the number of pours"),
     ({"mode": "grid", "samples": 3, "axes": {"liquid.fill_depth": [0.1]}}, "samples: only in mode 'sample'"),
     ({"mode": "random", "axes": {"liquid.fill_depth": [0.1]}}, "mode: must be one of 'grid', 'sample'"),

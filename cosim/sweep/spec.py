@@ -118,6 +118,8 @@ def _range_values(field: str, table: dict) -> tuple:
     :data:`RANGE_DIGITS` significant digits (0.11, not 0.11000000000000001, as a user would write it)."""
     start, stop = _number(f"{field}.start", table["start"]), _number(f"{field}.stop", table["stop"])
     num = POURS.check(f"{field}.num", table["num"])
+    if not math.isfinite(float(stop) - float(start)):  # the evenly spaced values need the width itself finite
+        raise InputError(f"{field}: stop - start must be a finite number, got {start:g} to {stop:g}")
     if num == 1:
         return (start,)
     if isinstance(start, int) and isinstance(stop, int) and (stop - start) % (num - 1) == 0:
@@ -134,6 +136,8 @@ def _uniform_interval(field: str, bounds: Any) -> tuple[float, float]:
     lo, hi = (float(_number(f"{field}.uniform[{k}]", b)) for k, b in enumerate(bounds))
     if not lo < hi:
         raise InputError(f"{field}.uniform: lo must be below hi, got [{lo:g}, {hi:g}]")
+    if not math.isfinite(hi - lo):  # numpy's draw needs the width itself finite
+        raise InputError(f"{field}.uniform: hi - lo must be a finite number, got [{lo:g}, {hi:g}]")
     return lo, hi
 
 
