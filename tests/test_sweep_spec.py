@@ -3,6 +3,7 @@ and the resources a pour asks Ray for. No Ray, no pour."""
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -122,6 +123,18 @@ def test_cli_without_the_cluster_it_names_writes_nothing(tmp_path, capsys, monke
     path.write_text('[axes]\n"liquid.fill_depth" = [0.1]\n')
     assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--address", "auto"]) == 2
     assert capsys.readouterr().err.startswith("cosim sweep: error: --address: no Ray cluster at auto (")
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_refuses_a_head_address_where_nothing_listens_at_once(tmp_path, capsys):
+    # Ray's own client retries such an address for minutes, logging each try
+    path = tmp_path / "s.toml"
+    path.write_text('[axes]\n"liquid.fill_depth" = [0.1]\n')
+    start = time.perf_counter()
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out"), "--address", "127.0.0.1:1"]) == 2
+    assert time.perf_counter() - start < 30.0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("cosim sweep: error: --address: no Ray cluster at 127.0.0.1:1 (nothing accepts"), err
     assert not (tmp_path / "out").exists()
 
 

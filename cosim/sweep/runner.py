@@ -11,6 +11,7 @@ the sweep runs the pour again.
 from __future__ import annotations
 
 import logging
+import socket
 import warnings
 from collections import deque
 from pathlib import Path
@@ -69,6 +70,20 @@ def failure_record(pour: PlannedPour, exc: BaseException) -> dict:
     return {"axes": pour.point.axes, **failure(exc)}
 
 
+CONNECT_TIMEOUT = 5.0  # s: a Ray head answers a TCP connection at once; Ray's own client retries for minutes
+
+
+def check_listening(address: str) -> None:
+    """Refuse a 'HOST:PORT' ``address`` at which nothing accepts a TCP connection within :data:`CONNECT_TIMEOUT`
+    (Ray would retry it for minutes, logging each try)."""
+    host, _, port = address.rpartition(":")
+    try:
+        socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT).close()
+    except (OSError, ValueError) as exc:
+        raise InputError(f"--address: no Ray cluster at {address} (nothing accepts a connection there: "
+                         f"{getattr(exc, 'strerror', None) or exc})") from None
+
+
 def connect(address: str | None) -> bool:
     """Join the Ray cluster at ``address`` ('auto': the one started on this machine with ``ray start``), or start a
     local one on this machine's cores when None; nothing when this process is connected already. Returns whether it
@@ -77,6 +92,8 @@ def connect(address: str | None) -> bool:
 
     if ray.is_initialized():
         return False
+    if address and address != "auto" and not address.startswith("ray://"):
+        check_listening(address)
     # Ray Client logs the settings it passes to the server and warns of a timeout before it raises it: the outcome
     # is this function's one line
     client_log = logging.getLogger("ray.client_builder")
