@@ -1,5 +1,5 @@
-"""Sweep files: axes (lists, ranges, uniform draws), grid and sample expansion, refused keys and values; pour keys
-and the resources a pour asks Ray for. No Ray, no pour."""
+"""Sweep files: axes (lists, ranges, uniform draws), grid and sample expansion, refused keys and values; refused
+cluster addresses; pour keys and the resources a pour asks Ray for. No Ray cluster is started and no pour runs."""
 
 from __future__ import annotations
 
