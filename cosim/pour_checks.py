@@ -2,8 +2,7 @@
 
 :func:`check_pour` refuses a scene (one :class:`InputError` line naming the field) or returns a :class:`PourPlan`:
 the robot scene, the joint limits, the liquid's configuration, its particle counts, its memory and an estimate of
-the run's wall time. Checked, in order: Rerun present when the recording is on; the exported trajectory's sample
-rate against the run's length; the device; the robot scene (the
+the run's wall time. Checked, in order: Rerun present when the recording is on; the device; the robot scene (the
 scene file, or the cell of the scene's vessels and arms, their home postures solved); the fill below the
 pourer's rim; the catcher holding what is poured; the catcher above the table; each arm's load against its rated
 payload; the joint-limit overrides; the arms' reach over the pour's poses, free of collisions (:func:`check_reach`);
@@ -280,10 +279,6 @@ def check_pour(scene: PourScene, long_run_ok: bool = False) -> PourPlan:
     if scene.logging.enabled and find_spec("rerun") is None:
         raise InputError("logging.enabled: the Rerun recording needs rerun-sdk, which is not installed "
                          "(install it, or run without the recording: --no-log or logging.enabled = false)")
-    if scene.trajectory.sample_rate_hz * scene.coupling.max_duration < 1.0:  # the exported trajectory's two samples
-        raise InputError(f"trajectory.sample_rate_hz: must give at least 2 samples over coupling.max_duration = "
-                         f"{scene.coupling.max_duration:g} s (cosim pour --duration), >= {1.0 / scene.coupling.max_duration:.6g} "
-                         f"Hz, or a longer run; got {scene.trajectory.sample_rate_hz:g}")
     device = resolve_device(scene.device)
     robots = robot_scene(scene)
     pourer = robots.arms[ArmRole.POUR].vessel

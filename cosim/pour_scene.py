@@ -365,6 +365,10 @@ class PourScene:
         if len(self.name) > MAX_NAME_LENGTH:
             raise InputError(f"scene.name: at most {MAX_NAME_LENGTH} characters (it names the run folder), got {len(self.name)}")
         check_device("scene.device", self.device)
+        if self.trajectory.sample_rate_hz * self.coupling.max_duration < 1.0:  # the exported trajectory's two samples
+            raise InputError(f"trajectory.sample_rate_hz: must give at least 2 samples over coupling.max_duration = "
+                             f"{self.coupling.max_duration:g} s (cosim pour --duration), >= "
+                             f"{1.0 / self.coupling.max_duration:.6g} Hz, or a longer run; got {self.trajectory.sample_rate_hz:g}")
         if self.robots.scene and self.cell_config() is not None:
             raise InputError("robots.scene: a scene file brings its own vessels and placement, and its arms; leave [vessels], "
                              "[placement] and [arms] at their defaults with it, or leave robots.scene out")

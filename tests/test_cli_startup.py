@@ -75,6 +75,15 @@ def test_a_refused_scene_file_loads_not_even_numpy(command, wrong, tmp_path):
     assert status == "2" and loaded == []
 
 
+def test_a_sample_rate_under_two_samples_is_refused_without_numpy(tmp_path):
+    """A check across two sections (the trajectory's rate against the run's length) is the scene's own, not the
+    pour checks' that load the numerics."""
+    path = tmp_path / "rate.toml"
+    path.write_text("[trajectory]\nsample_rate_hz = 1e-9\n")
+    status, *loaded = _probe(["scene", "--check", str(path)], ("numpy",))
+    assert status == "2" and loaded == []
+
+
 def test_the_controllers_package_gives_each_public_name_from_its_module():
     import importlib
 
