@@ -74,9 +74,10 @@ CONNECT_TIMEOUT = 5.0  # s: a Ray head answers a TCP connection at once; Ray's o
 
 
 def check_listening(address: str) -> None:
-    """Refuse a 'HOST:PORT' ``address`` at which nothing accepts a TCP connection within :data:`CONNECT_TIMEOUT`
-    (Ray would retry it for minutes, logging each try)."""
-    host, _, port = address.rpartition(":")
+    """Refuse a '[ray://]HOST:PORT' ``address`` (a head's, or a Ray Client server's) at which nothing accepts a TCP
+    connection within :data:`CONNECT_TIMEOUT` (Ray retries a head's address for minutes, logging each try; Ray Client
+    waits 30 s)."""
+    host, _, port = address.removeprefix("ray://").rpartition(":")
     try:
         socket.create_connection((host, int(port)), timeout=CONNECT_TIMEOUT).close()
     except (OSError, ValueError) as exc:
@@ -92,7 +93,7 @@ def connect(address: str | None) -> bool:
 
     if ray.is_initialized():
         return False
-    if address and address != "auto" and not address.startswith("ray://"):
+    if address and address != "auto":
         check_listening(address)
     # Ray Client logs the settings it passes to the server and warns of a timeout before it raises it: the outcome
     # is this function's one line
