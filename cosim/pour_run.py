@@ -173,10 +173,11 @@ def run_pour(scene: PourScene, out: Path | None = None, progress: bool = True, l
     with ``progress``, their particle counts and run-time estimate are printed before the first step.
     ``identify_plant``: see :func:`prepare`."""
     field = "--out" if out is not None else "--out (default recordings/)"
-    if out is not None:
-        check_output_folder(out, field, PARTIAL_NAME_EXTRA)  # a name too long refused before anything looks it up
+    if out is not None:  # before destination() looks it up: a name too long is refused, not an OSError
+        check_output_folder(out, field, PARTIAL_NAME_EXTRA)
     final = destination(out, scene.run_name)
-    check_output_folder(final, field, PARTIAL_NAME_EXTRA)
+    if out is None:  # the new folder under recordings/
+        check_output_folder(final, field, PARTIAL_NAME_EXTRA)
     plan = check_pour(scene, long_run_ok)
     if progress:
         print(plan.summary(), file=sys.stderr, flush=True)
