@@ -1,15 +1,17 @@
-"""Imported by pytest before any test module: pins numpy's OpenBLAS kernels before numpy is loaded
-(cosim.reproducibility), as the cosim command does."""
+"""Imported by pytest before any test module: pins numpy's OpenBLAS kernels and keeps it on one thread before numpy
+is loaded (cosim.reproducibility, cosim.blas_threads), as the cosim command does."""
 
 import math
 
 import pytest
 
+from cosim.blas_threads import limit_openblas_threads
 from cosim.reproducibility import pin_openblas_core
 
 pin_openblas_core()
+limit_openblas_threads()
 
-from cosim.robots.scene import RobotScene  # noqa: E402  (after the OpenBLAS pin)
+from cosim.robots.scene import RobotScene  # noqa: E402  (after the OpenBLAS settings)
 from cosim.trajectory.pour_motion import Pivot, PourMotionSpec  # noqa: E402
 from cosim.trajectory.scripted import ScriptedRun, generate_scripted, pour_poses  # noqa: E402
 

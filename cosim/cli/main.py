@@ -23,6 +23,7 @@ from typing import Iterator, NoReturn
 
 from cosim import __version__
 from cosim.errors import InputError, SimulationError
+from cosim.blas_threads import limit_openblas_threads
 from cosim.reproducibility import pin_openblas_core
 
 # Subcommands, in the order `cosim --help` lists them: name -> (its module, the line `cosim --help` shows).
@@ -113,7 +114,8 @@ def exit_status(exc: Exception) -> int | None:
 
 
 def main(argv: list[str] | None = None) -> int:
-    pin_openblas_core()  # before any subcommand imports numpy
+    pin_openblas_core()  # both before any subcommand imports numpy
+    limit_openblas_threads()
     argv = sys.argv[1:] if argv is None else argv
     parser = build_parser(requested_command(argv))
     args = parser.parse_args(argv)
