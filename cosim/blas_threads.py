@@ -1,11 +1,11 @@
 """numpy's OpenBLAS on one thread, set before numpy loads.
 
-OpenBLAS starts a worker thread per core beside the caller's. Its LU back-substitution (``getrs``, under
-``numpy.linalg.solve`` and ``scipy.linalg``) hands its right-hand sides to the workers whatever the matrix's size, so
-every solve of the IK's 6 x 6 system wakes a worker, waits for it, and leaves it spinning for its next call, on the
-cores the liquid's solver lanes run on (``cosim.fluid.lanes``). The pour's matrices are a few rows by a few columns:
-no call in it is large enough to gain from a second thread. With one thread a ``getrs`` of one right-hand side runs
-the same arithmetic (the default pour's trajectory is the same to the byte; measured in docs/performance.md).
+OpenBLAS starts a worker thread per core beside the caller's. It hands the LU back-substitution of
+``numpy.linalg.solve`` (``getrs``) to its workers even for a 6 x 6 system, so every solve of the IK wakes a worker,
+waits for it, and leaves the workers spinning for their next call on the cores the liquid's solver lanes run on
+(``cosim.fluid.lanes``). The pour's matrices are a few rows by a few columns: no call in it gains from a second
+thread. The workers split the right-hand sides among them, and each one's back-substitution is the same arithmetic
+on one thread (docs/performance.md).
 
 Like the kernels' pin (:mod:`cosim.reproducibility`) this only works before numpy is first imported (OpenBLAS reads
 the variable once, when it loads), so the ``cosim`` command and the test suite's ``conftest.py`` call
