@@ -22,8 +22,8 @@ import threading
 from typing import Iterator, NoReturn
 
 from cosim import __version__
-from cosim.errors import InputError, SimulationError
 from cosim.blas_threads import limit_openblas_threads
+from cosim.errors import InputError, SimulationError
 from cosim.reproducibility import pin_openblas_core
 
 # Subcommands, in the order `cosim --help` lists them: name -> (its module, the line `cosim --help` shows).
